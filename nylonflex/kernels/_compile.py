@@ -1,0 +1,68 @@
+"""Compile options, and the Numba compilation of the physics layer's formulas.
+
+The physics modules mark their small pure functions with ``@formula`` and never import
+Numba. :func:`jit_formula` compiles such a function *and every formula it calls*: it
+rebuilds the function over a copy of its globals in which each called formula is replaced
+by its compiled twin, then hands it to ``numba.njit``. One formula, one place; both layers
+run the same source lines.
+"""
+
+from __future__ import annotations
+
+import os
+import types
+
+import numba
+
+#: Options of every kernel. ``cache`` writes compiled code beside the sources so a second
+#: run starts warm; ``fastmath`` stays off: the kernels must match the physics to 1e-9.
+JIT_OPTIONS = {"cache": os.environ.get("NYLONFLEX_NO_CACHE") is None, "nogil": True,
+               "error_model": "numpy", "fastmath": False}
+
+_COMPILED: dict[types.FunctionType, numba.core.registry.CPUDispatcher] = {}
+
+
+def is_formula(obj) -> bool:
+    """True for a function marked with the physics layer's ``@formula``."""
+    return isinstance(obj, types.FunctionType) and getattr(obj, "__nylonflex_formula__", False)
+
+
+def jit_formula(func):
+    """The Numba-compiled twin of a physics ``@formula`` (memoised)."""
+    if func in _COMPILED:
+        return _COMPILED[func]
+    if not is_formula(func):
+        raise TypeError(f"{func.__qualname__} is not a physics @formula")
+    namespace = dict(func.__globals__)
+    for name in func.__code__.co_names:
+        if is_formula(namespace.get(name)):
+            namespace[name] = jit_formula(namespace[name])
+    clone = types.FunctionType(func.__code__, namespace, func.__name__, func.__defaults__,
+                               func.__closure__)
+    clone.__module__ = func.__module__
+    clone.__qualname__ = func.__qualname__
+    clone.__doc__ = func.__doc__
+    _COMPILED[func] = numba.njit(**JIT_OPTIONS)(clone)
+    return _COMPILED[func]
+
+
+def jit_kernel(func=None, *, parallel=False):
+    """``njit`` a kernel whose body calls physics formulas by their module-level names.
+
+    Formulas referenced as globals of ``func`` are swapped for their compiled twins the same
+    way :func:`jit_formula` does, so a kernel module can simply import them from physics.
+    """
+
+    def wrap(f):
+        namespace = dict(f.__globals__)
+        for name in f.__code__.co_names:
+            if is_formula(namespace.get(name)):
+                namespace[name] = jit_formula(namespace[name])
+        clone = types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__,
+                                   f.__closure__)
+        clone.__module__ = f.__module__
+        clone.__qualname__ = f.__qualname__ + ("_parallel" if parallel else "")
+        clone.__doc__ = f.__doc__
+        return numba.njit(parallel=parallel, **JIT_OPTIONS)(clone)
+
+    return wrap if func is None else wrap(func)

@@ -1,0 +1,346 @@
+"""Named, cited material parameter sets (MODEL.md section 9).
+
+Each set is a plain dict of SI values beside a ``sources`` dict that says where every
+value comes from, tagged as MODEL.md does:
+
+- ``S`` read in a source,
+- ``D`` derived,
+- ``P`` a proposal,
+- ``K`` calibrated.
+
+A config or a caller picks a set by name and may override any field
+(:func:`silicone_parameters`, :func:`nylon_parameters`). The returned parameters are
+frozen :class:`Silicone` and :class:`Nylon` objects that the physics functions take.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any, Mapping
+
+import numpy as np
+
+ZERO_CELSIUS = 273.15  # [K]
+
+__all__ = [
+    "NYLON_PARAMETERS",
+    "SILICONE_PARAMETERS",
+    "Nylon",
+    "Silicone",
+    "nylon_parameters",
+    "silicone_parameters",
+]
+
+#: Ogden sets in the paper's convention (eq. 5): W = sum mu_i/alpha_i (l1^a + l2^a + l3^a - 3).
+#: ``mu`` [Pa], ``alpha`` [-].
+SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
+    "tc5005": {
+        "mu": (56.19e3, 10.49e3),
+        "alpha": (0.2975, 2.770),
+        "description": "BJB TC-5005 (the paper's silicone), stand-in fit",
+        "sources": {
+            "mu": "D/P: no TC-5005 data is published; Ogden N=2 fit (stretch <= 4) to the raw "
+            "tensile data of Ecoflex 00-50, the nearest hardness class, Marechal et al., "
+            "Soft Robotics 2021 (Soft-Robotics-Materials-Database)",
+            "alpha": "D/P: same fit",
+        },
+    },
+    "ecoflex_00_30": {
+        "mu": (16.11e3, -0.3231e3),
+        "alpha": (1.977, -8.149),
+        "description": "Smooth-On Ecoflex 00-30",
+        "sources": {
+            "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
+            "alpha": "D: same fit",
+        },
+    },
+    "dragon_skin_10": {
+        "mu": (30.30e3, -1.620e3),
+        "alpha": (2.970, -6.266),
+        "description": "Smooth-On Dragon Skin 10",
+        "sources": {
+            "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
+            "alpha": "D: same fit",
+        },
+    },
+    "elastosil_m4601": {
+        "mu": (220e3, 0.0),
+        "alpha": (2.0, 1.0),
+        "description": "Wacker Elastosil M4601 (neo-Hookean)",
+        "sources": {
+            "mu": "D: neo-Hookean equal to Yeoh C1 = 0.11 MPa, Polygerinos et al., "
+            "IEEE T-RO 31(3):778, 2015",
+            "alpha": "D: neo-Hookean (alpha = 2)",
+        },
+    },
+}
+
+#: Self-coiled silver-coated nylon 6,6 thread, SI units (temperatures in K). ``alpha`` keeps
+#: the paper's eq. (2) convention of a temperature in degC; it cancels from the stroke.
+NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
+    "silver_nylon66": {
+        "fibre_diameter": 0.34e-3,
+        "stroke_reference": 0.10,
+        "alpha": -0.04341,
+        "gamma": 1.951e-4,
+        "beta": 0.04944,
+        "t_g": 118.6 + ZERO_CELSIUS,
+        "sigma_g": 41.3,
+        "t_amb": 25.0 + ZERO_CELSIUS,
+        "t_max": 150.0 + ZERO_CELSIUS,
+        "resistance_per_length": 150.0,
+        "heat_capacity_per_length": 0.45,
+        "heat_loss_per_length": 0.03,
+        "stiffness": 16.0,
+        "damping": 0.1,
+        "thermal_force_coefficient": 2e-3,
+        "coil_index_table": (1.1, 1.3, 1.5, 1.7),
+        "stroke_max_table": (0.054, 0.068, 0.083, 0.097),
+        "tensile_strength_table": (100e6, 85e6, 73e6, 65e6),
+        "description": "silver-coated nylon 6,6 sewing thread, self-coiled",
+        "sources": {
+            "fibre_diameter": "S: Sun et al., Soft Robotics 2021 (Shieldex 4-ply after twisting)",
+            "stroke_reference": "P: 10 % for self-coiled conductive thread (Yip & Niemeyer "
+            "2015; Haines et al. 2014, movie S4)",
+            "alpha": "D: fit of the eq. (2) form to coiled-nylon stroke data (Kianzad et al., "
+            "SPIE 2015), scaled to stroke_reference",
+            "gamma": "D: same fit",
+            "beta": "D: same fit",
+            "t_g": "D: same fit; an effective activation centre, not the DSC glass transition",
+            "sigma_g": "D: same fit",
+            "t_amb": "P: room temperature",
+            "t_max": "P: below the 160-200 degC annealing temperature",
+            "resistance_per_length": "S: the paper, 0.15 ohm/mm",
+            "heat_capacity_per_length": "D: rho = 1300 kg/m3, c_p = 1267 J/(kg K) (Sun et al., "
+            "IROS 2018) for a coiled 4-ply thread",
+            "heat_loss_per_length": "P: wound on silicone, one side insulated; with 12 V on a "
+            "0.5 m muscle it settles near t_max",
+            "stiffness": "P: order of magnitude for a 60 mm self-coiled thread",
+            "damping": "P: same",
+            "thermal_force_coefficient": "P: same",
+            "stroke_max_table": "K: calibrated on the paper's two worked examples (section 4), "
+            "linear in coil index between 1.1 and 1.7",
+            "tensile_strength_table": "P: about 100 MPa at C = 1.1 (1 kg on a 0.34 mm thread, "
+            "Cho et al. via Sun et al. 2021), falling as 1/C",
+            "coil_index_table": "MODEL.md section 9",
+        },
+    },
+}
+
+
+@dataclass(frozen=True)
+class Silicone:
+    """Incompressible Ogden silicone, paper's eq. (5) convention.
+
+    Attributes
+    ----------
+    mu : tuple of float
+        Ogden moduli mu_i [Pa].
+    alpha : tuple of float
+        Ogden exponents alpha_i [-].
+    name : str
+        Name of the set it came from (with overrides, ``"<set>+override"``).
+    """
+
+    mu: tuple[float, ...]
+    alpha: tuple[float, ...]
+    name: str = "custom"
+    description: str = ""
+    sources: Mapping[str, str] = field(default_factory=dict, compare=False)
+
+    @property
+    def initial_shear_modulus(self) -> float:
+        """Initial shear modulus mu_0 = 1/2 sum mu_i alpha_i [Pa]."""
+        return 0.5 * sum(m * a for m, a in zip(self.mu, self.alpha))
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(mu, alpha)`` as float64 arrays, the form the formula functions take."""
+        return np.asarray(self.mu, dtype=float), np.asarray(self.alpha, dtype=float)
+
+
+@dataclass(frozen=True)
+class Nylon:
+    """Coiled nylon muscle parameters (MODEL.md section 9), SI except the eq. (2) shape.
+
+    Attributes
+    ----------
+    fibre_diameter : float
+        Diameter of the (twisted) fibre d_f [m].
+    stroke_reference : float
+        Nominal free stroke of the reference shape at ``t_max`` [-].
+    alpha, gamma, beta : float
+        Reference eq. (2) constants [-], [1/K], [-] (``alpha`` for a temperature in degC).
+    t_g, sigma_g : float
+        Effective activation centre [K] and width [K] of eq. (2).
+    t_amb, t_max : float
+        Ambient and highest safe temperature [K].
+    resistance_per_length : float
+        Electrical resistance per muscle length r' [ohm/m].
+    heat_capacity_per_length : float
+        Heat capacity per muscle length c' [J/(K m)].
+    heat_loss_per_length : float
+        Heat loss coefficient per muscle length lambda' [W/(K m)].
+    stiffness, damping, thermal_force_coefficient : float
+        Eq. (1) constants k [N/m], b_d [N s/m], c [N/K].
+    coil_index_table, stroke_max_table, tensile_strength_table : tuple of float
+        Coil index C [-], its maximum stroke s_max [-] and tensile strength sigma_u [Pa].
+    """
+
+    fibre_diameter: float
+    stroke_reference: float
+    alpha: float
+    gamma: float
+    beta: float
+    t_g: float
+    sigma_g: float
+    t_amb: float
+    t_max: float
+    resistance_per_length: float
+    heat_capacity_per_length: float
+    heat_loss_per_length: float
+    stiffness: float
+    damping: float
+    thermal_force_coefficient: float
+    coil_index_table: tuple[float, ...]
+    stroke_max_table: tuple[float, ...]
+    tensile_strength_table: tuple[float, ...]
+    name: str = "custom"
+    description: str = ""
+    sources: Mapping[str, str] = field(default_factory=dict, compare=False)
+
+    @property
+    def fibre_area(self) -> float:
+        """Fibre cross-section A_f = pi d_f^2 / 4 [m^2]."""
+        return np.pi * self.fibre_diameter**2 / 4.0
+
+    @property
+    def coil_index_range(self) -> tuple[float, float]:
+        """Smallest and largest coil index of the table [-]."""
+        return self.coil_index_table[0], self.coil_index_table[-1]
+
+
+def _resolve(kind, table, value, overrides):
+    if isinstance(value, (Silicone, Nylon)):
+        if overrides:
+            raise ValueError(f"{kind}: overrides need a set name, not an object")
+        return value
+    if isinstance(value, Mapping):
+        value = dict(value)
+        overrides = {**{k: v for k, v in value.items() if k != "set"}, **(overrides or {})}
+        value = value.get("set")
+        if value is None:
+            raise ValueError(f"{kind}: a mapping needs 'set', one of {sorted(table)}")
+    if not isinstance(value, str) or value not in table:
+        raise ValueError(f"{kind}: unknown set {value!r}; accepted: {', '.join(sorted(table))}")
+    params = dict(table[value])
+    name = value
+    if overrides:
+        cls = Silicone if kind == "silicone" else Nylon
+        known = {f.name for f in fields(cls)} - {"name", "description", "sources"}
+        for key in overrides:
+            if key not in known:
+                raise ValueError(
+                    f"{kind}.{key}: unknown field; accepted: {', '.join(sorted(known))}"
+                )
+        params.update(overrides)
+        name = f"{value}+override"
+    return name, params
+
+
+def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
+    """The named Ogden set, with fields overridden.
+
+    Parameters
+    ----------
+    silicone : str, dict or Silicone
+        A name of :data:`SILICONE_PARAMETERS`, a mapping ``{"set": name, field: value}``
+        or a ready :class:`Silicone` (returned as is).
+    **overrides
+        Fields to replace: ``mu`` [Pa], ``alpha`` [-].
+
+    Raises
+    ------
+    ValueError
+        Unknown set or field, or Ogden constants that are not a valid material.
+    """
+    resolved = _resolve("silicone", SILICONE_PARAMETERS, silicone, overrides)
+    if isinstance(resolved, Silicone):
+        return resolved
+    name, p = resolved
+    try:
+        mu = tuple(float(x) for x in np.atleast_1d(p["mu"]))
+        alpha = tuple(float(x) for x in np.atleast_1d(p["alpha"]))
+    except (TypeError, ValueError):
+        raise ValueError("silicone.mu/alpha: must be lists of numbers [Pa] and [-]") from None
+    if len(mu) != len(alpha) or not 1 <= len(mu) <= 6:
+        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
+    if not all(np.isfinite(mu + alpha)) or any(a == 0 for a in alpha):
+        raise ValueError("silicone.alpha: must be finite and non-zero")
+    mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
+    if not mu0 > 0:
+        raise ValueError(
+            f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i = {mu0:g} Pa; must be > 0"
+        )
+    return Silicone(
+        mu=mu,
+        alpha=alpha,
+        name=name,
+        description=p.get("description", ""),
+        sources=dict(p.get("sources", {})),
+    )
+
+
+def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
+    """The named nylon muscle set, with fields overridden.
+
+    Parameters
+    ----------
+    nylon : str, dict or Nylon
+        A name of :data:`NYLON_PARAMETERS`, a mapping ``{"set": name, field: value}`` or a
+        ready :class:`Nylon`.
+    **overrides
+        Fields of :class:`Nylon` to replace, SI.
+
+    Raises
+    ------
+    ValueError
+        Unknown set or field, or a value outside its physical range.
+    """
+    resolved = _resolve("nylon", NYLON_PARAMETERS, nylon, overrides)
+    if isinstance(resolved, Nylon):
+        return resolved
+    name, p = resolved
+    kwargs = {}
+    for f in fields(Nylon):
+        if f.name in ("name", "description", "sources"):
+            continue
+        v = p[f.name]
+        try:
+            if f.name.endswith("_table"):
+                kwargs[f.name] = tuple(float(x) for x in v)
+            else:
+                kwargs[f.name] = float(v)
+        except (TypeError, ValueError):
+            raise ValueError(f"nylon.{f.name}: must be a number, got {v!r}") from None
+    for key in (
+        "fibre_diameter",
+        "stroke_reference",
+        "sigma_g",
+        "resistance_per_length",
+        "heat_capacity_per_length",
+        "heat_loss_per_length",
+    ):
+        if not (np.isfinite(kwargs[key]) and kwargs[key] > 0):
+            raise ValueError(f"nylon.{key}: must be > 0, got {kwargs[key]!r}")
+    if not kwargs["t_max"] > kwargs["t_amb"]:
+        raise ValueError("nylon.t_max: must be above nylon.t_amb")
+    c, smax, su = (kwargs[k] for k in ("coil_index_table", "stroke_max_table",
+                                        "tensile_strength_table"))
+    if not (len(c) == len(smax) == len(su) >= 1) or any(np.diff(c) <= 0):
+        raise ValueError("nylon.coil_index_table: must increase, one s_max and sigma_u a row")
+    if not all(0 < s < 1 for s in smax):
+        raise ValueError("nylon.stroke_max_table: each s_max must be in (0, 1)")
+    if not all(s > 0 for s in su):
+        raise ValueError("nylon.tensile_strength_table: each sigma_u must be > 0 Pa")
+    return Nylon(name=name, description=p.get("description", ""),
+                 sources=dict(p.get("sources", {})), **kwargs)

@@ -1,0 +1,43 @@
+"""The physical model of MODEL.md as plain, documented functions (SI in and out).
+
+One module per domain: :mod:`.nylon` (stroke, coil-index table, eq. 1), :mod:`.thermal`
+(eq. 3), :mod:`.chamber` (Boyle), :mod:`.silicone` (Ogden), :mod:`.wrap` (wrap geometry and
+nylon force), :mod:`.bending` (moments, curvature, angle, tip force) and :mod:`.limits`
+(design limits). This package imports neither Numba, xarray nor matplotlib.
+"""
+
+from .bending import (
+    bend_angle,
+    curvature,
+    material_moment,
+    pressure_moment,
+    tip_force,
+)
+from .chamber import P_ATM, chamber_pressure, volume_ratio
+from .limits import design_limits, stroke_limit
+from .nylon import (
+    free_strain,
+    nylon_force_limit,
+    stroke,
+    stroke_max,
+    temperature_for_stroke,
+    tensile_strength,
+    thermomechanical_force,
+)
+from .silicone import (
+    bending_stress,
+    cauchy_stress,
+    hoop_stress,
+    initial_shear_modulus,
+    strain_energy,
+)
+from .thermal import (
+    muscle_resistance,
+    steady_temperature,
+    temperature_rate,
+    temperature_step,
+    thermal_time_constant,
+)
+from .wrap import muscle_length, muscle_width, nylon_force, outer_perimeter, wrap_pitch, wrap_turns
+
+__all__ = [name for name in dir() if not name.startswith("_")]

@@ -1,0 +1,208 @@
+"""The coiled nylon muscle: stroke against temperature, coil-index table, eq. (1).
+
+MODEL.md section 2. Temperatures are in K.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..materials import nylon_parameters
+from ._formula import ZERO_CELSIUS, check, formula, scalar_or_array
+
+__all__ = [
+    "free_strain",
+    "nylon_force_limit",
+    "stroke",
+    "stroke_max",
+    "temperature_for_stroke",
+    "tensile_strength",
+    "thermomechanical_force",
+]
+
+_SQRT2 = math.sqrt(2.0)
+
+
+@formula
+def _stroke_shape(temperature, t_amb, gamma, beta, t_g, sigma_g):
+    """Reference stroke eps_ref(T_amb) - eps_ref(T) of the eq. (2) shape [-]; T in K."""
+    c = 1.0 / (sigma_g * _SQRT2)
+    return gamma * (temperature - t_amb) + beta * (
+        math.erf((temperature - t_g) * c) - math.erf((t_amb - t_g) * c)
+    )
+
+
+@formula
+def _stroke_scale(coil_index, c_table, smax_table, t_amb, t_max, gamma, beta, t_g, sigma_g):
+    """Factor s_max(C) / s_ref(T_max) that scales alpha, beta, gamma to coil index C [-]."""
+    return np.interp(coil_index, c_table, smax_table) / _stroke_shape(
+        t_max, t_amb, gamma, beta, t_g, sigma_g
+    )
+
+
+def _nylon(nylon):
+    return nylon_parameters(nylon)
+
+
+def _coil_index(coil_index, ny):
+    lo, hi = ny.coil_index_range
+    return check("coil_index", coil_index, lo, hi, unit="-")
+
+
+def _shape_args(ny):
+    return ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g
+
+
+def _scale(coil_index, ny):
+    c = _coil_index(coil_index, ny)
+    return _stroke_scale(c, np.asarray(ny.coil_index_table), np.asarray(ny.stroke_max_table),
+                         ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+
+
+def stroke_max(coil_index, nylon="silver_nylon66"):
+    """Largest stroke s_max(C) of a muscle of coil index C, reached at T_max [-].
+
+    Linear interpolation in the coil-index table (MODEL.md section 9).
+
+    Parameters
+    ----------
+    coil_index : float or array
+        Spring index C = D/d [-], inside the table (1.1-1.7 for the default set).
+    nylon : str, dict or Nylon
+        Muscle set.
+
+    Raises
+    ------
+    ValueError
+        A coil index outside the table.
+    """
+    ny = _nylon(nylon)
+    c = _coil_index(coil_index, ny)
+    return scalar_or_array(np.interp(c, ny.coil_index_table, ny.stroke_max_table))
+
+
+def tensile_strength(coil_index, nylon="silver_nylon66"):
+    """Tensile strength sigma_u(C) on the fibre cross-section [Pa] (table, linear in C)."""
+    ny = _nylon(nylon)
+    c = _coil_index(coil_index, ny)
+    return scalar_or_array(np.interp(c, ny.coil_index_table, ny.tensile_strength_table))
+
+
+def nylon_force_limit(coil_index, nylon="silver_nylon66"):
+    """Breaking force F_lim(C) = sigma_u(C) pi d_f^2 / 4 of the muscle [N]."""
+    ny = _nylon(nylon)
+    return scalar_or_array(np.asarray(tensile_strength(coil_index, ny)) * ny.fibre_area)
+
+
+def free_strain(temperature, coil_index, nylon="silver_nylon66"):
+    """Free tensile strain eps(T) of eq. (2) for coil index C [-].
+
+    eps(T) = alpha - gamma T - beta erf((T - T_g) / (sigma_g sqrt 2)), with alpha, beta,
+    gamma the reference constants times s_max(C)/s_ref(T_max) and T in degC for alpha.
+
+    Parameters
+    ----------
+    temperature : float or array
+        Muscle temperature T [K], > 0.
+    coil_index : float or array
+        Coil index C [-], inside the table.
+    nylon : str, dict or Nylon
+        Muscle set.
+
+    References
+    ----------
+    Paper eq. (2) (Sharafi & Li 2015); MODEL.md section 2.
+    """
+    ny = _nylon(nylon)
+    t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
+    k = _scale(coil_index, ny)
+    erf = np.vectorize(math.erf, otypes=[float])
+    eps = ny.alpha - ny.gamma * (t - ZERO_CELSIUS) - ny.beta * erf(
+        (t - ny.t_g) / (ny.sigma_g * _SQRT2)
+    )
+    return scalar_or_array(k * eps)
+
+
+def stroke(temperature, coil_index, nylon="silver_nylon66"):
+    """Muscle contraction s(T) = eps(T_amb) - eps(T) [-]; zero at T_amb, s_max(C) at T_max.
+
+    Parameters
+    ----------
+    temperature : float or array
+        Muscle temperature T [K], > 0.
+    coil_index : float or array
+        Coil index C [-], inside the table.
+    nylon : str, dict or Nylon
+        Muscle set.
+
+    Notes
+    -----
+    MODEL.md section 2 [choice]: one eq. (2) shape scaled per coil index. The scale is
+    s_max(C) over the reference shape's own stroke at T_max (0.1000054 for the default set,
+    not the nominal 0.10), so s(T_max) = s_max(C) exactly.
+    """
+    ny = _nylon(nylon)
+    t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
+    k = _scale(coil_index, ny)
+    shape = np.vectorize(lambda x: _stroke_shape(x, *_shape_args(ny)), otypes=[float])(t)
+    return scalar_or_array(k * shape)
+
+
+def temperature_for_stroke(stroke_value, coil_index, nylon="silver_nylon66"):
+    """Temperature [K] at which the muscle reaches a stroke, the inverse of :func:`stroke`.
+
+    Parameters
+    ----------
+    stroke_value : float
+        Contraction s [-], 0 <= s <= s_max(C) (the range between T_amb and T_max).
+    coil_index : float
+        Coil index C [-].
+    nylon : str, dict or Nylon
+        Muscle set.
+    """
+    ny = _nylon(nylon)
+    smax = float(stroke_max(coil_index, ny))
+    s = float(check("stroke", stroke_value, 0.0, smax, unit="-"))
+    if s == 0.0:
+        return ny.t_amb
+    k = float(_scale(coil_index, ny))
+    f = lambda t: k * _stroke_shape(t, *_shape_args(ny)) - s  # noqa: E731
+    return brentq(f, ny.t_amb, ny.t_max, xtol=1e-12, rtol=1e-15)
+
+
+def thermomechanical_force(displacement, velocity, temperature, rest_displacement=0.0,
+                           rest_temperature=None, nylon="silver_nylon66"):
+    """Force of the muscle, eq. (1): F = k (x - x0) + b_d dx/dt + c (T - T0) [N].
+
+    Parameters
+    ----------
+    displacement : float or array
+        End displacement x [m].
+    velocity : float or array
+        End velocity dx/dt [m/s].
+    temperature : float or array
+        Muscle temperature T [K], > 0.
+    rest_displacement : float, default 0
+        x0 [m].
+    rest_temperature : float, optional
+        T0 [K]; the set's ambient temperature by default.
+    nylon : str, dict or Nylon
+        Muscle set (``stiffness`` k [N/m], ``damping`` b_d [N s/m],
+        ``thermal_force_coefficient`` c [N/K]).
+
+    References
+    ----------
+    Paper eq. (1), after Yip & Niemeyer 2015 and Kianzad et al. 2015; not used by the sweep.
+    """
+    ny = _nylon(nylon)
+    x = check("displacement", displacement, unit="m")
+    v = check("velocity", velocity, unit="m/s")
+    t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
+    t0 = ny.t_amb if rest_temperature is None else float(
+        check("rest_temperature", rest_temperature, 0.0, lo_open=True, unit="K"))
+    f = ny.stiffness * (x - rest_displacement) + ny.damping * v + \
+        ny.thermal_force_coefficient * (t - t0)
+    return scalar_or_array(f)

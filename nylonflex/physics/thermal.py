@@ -1,0 +1,129 @@
+"""Thermo-electric model of the muscle, eq. (3): C dT/dt = V^2/R - Lambda (T - T_amb).
+
+MODEL.md sections 2 and 10: R = r' l_m, C = c' l_m, Lambda = lambda' l_m for a muscle of
+length l_m, so the time constant tau = c'/lambda' does not depend on the length.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..materials import nylon_parameters
+from ._formula import check, formula, scalar_or_array
+
+__all__ = [
+    "muscle_resistance",
+    "steady_temperature",
+    "temperature_rate",
+    "temperature_step",
+    "thermal_time_constant",
+]
+
+
+@formula
+def _temperature_step(temperature, voltage, dt, muscle_length, t_amb, r_per_len,
+                      c_per_len, loss_per_len):
+    """Exact solution of eq. (3) over a step dt at constant voltage [K].
+
+    T(t + dt) = T_ss + (T(t) - T_ss) exp(-dt/tau), T_ss = T_amb + V^2/(R Lambda).
+    """
+    r = r_per_len * muscle_length
+    loss = loss_per_len * muscle_length
+    t_ss = t_amb + voltage * voltage / (r * loss)
+    return t_ss + (temperature - t_ss) * np.exp(-dt * loss_per_len / c_per_len)
+
+
+def _lengths(muscle_length):
+    return check("muscle_length", muscle_length, 0.0, lo_open=True, unit="m")
+
+
+def muscle_resistance(muscle_length, nylon="silver_nylon66"):
+    """Electrical resistance R = r' l_m of the muscle [ohm].
+
+    Parameters
+    ----------
+    muscle_length : float or array
+        Length of muscle in the wrap l_m [m], > 0.
+    nylon : str, dict or Nylon
+        Muscle set (``resistance_per_length`` r' [ohm/m]; the paper measured 0.15 ohm/mm).
+    """
+    ny = nylon_parameters(nylon)
+    return scalar_or_array(ny.resistance_per_length * _lengths(muscle_length))
+
+
+def thermal_time_constant(nylon="silver_nylon66"):
+    """Time constant tau = C/Lambda = c'/lambda' of eq. (3) [s]."""
+    ny = nylon_parameters(nylon)
+    return ny.heat_capacity_per_length / ny.heat_loss_per_length
+
+
+def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66"):
+    """Right-hand side of eq. (3): dT/dt = (V^2/R - Lambda (T - T_amb)) / C [K/s].
+
+    Parameters
+    ----------
+    temperature : float or array
+        Muscle temperature T [K], > 0.
+    voltage : float or array
+        Applied voltage V [V].
+    muscle_length : float or array
+        Muscle length l_m [m], > 0.
+    nylon : str, dict or Nylon
+        Muscle set.
+
+    References
+    ----------
+    Paper eq. (3) (Yip & Niemeyer 2015).
+    """
+    ny = nylon_parameters(nylon)
+    t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
+    v = check("voltage", voltage, unit="V")
+    lm = _lengths(muscle_length)
+    heat = v * v / (ny.resistance_per_length * lm)
+    loss = ny.heat_loss_per_length * lm * (t - ny.t_amb)
+    return scalar_or_array((heat - loss) / (ny.heat_capacity_per_length * lm))
+
+
+def steady_temperature(voltage, muscle_length, nylon="silver_nylon66"):
+    """Steady state of eq. (3), T_ss = T_amb + V^2 / (R Lambda) [K].
+
+    Parameters
+    ----------
+    voltage : float or array
+        Applied voltage V [V].
+    muscle_length : float or array
+        Muscle length l_m [m], > 0.
+    nylon : str, dict or Nylon
+        Muscle set.
+    """
+    ny = nylon_parameters(nylon)
+    v = check("voltage", voltage, unit="V")
+    lm = _lengths(muscle_length)
+    return scalar_or_array(ny.t_amb + v * v / (ny.resistance_per_length * ny.heat_loss_per_length
+                                               * lm * lm))
+
+
+def temperature_step(temperature, voltage, dt, muscle_length, nylon="silver_nylon66"):
+    """Temperature after a step dt at constant voltage, exact solution of eq. (3) [K].
+
+    Parameters
+    ----------
+    temperature : float
+        Temperature at the start of the step [K], > 0.
+    voltage : float
+        Voltage held over the step [V].
+    dt : float
+        Step [s], >= 0.
+    muscle_length : float
+        Muscle length l_m [m], > 0.
+    nylon : str, dict or Nylon
+        Muscle set.
+    """
+    ny = nylon_parameters(nylon)
+    t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
+    v = check("voltage", voltage, unit="V")
+    h = check("dt", dt, 0.0, unit="s")
+    lm = _lengths(muscle_length)
+    return scalar_or_array(_temperature_step(t, v, h, lm, ny.t_amb, ny.resistance_per_length,
+                                             ny.heat_capacity_per_length,
+                                             ny.heat_loss_per_length))

@@ -1,0 +1,115 @@
+"""Unit strings at the edges (configs, command line, charts); SI everywhere inside.
+
+Every quantity has a *kind* (length, angle, pressure, ...). A unit string is parsed once,
+here, into a factor (and for temperatures an offset) to SI.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+__all__ = ["UNITS", "InputError", "parse_quantity", "to_si", "from_si", "unit_kind"]
+
+
+class InputError(ValueError):
+    """Bad user input: the message is one line naming the field and what it accepts."""
+
+
+#: unit -> (kind, factor to SI, offset to SI); SI value = value * factor + offset.
+UNITS: dict[str, tuple[str, float, float]] = {
+    "m": ("length", 1.0, 0.0),
+    "cm": ("length", 1e-2, 0.0),
+    "mm": ("length", 1e-3, 0.0),
+    "um": ("length", 1e-6, 0.0),
+    "rad": ("angle", 1.0, 0.0),
+    "deg": ("angle", math.pi / 180.0, 0.0),
+    "Pa": ("pressure", 1.0, 0.0),
+    "kPa": ("pressure", 1e3, 0.0),
+    "MPa": ("pressure", 1e6, 0.0),
+    "bar": ("pressure", 1e5, 0.0),
+    "N": ("force", 1.0, 0.0),
+    "mN": ("force", 1e-3, 0.0),
+    "N m": ("torque", 1.0, 0.0),
+    "N mm": ("torque", 1e-3, 0.0),
+    "mN m": ("torque", 1e-3, 0.0),
+    "K": ("temperature", 1.0, 0.0),
+    "degC": ("temperature", 1.0, 273.15),
+    "s": ("time", 1.0, 0.0),
+    "ms": ("time", 1e-3, 0.0),
+    "min": ("time", 60.0, 0.0),
+    "h": ("time", 3600.0, 0.0),
+    "Hz": ("frequency", 1.0, 0.0),
+    "V": ("voltage", 1.0, 0.0),
+    "W": ("power", 1.0, 0.0),
+    "A": ("current", 1.0, 0.0),
+    "mA": ("current", 1e-3, 0.0),
+    "1": ("dimensionless", 1.0, 0.0),
+    "%": ("dimensionless", 1e-2, 0.0),
+}
+
+_ALIASES = {"Nm": "N m", "N*m": "N m", "N.m": "N m", "Nmm": "N mm", "C": "degC",
+            "celsius": "degC", "degrees": "deg", "degree": "deg", "": "1", "-": "1",
+            "mNm": "mN m"}
+
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+
+
+def _canonical(unit: str) -> str:
+    unit = unit.strip()
+    return _ALIASES.get(unit, unit)
+
+
+def unit_kind(unit: str) -> str:
+    """The kind of quantity a unit measures ("length", "angle", ...)."""
+    unit = _canonical(unit)
+    if unit not in UNITS:
+        raise InputError(f"unknown unit {unit!r}; accepted: {', '.join(UNITS)}")
+    return UNITS[unit][0]
+
+
+def to_si(value, unit: str, field: str = "value", kind: str | None = None):
+    """Convert ``value`` (number or array) given in ``unit`` to SI.
+
+    Raises
+    ------
+    InputError
+        Unknown unit, or a unit of another kind than ``kind``; the message names ``field``.
+    """
+    u = _canonical(unit)
+    if u not in UNITS:
+        raise InputError(f"{field}: unknown unit {unit!r}; accepted: "
+                         f"{', '.join(_units_of(kind) if kind else UNITS)}")
+    k, factor, offset = UNITS[u]
+    if kind is not None and k != kind:
+        raise InputError(f"{field}: unit {unit!r} is not a {kind}; accepted: "
+                         f"{', '.join(_units_of(kind))}")
+    return value * factor + offset
+
+
+def from_si(value, unit: str):
+    """Convert an SI value (number or array) to ``unit``."""
+    _, factor, offset = UNITS[_canonical(unit)]
+    return (value - offset) / factor
+
+
+def _units_of(kind):
+    return [u for u, (k, _, _) in UNITS.items() if k == kind]
+
+
+def parse_quantity(text, field: str, kind: str, default_unit: str):
+    """Parse ``"7.5mm"``, ``"8 deg"`` or a bare ``"7.5"`` (in ``default_unit``) to SI.
+
+    Raises
+    ------
+    InputError
+        Not a number, or a unit of the wrong kind; the message names ``field``.
+    """
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        return to_si(float(text), default_unit, field, kind)
+    m = _NUMBER.match(str(text))
+    if not m:
+        raise InputError(f"{field}: expected a number with an optional unit "
+                         f"({', '.join(_units_of(kind))}), got {text!r}")
+    number, unit = m.groups()
+    return to_si(float(number), unit or default_unit, field, kind)
