@@ -95,6 +95,14 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     return s, limit, p, moment, kappa, force, kappa_full
 
 
+@formula
+def _design_values(s, limit, p, moment, kappa, force, kappa_full, force_limit, length):
+    """The nine design variables (order of DESIGN_VARIABLES) of a design of length L [m]."""
+    fraction = 1.0 if limit == 0 else kappa / kappa_full
+    return (s, limit, p, moment, moment / length, kappa * length, fraction, force,
+            force / force_limit)
+
+
 def _inputs(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness, ny):
     lo, hi = ny.coil_index_range
     a = check("radius", radius, 0.0, lo_open=True, unit="m")
@@ -177,16 +185,17 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     a, t, L, c, psi, b = np.broadcast_arrays(a, t, L, c, psi, b)
     nodes = quadrature_nodes()
     c_tab = np.asarray(ny.coil_index_table)
-    out = {name: np.empty(a.shape) for name in DESIGN_VARIABLES}
+    out = {name: np.empty(a.shape, dtype=np.int8 if name == "limit" else float)
+           for name in DESIGN_VARIABLES}
     for idx in np.ndindex(a.shape):
         ai, ti, bi, Li, ci, pi = (float(x[idx]) for x in (a, t, b, L, c, psi))
         force_limit = float(np.interp(ci, c_tab, ny.tensile_strength_table)) * ny.fibre_area
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))
         lever = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0)) / math.cos(pi)
-        s, limit, p, moment, kappa, force, kappa_full = _stroke_state(
-            ai, ti, bi, lever, force_limit, s_max, 0.0, mu, alpha, *nodes, P_ATM)
-        values = (s, limit, p, moment, moment / Li, kappa * Li,
-                  1.0 if limit == 0 else kappa / kappa_full, force, force / force_limit)
+        state = _stroke_state(ai, ti, bi, lever, force_limit, s_max, 0.0, mu, alpha, *nodes,
+                              P_ATM)
+        values = _design_values(*state, force_limit, Li)
         for name, v in zip(DESIGN_VARIABLES, values):
             out[name][idx] = v
-    return {name: scalar_or_array(v) for name, v in out.items()}
+    return {name: (int(v) if name == "limit" and v.ndim == 0 else scalar_or_array(v))
+            for name, v in out.items()}

@@ -1,0 +1,262 @@
+"""The design cube on disk: NetCDF4/HDF5 written through h5netcdf, read with xarray.
+
+Durability: a sweep journals every finished slab of radii as its own small ``.npz`` file in
+``<cube>.parts/`` (written to a temporary name, then renamed, so a slab file is whole or
+absent) and writes the same slab into ``<cube>.building``. Only a finished run renames
+the building file to ``<cube>``: a killed run never leaves a file that reads as complete.
+``--resume`` keeps the journal's slabs (if the config hash matches) and computes the rest.
+A run stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete = "false"`` and a
+``slab_done`` mask, so the part already done can be queried.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .units import InputError
+from .variables import AXES, COORDS, CURVES, DESIGN
+
+__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "CubeFile", "Journal", "info_command",
+           "open_cube"]
+
+#: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
+CUBE_FORMAT = "1"
+#: Attributes that differ between two runs of the same config (timing, host, when).
+VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "workers",
+                  "resumed_slabs", "python_version", "hostname")
+
+_COMPRESSION = {"compression": "gzip", "compression_opts": 1, "shuffle": True}
+
+
+def _chunks(dims, sizes, radius_chunk):
+    shape = [sizes[d] for d in dims]
+    if dims and dims[0] == "radius":
+        shape[0] = min(radius_chunk, shape[0])
+    # keep chunks near or under 2 MB of float64 by halving the largest trailing dims
+    while np.prod(shape) > 2**18 and max(shape[1:] or [1]) > 1:
+        j = 1 + int(np.argmax(shape[1:]))
+        shape[j] = (shape[j] + 1) // 2
+    return tuple(int(x) for x in shape)
+
+
+class CubeFile:
+    """Writes one cube file slab by slab (h5netcdf; gzip level 1 with shuffle)."""
+
+    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int):
+        import h5netcdf
+
+        self.path = Path(path)
+        self.f = h5netcdf.File(self.path, "w")
+        sizes = {name: len(values) for name, values in coords.items()}
+        self.f.dimensions = sizes
+        for name, values in coords.items():
+            v = self.f.create_variable(name, (name,), "f8", data=np.asarray(values, float))
+            v.attrs.update(COORDS[name].attrs())
+        for var in (*DESIGN.values(), *CURVES.values()):
+            fill = None if var.dtype == "int8" else np.nan
+            v = self.f.create_variable(var.name, var.dims, var.dtype, fillvalue=fill,
+                                       chunks=_chunks(var.dims, sizes, radius_chunk),
+                                       **_COMPRESSION)
+            v.attrs.update(var.attrs())
+        done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
+        done.attrs.update({"units": "1", "long_name": "radius computed",
+                           "description": "1 where this radius's slab is in the cube",
+                           "flag_values": np.array([0, 1], np.int8),
+                           "flag_meanings": "missing done"})
+        self.f.attrs.update(attrs)
+
+    def write(self, i0: int, i1: int, arrays: dict):
+        """Write the variables of radii [i0, i1) (and those without a radius dim)."""
+        for name, data in arrays.items():
+            var = self.f.variables[name]
+            if var.dimensions and var.dimensions[0] == "radius":
+                var[i0:i1] = data
+            else:
+                var[...] = data
+        self.f.variables["slab_done"][i0:i1] = 1
+
+    def close(self, attrs: dict | None = None):
+        if attrs:
+            self.f.attrs.update(attrs)
+        self.f.close()
+
+
+class Journal:
+    """The ``<cube>.parts`` folder: a manifest and one ``.npz`` per finished slab."""
+
+    def __init__(self, cube_path):
+        self.dir = Path(str(cube_path) + ".parts")
+        self.manifest = self.dir / "manifest.json"
+
+    def exists(self) -> bool:
+        return self.manifest.is_file()
+
+    def read_manifest(self) -> dict:
+        try:
+            return json.loads(self.manifest.read_text())
+        except (OSError, ValueError):
+            return {}
+
+    def start(self, manifest: dict):
+        if self.dir.exists():
+            shutil.rmtree(self.dir)
+        self.dir.mkdir(parents=True)
+        _atomic_write(self.manifest, json.dumps(manifest, indent=1).encode())
+
+    def _slab_path(self, k):
+        return self.dir / f"slab-{k:06d}.npz"
+
+    def done(self) -> set[int]:
+        out = set()
+        for p in self.dir.glob("slab-*.npz"):
+            with contextlib.suppress(ValueError):
+                out.add(int(p.stem.split("-")[1]))
+        return out
+
+    def save(self, k: int, arrays: dict):
+        tmp = self._slab_path(k).with_suffix(".tmp")
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+        os.replace(tmp, self._slab_path(k))
+
+    def load(self, k: int) -> dict:
+        with np.load(self._slab_path(k)) as z:
+            return {name: z[name] for name in z.files}
+
+    def remove(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def _atomic_write(path: Path, data: bytes):
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
+
+
+@contextlib.contextmanager
+def exclusive(cube_path):
+    """Hold ``<cube>.lock`` for a run; a second run on the same output is refused."""
+    import fcntl
+
+    lock = Path(str(cube_path) + ".lock")
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fh = open(lock, "a+")
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        fh.close()
+        raise RuntimeError(f"another sweep is writing {cube_path} (lock {lock}); "
+                           "wait for it or stop it first") from None
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            lock.unlink()
+        fcntl.flock(fh, fcntl.LOCK_UN)
+        fh.close()
+
+
+def cube_attrs(path) -> dict | None:
+    """Global attributes of a nylonflex cube file, or None if it is not one."""
+    import h5py
+
+    path = Path(path)
+    if not path.is_file() or not h5py.is_hdf5(path):
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    except OSError:
+        return None
+    return attrs if attrs.get("nylonflex_cube") else None
+
+
+def _attr(v):
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.ndarray) and v.size == 1:
+        return v.item()
+    return v
+
+
+def open_cube(path, *, quiet: bool = False):
+    """Open a cube written by ``nylonflex sweep`` as an :class:`xarray.Dataset` (lazy).
+
+    An incomplete cube (a sweep stopped early) opens with a warning, its missing radii
+    masked (NaN; ``limit`` then reads as float).
+
+    Raises
+    ------
+    InputError
+        The path is missing, not HDF5, or not a nylonflex cube.
+    """
+    import xarray as xr
+
+    path = Path(path)
+    if not path.exists():
+        parts = Journal(path)
+        extra = (f"; an interrupted run's slabs are in {parts.dir} (finish it with "
+                 "'nylonflex sweep CONFIG --resume')") if parts.exists() else ""
+        raise InputError(f"{path}: no such cube{extra}")
+    attrs = cube_attrs(path)
+    if attrs is None:
+        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
+                         "written by 'nylonflex sweep')")
+    ds = xr.open_dataset(path, engine="h5netcdf")
+    if attrs.get("complete") != "true":
+        done = ds["slab_done"].values.astype(bool)
+        if not quiet:
+            warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
+                          "computed; the rest is masked", stacklevel=2)
+        mask = xr.DataArray(done, dims=("radius",), coords={"radius": ds["radius"]})
+        for name in list(DESIGN) + list(CURVES):
+            if "radius" in ds[name].dims:
+                ds[name] = ds[name].where(mask)
+    return ds
+
+
+def info_command(args) -> int:
+    """``nylonflex info CUBE``: dims, ranges, provenance and completeness."""
+    from .variables import VARIABLES
+    from .units import from_si
+
+    path = Path(args.cube)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = open_cube(path, quiet=True)
+    a = ds.attrs
+    out = sys.stdout
+    complete = a.get("complete") == "true"
+    done = int(ds["slab_done"].sum())
+    print(f"cube      {path}", file=out)
+    print(f"name      {a.get('name')}   config sha256 {a.get('config_sha256', '')[:16]}", file=out)
+    print(f"status    {'complete' if complete else 'INCOMPLETE'} "
+          f"({done}/{ds.sizes['radius']} radii)", file=out)
+    n = int(np.prod([ds.sizes[d] for d in AXES]))
+    print(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES), file=out)
+    print("axes", file=out)
+    for name in (*AXES, "stroke", "pressure"):
+        v = VARIABLES[name]
+        vals = from_si(ds[name].values, v.display)
+        unit = "" if v.display == "1" else f" {v.display}"
+        print(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})", file=out)
+    print("variables", file=out)
+    for name in (*DESIGN, *CURVES):
+        print(f"  {name:<18} ({', '.join(ds[name].dims)}) [{ds[name].attrs.get('units')}] "
+              f"{ds[name].attrs.get('long_name')}", file=out)
+    print("provenance", file=out)
+    for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
+                "quadrature", "created", "run_seconds", "designs_per_second", "workers",
+                "scheduler"):
+        if key in a:
+            print(f"  {key:<18} {a[key]}", file=out)
+    ds.close()
+    return 0
