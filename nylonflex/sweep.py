@@ -324,6 +324,7 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
             signal.signal(signal.SIGTERM, previous)
         if scheduler is not None:
             runner.close()
+            runner_info = runner.info()  # counts workers that joined during the run
     seconds = time.perf_counter() - t0
     complete = stopped is None and len(done_slabs) == len(slabs)
     final = {
