@@ -74,7 +74,7 @@ def figure9(ds, path):
         rise = a.get("rise_time", math.nan)
         rise_s = "not reached" if math.isnan(rise) else f"{rise:.2f} s"
         title = f"Step response: rise time (10-90 %) {rise_s}, overshoot " \
-                f"{100 * a.get('overshoot', math.nan):.1f} %"
+                f"{100 * a.get('overshoot', math.nan):.2f} %"
     else:
         title = f"Tracking: RMS error {math.degrees(a.get('rms_error', math.nan)):.2f} deg " \
                 f"({100 * a.get('rms_error_fraction', math.nan):.1f} % of the span)"
@@ -87,7 +87,7 @@ def figure9(ds, path):
     axp.legend(loc="upper right", fontsize=7, ncol=2)
     axp.set_ylabel("heating [W]")
     axp.set_xlabel("time [s]")
-    axp.set_ylim(0, max(float(ds["power"].max()) * 1.15, 0.1))
+    axp.set_ylim(0, max(float(ds["power"].max()) * 1.5, 0.1))  # room for the legend
     axp.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=130)

@@ -90,7 +90,7 @@ SIM_METRICS: dict[str, tuple[str, str]] = {
     "temperature_max": ("K", "highest muscle temperature"),
     "time_above_t_max": ("s", "time above the muscle's highest safe temperature"),
     "nylon_use_max": ("1", "peak muscle load over its breaking force"),
-    "reach": ("rad", "steady bend angle at full heating"),
+    "reach": ("rad", "largest bend angle the muscle can reach: full heating alone, or its start"),
 }
 
 # ---------------------------------------------------------------------------------------
