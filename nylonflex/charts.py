@@ -1,0 +1,726 @@
+"""Design charts drawn from a saved cube: the paper's figures 4, 6, 7 and 12, and a design map.
+
+Charts read the :class:`xarray.Dataset` only; they never compute physics. Every axis label
+comes from the variable registry (:mod:`nylonflex.variables`) in the unit a designer reads
+(mm, deg, kPa, N), and every title names the slice of the cube it shows. matplotlib is
+imported lazily with the headless Agg backend (after ``xarray/plot/utils.py``).
+
+Each chart is a function ``f(ds, **slice) -> matplotlib.figure.Figure``; the keyword
+arguments choose the slice in SI (default: the grid values nearest the paper's choices).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .config import CHARTS as _CHART_NAMES
+from .units import InputError, from_si
+from .variables import VARIABLES, display_label
+
+__all__ = ["CHARTS", "FORMATS", "chart_command", "design_map", "draw_charts", "fig4", "fig6",
+           "fig7", "fig12a", "fig12b", "fig12c"]
+
+#: Image formats a chart can be written in.
+FORMATS = ("png", "pdf", "svg")
+
+# Colours of the Okabe-Ito palette (readable for colour-blind readers and in greyscale).
+_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
+            "#000000")
+# Dash patterns of the strength limits, one per wrap angle; all black as in the paper.
+_DASHES = ((0, (6, 2)), (0, (3, 1.5)), (0, (1, 1.2)), (0, (6, 1.5, 1, 1.5)),
+           (0, (10, 3)), (0, (2, 3)))
+
+_RC = {"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8.5,
+       "legend.title_fontsize": 8.5, "xtick.labelsize": 9, "ytick.labelsize": 9,
+       "figure.titlesize": 11, "axes.grid": True, "grid.alpha": 0.3, "lines.linewidth": 1.6,
+       "savefig.dpi": 200, "svg.fonttype": "none", "pdf.fonttype": 42}
+
+# The paper's worked examples (section 4), SI: (radius, wall, length, coil index).
+_EXAMPLES = ((20e-3, 6e-3, 90e-3, 1.1), (7.5e-3, 2e-3, 70e-3, 1.7))
+_WRAP_DEFAULT = math.radians(8.0)  # MODEL.md s. 8 checks the examples at psi = 8 deg
+_LENGTH_DEFAULT = 90e-3
+
+
+# ---------------------------------------------------------------------------- helpers
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _figure(nrows=1, ncols=1, size=(6.0, 4.2), **kw):
+    plt = _plt()
+    with plt.rc_context(_RC):
+        fig, axes = plt.subplots(nrows, ncols, figsize=size, layout="constrained",
+                                 squeeze=False, **kw)
+    return fig, axes
+
+
+def _disp(name, values):
+    """SI values of a registered name in its display unit."""
+    return from_si(np.asarray(values, dtype=float), VARIABLES[name].display)
+
+
+def _text(name, si) -> str:
+    """``"90 mm"``, ``"8 deg"``, ``"1.7"``: a value of a registered name for a title."""
+    v = VARIABLES[name]
+    value = float(_disp(name, si))
+    unit = "" if v.display == "1" else (" deg" if v.display == "deg" else f" {v.display}")
+    return f"{value:.4g}{unit}"
+
+
+_SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
+           "wrap_angle": "\u03c8", "pressure": "p"}
+
+
+def _eq(name, si) -> str:
+    """``"L = 90 mm"``: a slice value for a legend or title."""
+    return f"{_SYMBOL.get(name, name)} = {_text(name, si)}"
+
+
+def _nearest(ds, name, target):
+    """The grid value of ``name`` nearest ``target`` [SI]."""
+    values = ds[name].values
+    return float(values[int(np.argmin(np.abs(values - target)))])
+
+
+def _spread(ds, name, lo, hi, n):
+    """Up to ``n`` grid values of ``name`` in [lo, hi] [SI], evenly spread, ends included.
+
+    Falls back to the nearest grid values of ``lo`` and ``hi`` when none lies inside.
+    """
+    values = ds[name].values
+    span = max(abs(hi - lo), 1e-300)
+    inside = values[(values >= lo - 1e-9 * span) & (values <= hi + 1e-9 * span)]
+    if inside.size == 0:
+        inside = np.unique([_nearest(ds, name, lo), _nearest(ds, name, hi)])
+    if inside.size <= n:
+        return [float(x) for x in inside]
+    idx = np.unique(np.round(np.linspace(0, inside.size - 1, n)).astype(int))
+    return [float(inside[i]) for i in idx]
+
+
+def _pick_few(ds, name, n):
+    """Up to ``n`` grid values of ``name`` spread over its whole range."""
+    values = ds[name].values
+    return _spread(ds, name, float(values.min()), float(values.max()), n)
+
+
+def _label(name, unit_note=""):
+    return display_label(name) + unit_note
+
+
+def _footer(fig, ds):
+    name = ds.attrs.get("name", "?")
+    version = ds.attrs.get("nylonflex_version", "?")
+    note = f"cube '{name}' (nylonflex {version}, {ds.attrs.get('silicone', '?')} / " \
+           f"{ds.attrs.get('nylon', '?')})"
+    if ds.attrs.get("complete") != "true":
+        note += " - INCOMPLETE cube: missing radii are blank"
+    # above the canvas (savefig's tight bounding box takes it in): clear of titles,
+    # axes and legends whatever the layout
+    fig.text(0.0, 1.0, note, ha="left", va="bottom", fontsize=7, color="0.4")
+
+
+def _suptitle(fig, title, subtitle):
+    fig.suptitle(f"{title}\n{subtitle}", fontsize=_RC["figure.titlesize"])
+
+
+def _stroke_max(ds):
+    """s_max(C) read off the cube: the usable stroke of stroke-limited designs [-].
+
+    NaN for a coil index with no stroke-limited design in the cube.
+    """
+    s = ds["usable_stroke"].where(ds["limit"] == 0)
+    dims = [d for d in s.dims if d != "coil_index"]
+    return s.max(dims).values
+
+
+# ---------------------------------------------------------------------------- figure 12
+def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
+           radius=None, wall_thickness=None):
+    """Figure 12(a): nylon force against stroke, with each coil index's strength limit.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    radii, walls : sequence of float, optional
+        Radii and wall thicknesses of the left panel [m]; default five radii over the
+        grid and the walls nearest 2 and 6 mm.
+    wrap_angle : float, optional
+        Wrap angle of the left panel [rad]; default nearest 8 deg.
+    wrap_angles : sequence of float, optional
+        Wrap angles of the right panel [rad]; default up to four over the grid.
+    radius, wall_thickness : float, optional
+        Design of the right panel [m]; default nearest 15 mm and 4 mm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    radii = [_nearest(ds, "radius", r) for r in radii] if radii else \
+        _pick_few(ds, "radius", 5)
+    walls = [_nearest(ds, "wall_thickness", t) for t in walls] if walls else \
+        sorted({_nearest(ds, "wall_thickness", t) for t in (2e-3, 6e-3)})
+    psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
+    psis = [_nearest(ds, "wrap_angle", w) for w in wrap_angles] if wrap_angles else \
+        _pick_few(ds, "wrap_angle", 4)
+    a_r = _nearest(ds, "radius", 15e-3 if radius is None else radius)
+    t_r = _nearest(ds, "wall_thickness", 4e-3 if wall_thickness is None else wall_thickness)
+
+    # F_n does not depend on the coil index (MODEL.md s. 4): read it at the first one
+    force = ds["nylon_force"].isel(coil_index=0)
+    stroke = _disp("stroke", ds["stroke"].values)
+    f_lim = _disp("nylon_force_limit", ds["nylon_force_limit"].values)
+    s_max = _stroke_max(ds)
+    coils = ds["coil_index"].values
+
+    from matplotlib.lines import Line2D
+
+    fig, axes = _figure(1, 2, size=(9.0, 5.4), sharey=True)
+    left, right = axes[0]
+    styles = ("-", "-.", ":", (0, (5, 1, 1, 1, 1, 1)))
+    for i, a in enumerate(radii):
+        for j, t in enumerate(walls):
+            y = force.sel(radius=a, wall_thickness=t, wrap_angle=psi).values
+            left.plot(stroke, _disp("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
+                      ls=styles[j % len(styles)])
+    left.set_title(f"radius and wall at {_eq('wrap_angle', psi)}")
+    for i, w in enumerate(psis):
+        y = force.sel(radius=a_r, wall_thickness=t_r, wrap_angle=w).values
+        right.plot(stroke, _disp("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
+                   label=_eq("wrap_angle", w))
+    right.set_title(f"wrap angle at {_eq('radius', a_r)}, {_eq('wall_thickness', t_r)}")
+
+    # Each coil index's working box: F_n <= F_lim(C) up to s <= s_max(C), dashed black.
+    top = max(float(np.nanmax(f_lim)) * 1.3, 1e-9)
+    for ax in (left, right):
+        for k, c in enumerate(coils):
+            end = s_max[k] if np.isfinite(s_max[k]) else stroke[-1]
+            ax.plot([stroke[0], end], [f_lim[k]] * 2, color="k", ls="--", lw=1.1)
+            if np.isfinite(s_max[k]):
+                ax.plot([end, end], [0, f_lim[k]], color="k", ls=":", lw=0.9)
+            ax.annotate(f"C = {c:g}", (end, f_lim[k]), xytext=(-2, 2),
+                        textcoords="offset points", fontsize=8, ha="right", va="bottom",
+                        bbox={"boxstyle": "square,pad=0.05", "fc": "white", "ec": "none",
+                              "alpha": 0.8})
+        ax.set_xlim(stroke[0], stroke[-1])
+        ax.set_ylim(0, top)
+        ax.set_xlabel(_label("stroke", " [-]"))
+    left.set_ylabel(_label("nylon_force"))
+    handles = [Line2D([], [], color=_COLOURS[i % len(_COLOURS)], label=_eq("radius", a))
+               for i, a in enumerate(radii)]
+    handles += [Line2D([], [], color="0.3", ls=styles[j % len(styles)],
+                       label=_eq("wall_thickness", t)) for j, t in enumerate(walls)]
+    left.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4,
+                fontsize=8)
+    right.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4, fontsize=8)
+    _suptitle(fig, "Figure 12(a): nylon force against muscle stroke",
+              "dashed: each coil index's strength limit F_lim(C) up to its largest stroke "
+              "s_max(C) (dotted)\nthe force is the same for every coil index and length")
+    _footer(fig, ds)
+    return fig
+
+
+def _cut_ins(ds, var, scale_name, sel, coils, psis):
+    """Where each wrap angle's strength limit cuts in, per coil index.
+
+    Returns ``{psi: [(radius, value) of the last grid design with a full range of motion,
+    one per coil index that reaches its limit inside the grid]}`` in display units.
+    """
+    x = _disp("radius", ds["radius"].values)
+    out = {}
+    for w in psis:
+        points = []
+        for c in coils:
+            cut = ds[[var, "limit"]].sel(coil_index=c, wrap_angle=w, **sel)
+            lim = cut["limit"].values
+            value = _disp(scale_name, cut[var].values)
+            hits = np.flatnonzero((lim[:-1] == 0) & (lim[1:] == 1))
+            if hits.size:
+                points.append((x[hits[0]], value[hits[0]]))
+        out[w] = points
+    return out
+
+
+def _limit_lines(ax, ds, var, sel, coils, psis):
+    """Fig. 12(b,c) panel: ``var`` against radius per coil index (solid while
+    stroke-limited) and each wrap angle's threshold (dashed black) through the last
+    designs with a full range of motion."""
+    x = _disp("radius", ds["radius"].values)
+    for k, c in enumerate(coils):
+        cut = ds[[var, "limit"]].sel(coil_index=c, **sel)
+        value = _disp(var, cut[var].transpose("wrap_angle", "radius").values)
+        stroke_limited = cut["limit"].transpose("wrap_angle", "radius").values == 0
+        # stroke-limited values are the same for every wrap angle (s* = s_max(C))
+        solid = np.where(stroke_limited.any(axis=0), np.nanmax(
+            np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
+        ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
+    for j, (w, points) in enumerate(_cut_ins(ds, var, var, sel, coils, psis).items()):
+        if not points:
+            continue
+        px, py = np.array(points).T
+        ax.plot(px, py, color="k", ls=_DASHES[j % len(_DASHES)], lw=1.2, marker="o",
+                ms=4, mfc="white", mec="k", zorder=4)
+        end = int(np.argmax(px))
+        ax.annotate(f"\u03c8 = {_text('wrap_angle', w)}", (px[end], py[end]),
+                    xytext=(4, -2), textcoords="offset points", fontsize=8, ha="left",
+                    va="top", zorder=6,
+                    bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
+                          "alpha": 0.8})
+    ax.set_xlabel(_label("radius"))
+
+
+def _legend_12bc(fig, coils, psis):
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color=_COLOURS[k % len(_COLOURS)], lw=2.0,
+                      label=f"C = {c:g}") for k, c in enumerate(coils)]
+    handles += [Line2D([], [], color="k", ls=_DASHES[j % len(_DASHES)], lw=1.2, marker="o",
+                       ms=4, mfc="white", mec="k",
+                       label=f"\u03c8 = {_text('wrap_angle', w)}")
+                for j, w in enumerate(psis)]
+    fig.legend(handles=handles, loc="outside lower center", ncol=4,
+               title="coil index C: solid while the design has its full range of motion "
+                     "(stroke-limited)\nwrap angle \u03c8: dashed threshold through the "
+                     "last full-range design of each C; beyond it the nylon's strength "
+                     "limits")
+
+
+def _examples(ax, ds, var, t, length=None, corner="upper left"):
+    """Mark the paper's worked examples (section 4) on a fig. 12(b,c) panel of wall ``t``.
+
+    ``length`` [m] is the panel's length for a length-dependent ``var`` (the star then sits
+    on the panel's curves); None labels the example's own tip force instead.
+    """
+    texts = []
+    for a, t_ex, l_ex, c_ex in _EXAMPLES:
+        if abs(_nearest(ds, "wall_thickness", t_ex) - t) > 1e-12:
+            continue
+        at = {"radius": _nearest(ds, "radius", a), "wall_thickness": t,
+              "length": _nearest(ds, "length", l_ex if length is None else length),
+              "coil_index": _nearest(ds, "coil_index", c_ex),
+              "wrap_angle": _nearest(ds, "wrap_angle", _WRAP_DEFAULT)}
+        point = ds[[var, "tip_force_max", "limit"]].sel(**at)
+        x, y = float(_disp("radius", at["radius"])), float(_disp(var, point[var]))
+        ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
+        text = f"paper example: {_eq('radius', at['radius'])}, " \
+               f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}"
+        full = "full range of motion" if int(point["limit"]) == 0 else \
+            "range of motion cut short"
+        if length is None:
+            text += f"\nat {_eq('length', at['length'])} tip force " \
+                    f"{float(point['tip_force_max']):.2f} N, {full}"
+        else:
+            text += f"\n{full}"
+        texts.append(text)
+        # an empty corner of the panel (fig. 12(b): curves rise to the right)
+        upper, left = corner.split()[0] == "upper", corner.split()[1] == "left"
+        step = 0.14 * (len(texts) - 1)
+        ax.annotate(text, (x, y),
+                    xytext=(0.03 if left else 0.97, 0.97 - step if upper else 0.03 + step),
+                    textcoords="axes fraction", ha="left" if left else "right",
+                    va="top" if upper else "bottom", fontsize=8, zorder=7,
+                    arrowprops={"arrowstyle": "->", "color": "0.3", "lw": 0.8,
+                                "shrinkB": 6},
+                    bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.6"})
+
+
+def _walls_12bc(ds, walls):
+    if walls:
+        return [_nearest(ds, "wall_thickness", t) for t in walls]
+    # the walls of the paper's two examples: 2 mm and 6 mm
+    return sorted({_nearest(ds, "wall_thickness", t) for t in (2e-3, 6e-3)})
+
+
+def fig12b(ds, *, walls=None, length=None):
+    """Figure 12(b): maximum torque against radius, per coil index, with strength limits.
+
+    The solid line of each coil index is its torque M* while the design is stroke-limited
+    (the muscle's whole stroke is usable); each wrap angle's dashed black threshold joins
+    the last such design of every coil index: beyond it the nylon's strength limits.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    walls : sequence of float, optional
+        Wall thicknesses, one panel each [m]; default nearest 2 and 6 mm.
+    length : float, optional
+        Length at which M* is read [m] (M* does not depend on it); default nearest 90 mm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    walls = _walls_12bc(ds, walls)
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    coils = [float(c) for c in ds["coil_index"].values]
+    psis = [float(w) for w in ds["wrap_angle"].values]
+    fig, axes = _figure(1, len(walls), size=(4.4 * len(walls) + 0.4, 5.4))
+    for ax, t in zip(axes[0], walls):
+        _limit_lines(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
+                     coils, psis)
+        _examples(ax, ds, "torque_max", t)
+        ax.set_title(f"wall thickness {_eq('wall_thickness', t)}")
+        ax.set_ylabel(_label("torque_max"))
+        ax.set_ylim(bottom=0)
+    _legend_12bc(fig, coils, psis)
+    _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
+              "any length (M* does not depend on L; tip force = M*/L)")
+    _footer(fig, ds)
+    return fig
+
+
+def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
+    """Figure 12(c): maximum bend angle and range of motion against radius.
+
+    Top row: the maximum free bend angle theta* per coil index, solid while the design has
+    its full range of motion, with each wrap angle's threshold dashed (as figure 12(b)).
+    Bottom row: the range of motion theta*/theta(s_max) [%] at one wrap angle; it falls
+    below 100 % where the nylon's strength cuts the bend short.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    walls : sequence of float, optional
+        Wall thicknesses, one column each [m]; default nearest 2 and 6 mm.
+    length : float, optional
+        Actuator length [m] (theta* grows in proportion); default nearest 90 mm.
+    wrap_angle : float, optional
+        Wrap angle of the bottom row [rad]; default nearest 8 deg.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    walls = _walls_12bc(ds, walls)
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
+    coils = [float(c) for c in ds["coil_index"].values]
+    psis = [float(w) for w in ds["wrap_angle"].values]
+    fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
+                        height_ratios=(3, 2))
+    x = _disp("radius", ds["radius"].values)
+    for col, t in enumerate(walls):
+        sel = {"wall_thickness": t, "length": length}
+        top, bottom = axes[0][col], axes[1][col]
+        _limit_lines(top, ds, "bend_angle_max", sel, coils, psis)
+        _examples(top, ds, "bend_angle_max", t, length, corner="lower right")
+        top.set_title(f"wall thickness {_eq('wall_thickness', t)}")
+        top.set_xlabel("")
+        top.set_ylabel(_label("bend_angle_max"))
+        top.set_ylim(bottom=0)
+        for k, c in enumerate(coils):
+            rf = ds["range_fraction"].sel(coil_index=c, wrap_angle=psi, **sel).values
+            bottom.plot(x, 100 * rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
+        bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)} "
+                         "(100 % = full range)")
+        bottom.set_xlabel(_label("radius"))
+        bottom.set_ylabel("range of motion [%]")
+        bottom.set_ylim(0, 105)
+    _legend_12bc(fig, coils, psis)
+    _suptitle(fig, "Figure 12(c): maximum bend angle (range of motion) against radius",
+              f"{_eq('length', length)} (the angle grows in proportion to L; "
+              "the range fraction does not)")
+    _footer(fig, ds)
+    return fig
+
+
+# ---------------------------------------------------------------------------- figures 4-7
+def fig4(ds):
+    """Figure 4: chamber pressure against muscle stroke, with each coil index's s_max.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = _figure(1, 1, size=(5.6, 4.3))
+    ax = axes[0][0]
+    stroke = _disp("stroke", ds["stroke"].values)
+    p = _disp("chamber_pressure", ds["chamber_pressure"].values)
+    ax.plot(stroke, p, color=_COLOURS[0], lw=2.0, label="p(s), Boyle's law")
+    s_max = _stroke_max(ds)
+    for k, c in enumerate(ds["coil_index"].values):
+        if not np.isfinite(s_max[k]):
+            continue
+        p_k = float(np.interp(s_max[k], ds["stroke"].values, p))  # reading the curve
+        ax.plot([s_max[k]] * 2, [0, p_k], color="k", ls=":", lw=0.9)
+        ax.plot(s_max[k], p_k, "o", color=_COLOURS[(k + 1) % len(_COLOURS)], ms=6,
+                mec="k", label=f"largest stroke of C = {c:g}: s_max = {s_max[k]:.3f}, "
+                               f"p = {p_k:.3g} {VARIABLES['pressure'].display}")
+    ax.set_xlim(stroke[0], stroke[-1])
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel(_label("stroke", " [-]"))
+    ax.set_ylabel(_label("chamber_pressure"))
+    ax.legend(loc="upper left")
+    _suptitle(fig, "Figure 4: chamber pressure against muscle stroke",
+              "sealed air chamber, same for every design")
+    _footer(fig, ds)
+    return fig
+
+
+def _curve_panel(ax, ds, var, name, values, fixed):
+    pressure = _disp("pressure", ds["pressure"].values)
+    for i, v in enumerate(values):
+        y = ds[var].sel({name: v, **fixed}).values
+        ax.plot(pressure, _disp(var, y), color=_COLOURS[i % len(_COLOURS)],
+                label=_eq(name, v))
+    ax.set_xlim(pressure[0], pressure[-1])
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel(_label("pressure"))
+    ax.set_ylabel(_label(var))
+    ax.set_title(", ".join(_eq(k, v) for k, v in fixed.items()))
+    ax.legend(loc="upper left", title=VARIABLES[name].long_name)
+
+
+def fig6(ds, *, radius=None, wall_thickness=None, length=None):
+    """Figure 6(b, c): bend angle against pressure, for radius 6-14 mm and wall 1-4 mm.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    radius : float, optional
+        Radius of the wall panel [m]; default nearest 10 mm.
+    wall_thickness : float, optional
+        Wall of the radius panel [m]; default nearest 2 mm.
+    length : float, optional
+        Actuator length [m]; default nearest 90 mm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    a = _nearest(ds, "radius", 10e-3 if radius is None else radius)
+    t = _nearest(ds, "wall_thickness", 2e-3 if wall_thickness is None else wall_thickness)
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    fig, axes = _figure(1, 2, size=(9.0, 4.2))
+    _curve_panel(axes[0][0], ds, "bend_angle", "radius",
+                 _spread(ds, "radius", 6e-3, 14e-3, 5),
+                 {"wall_thickness": t, "length": length})
+    _curve_panel(axes[0][1], ds, "bend_angle", "wall_thickness",
+                 _spread(ds, "wall_thickness", 1e-3, 4e-3, 5),
+                 {"radius": a, "length": length})
+    _suptitle(fig, "Figure 6: bend angle against chamber pressure",
+              "(b) radius 6-14 mm, (c) wall thickness 1-4 mm; free bending")
+    _footer(fig, ds)
+    return fig
+
+
+def fig7(ds, *, radius=None, wall_thickness=None, length=None):
+    """Figure 7: blocked tip force against pressure, varying radius, wall and length.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    radius, wall_thickness, length : float, optional
+        The design the other panels hold fixed [m]; default nearest 10, 2 and 90 mm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    a = _nearest(ds, "radius", 10e-3 if radius is None else radius)
+    t = _nearest(ds, "wall_thickness", 2e-3 if wall_thickness is None else wall_thickness)
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    fig, axes = _figure(1, 3, size=(11.0, 4.0), sharey=True)
+    _curve_panel(axes[0][0], ds, "tip_force", "radius", _spread(ds, "radius", 6e-3, 14e-3, 5),
+                 {"wall_thickness": t, "length": length})
+    _curve_panel(axes[0][1], ds, "tip_force", "wall_thickness",
+                 _pick_few(ds, "wall_thickness", 6), {"radius": a, "length": length})
+    _curve_panel(axes[0][2], ds, "tip_force", "length", _pick_few(ds, "length", 5),
+                 {"radius": a, "wall_thickness": t})
+    for ax in axes[0][1:]:
+        ax.set_ylabel("")
+    _suptitle(fig, "Figure 7: blocked tip force against chamber pressure",
+              "actuator held straight; each panel varies one dimension")
+    _footer(fig, ds)
+    return fig
+
+
+# ---------------------------------------------------------------------------- design map
+def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
+    """Maximum tip force over radius and wall thickness, strength-limited region hatched.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    length : float, optional
+        Actuator length [m]; default nearest 90 mm.
+    wrap_angle : float, optional
+        Wrap angle [rad]; default nearest 8 deg.
+    coil_index : float or sequence of float, optional
+        Coil index of each panel [-]; default every coil index of the cube (up to four).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.patches import Patch
+
+    plt = _plt()
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
+    if coil_index is None:
+        coils = _pick_few(ds, "coil_index", 4)
+    else:
+        coils = [_nearest(ds, "coil_index", c) for c in np.atleast_1d(coil_index)]
+    ncols = 1 if len(coils) == 1 else 2
+    nrows = math.ceil(len(coils) / ncols)
+    fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
+                        sharex=True, sharey=True)
+    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi)
+    force = _disp("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
+    top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
+    levels = _nice_levels(top)
+    x = _disp("radius", ds["radius"].values)
+    y = _disp("wall_thickness", ds["wall_thickness"].values)
+    mappable = None
+    for i, ax in enumerate(axes.flat):
+        if i >= len(coils):
+            ax.set_visible(False)
+            continue
+        c = coils[i]
+        f = _disp("tip_force_max", cut["tip_force_max"].sel(coil_index=c)
+                  .transpose("wall_thickness", "radius").values)
+        lim = cut["limit"].sel(coil_index=c).transpose("wall_thickness", "radius").values
+        mappable = ax.contourf(x, y, f, levels=levels, cmap="viridis", extend="max")
+        lines = ax.contour(x, y, f, levels=levels[2::2], colors="white", linewidths=0.6)
+        ax.clabel(lines, fmt="%g N", fontsize=7.5)
+        strength = np.where(np.isnan(lim), np.nan, (lim == 1).astype(float))
+        if np.nanmax(np.nan_to_num(strength)) > 0:
+            with plt.rc_context({"hatch.color": "white", "hatch.linewidth": 0.8}):
+                ax.contourf(x, y, strength, levels=[0.5, 1.5], colors="none",
+                            hatches=["///"])
+            ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
+        for a, t_ex, l_ex, c_ex in _EXAMPLES:
+            if (abs(_nearest(ds, "length", l_ex) - length) < 1e-12
+                    and abs(_nearest(ds, "coil_index", c_ex) - c) < 1e-12):
+                ax.plot(_disp("radius", a), _disp("wall_thickness", t_ex), "*", ms=13,
+                        mfc="gold", mec="k", clip_on=False, zorder=6)
+        ax.set_title(_eq("coil_index", c))
+        ax.grid(False)
+        if i % ncols == 0:
+            ax.set_ylabel(_label("wall_thickness"))
+        if i >= len(coils) - ncols:
+            ax.set_xlabel(_label("radius"))
+    fig.colorbar(mappable, ax=axes, label=_label("tip_force_max"), shrink=0.9)
+    handles = [Patch(fc="#2a788e", ec="white", hatch="///",
+                     label="strength-limited: nylon breaks first, range of motion cut short"),
+               Patch(fc="#2a788e", ec="none", label="stroke-limited: full range of motion")]
+    if any(abs(_nearest(ds, "length", e[2]) - length) < 1e-12 for e in _EXAMPLES):
+        from matplotlib.lines import Line2D
+
+        handles.append(Line2D([], [], ls="", marker="*", ms=10, mfc="gold", mec="k",
+                              label="paper's worked example"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=8)
+    _suptitle(fig, "Design map: maximum tip force over radius and wall thickness",
+              f"slice {_eq('length', length)}, {_eq('wrap_angle', psi)}; "
+              "one panel per coil index")
+    _footer(fig, ds)
+    return fig
+
+
+def _nice_levels(top):
+    """About ten round contour levels from 0 to ``top``."""
+    raw = top / 10
+    mag = 10 ** math.floor(math.log10(raw)) if raw > 0 else 1.0
+    step = min((s * mag for s in (1, 2, 2.5, 5, 10) if s * mag >= raw), default=raw)
+    return np.arange(0, top + step, step)
+
+
+# ---------------------------------------------------------------------------- drivers
+#: Chart name -> function, the names a config's ``charts`` list accepts.
+CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
+          "fig6": fig6, "fig7": fig7, "design_map": design_map}
+assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
+
+
+def draw_charts(ds, names, out_dir, fmt="png") -> list[Path]:
+    """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube (:func:`nylonflex.open_cube`).
+    names : sequence of str or None
+        Chart names (:data:`CHARTS`); None draws them all.
+    out_dir : path
+        Folder for the images (created if missing).
+    fmt : {"png", "pdf", "svg"}
+        Image format.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in the order of ``names``.
+
+    Raises
+    ------
+    InputError
+        An unknown chart name or format.
+    """
+    names = list(CHARTS) if not names else list(names)
+    unknown = [n for n in names if n not in CHARTS]
+    if unknown:
+        raise InputError(f"--figure: unknown chart {unknown[0]!r}; accepted: "
+                         f"{', '.join(CHARTS)}")
+    if fmt not in FORMATS:
+        raise InputError(f"--format: unknown image format {fmt!r}; accepted: "
+                         f"{', '.join(FORMATS)}")
+    plt = _plt()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in names:
+        with plt.rc_context(_RC):
+            fig = CHARTS[name](ds)
+            path = out_dir / f"{name}.{fmt}"
+            # fixed metadata so that the same cube gives byte-stable PDF/SVG files
+            meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
+                    "svg": {"Date": None}}[fmt]
+            fig.savefig(path, format=fmt, metadata=meta, bbox_inches="tight",
+                        pad_inches=0.08)
+            plt.close(fig)
+        written.append(path)
+    return written
+
+
+def chart_command(args) -> int:
+    """``nylonflex chart CUBE``: draw charts of a saved cube (beside it by default)."""
+    import warnings
+
+    from .storage import open_cube
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = open_cube(args.cube)
+    import sys
+
+    for w in caught:
+        print(f"nylonflex chart: warning: {w.message}", file=sys.stderr)
+    out = Path(args.out) if args.out else Path(args.cube).parent
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out: {out} is a file; give a folder for the images")
+    try:
+        for path in draw_charts(ds, args.figure, out, args.format):
+            print(path)
+    finally:
+        ds.close()
+    return 0
