@@ -1,4 +1,10 @@
-"""nylonflex: design-space sweeps of nylon-muscle-driven soft bending actuators."""
+"""nylonflex: design-space sweeps of nylon-muscle-driven soft bending actuators.
+
+>>> import nylonflex as nf
+>>> nf.design_limits(radius=7.5e-3, wall_thickness=2e-3, length=70e-3, coil_index=1.7,
+...                  wrap_angle=0.1396)["tip_force_max"]  # doctest: +ELLIPSIS
+0.150...
+"""
 
 from importlib.metadata import PackageNotFoundError, version
 
@@ -15,6 +21,20 @@ __all__ = [
     "SILICONE_PARAMETERS",
     "__version__",
     "design_limits",
+    "load_config",
     "nylon_parameters",
+    "open_cube",
+    "run_sweep",
     "silicone_parameters",
 ]
+
+_LAZY = {"load_config": "config", "run_sweep": "sweep", "open_cube": "storage"}
+
+
+def __getattr__(name):
+    # the sweep side pulls in pydantic, xarray and h5py: load it on first use only
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module 'nylonflex' has no attribute {name!r}")

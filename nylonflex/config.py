@@ -20,7 +20,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
 
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
-from .units import InputError, parse_quantity, to_si
+from .units import InputError, from_si, parse_quantity, to_si
 
 __all__ = ["CHARTS", "SweepConfig", "apply_overrides", "load_config", "parse_config"]
 
@@ -177,33 +177,31 @@ def _pydantic_message(err: ValidationError) -> str:
 def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
     kind, unit, lo, hi, shown = _AXIS_RULES[name]
     units = axis.units or unit
-    try:
-        to_si(1.0, units, f"{path}.units", kind)
-    except InputError:
-        raise
+    to_si(1.0, units, f"{path}.units", kind)
+    if name == "coil_index":
+        lo, hi = nylon.coil_index_range
+
+    def value(text, field):
+        v = parse_quantity(text, field, kind, units)
+        if not (np.isfinite(v) and lo - 1e-12 <= v <= hi + 1e-12):
+            rng = f"[{from_si(lo, shown):g}, {from_si(hi, shown):g}]"
+            unit_txt = "" if shown == "1" else f" {shown}"
+            raise InputError(f"{field}: must be in {rng}{unit_txt}, got "
+                             f"{from_si(v, shown):g}{unit_txt}")
+        return min(max(v, lo), hi)
+
     if axis.values is not None:
         if len(axis.values) == 0:
             raise InputError(f"{path}.values: needs at least one value")
-        vals = np.array([parse_quantity(v, f"{path}.values[{i}]", kind, units)
-                         for i, v in enumerate(axis.values)], dtype=float)
+        vals = np.array([value(v, f"{path}.values[{i}]") for i, v in enumerate(axis.values)])
     else:
         if not 1 <= axis.num <= _MAX_POINTS:
             raise InputError(f"{path}.num: must be in [1, {_MAX_POINTS}], got {axis.num}")
-        start = parse_quantity(axis.start, f"{path}.start", kind, units)
-        stop = parse_quantity(axis.stop, f"{path}.stop", kind, units)
+        start, stop = value(axis.start, f"{path}.start"), value(axis.stop, f"{path}.stop")
         vals = np.linspace(start, stop, axis.num) if axis.num > 1 else np.array([start])
-    if name == "coil_index":
-        lo, hi = nylon.coil_index_range
-    if not np.all(np.isfinite(vals)) or vals.min() < lo - 1e-12 or vals.max() > hi + 1e-12:
-        bad = vals[~np.isfinite(vals) | (vals < lo - 1e-12) | (vals > hi + 1e-12)][0]
-        from .units import from_si
-        rng = f"[{from_si(lo, shown):g}, {from_si(hi, shown):g}]"
-        unit_txt = "" if shown == "1" else f" {shown}"
-        raise InputError(f"{path}: must be in {rng}{unit_txt}, got "
-                         f"{from_si(bad, shown):g}{unit_txt}")
     if len(vals) > 1 and np.any(np.diff(vals) <= 0):
         raise InputError(f"{path}: values must be strictly increasing")
-    return np.clip(vals, lo, hi)
+    return vals
 
 
 def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:

@@ -55,9 +55,10 @@ def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
     """
     per = _bytes_per_radius(cfg)
     na = cfg.shape[0]
-    chunk = max(1, min(na, (2 * 2**20) // max(1, per // 9)))
-    per_slab = max(1, int(cfg.slab_megabytes * 2**20) // per)
-    per_slab = max(chunk, (per_slab // chunk) * chunk)
+    per_slab = min(na, max(1, int(cfg.slab_megabytes * 2**20) // per))
+    # chunks of about 2 MB of one variable, never longer than a slab
+    chunk = max(1, min(per_slab, (2 * 2**20) // max(1, per // 9)))
+    per_slab = (per_slab // chunk) * chunk
     return [(i, min(na, i + per_slab)) for i in range(0, na, per_slab)], chunk
 
 
@@ -289,8 +290,11 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     stopped = None
     previous = signal.getsignal(signal.SIGTERM)
 
+    term = []
+
     def on_term(signum, frame):
-        raise _Stop()
+        term.append(signum)  # a raise that lands in a weakref callback is swallowed;
+        raise _Stop()        # the loop below then stops after the slab it is writing
 
     in_main = _is_main_thread()
     if in_main:
@@ -317,6 +321,8 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
                 done_slabs.add(k)
                 computed += (i1 - i0) * per_radius
                 bar.update((i1 - i0) * per_radius)
+                if term:
+                    raise _Stop()
     except (KeyboardInterrupt, _Stop) as exc:
         stopped = exc
     finally:

@@ -1,0 +1,25 @@
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))  # tests/reference.py
+
+DEG = math.pi / 180.0
+
+#: MODEL.md section 8: the paper's two worked examples (a, t, L, C), psi = 8 deg, b = t.
+EXAMPLE_1 = dict(radius=20e-3, wall_thickness=6e-3, length=90e-3, coil_index=1.1,
+                 wrap_angle=8 * DEG)
+EXAMPLE_2 = dict(radius=7.5e-3, wall_thickness=2e-3, length=70e-3, coil_index=1.7,
+                 wrap_angle=8 * DEG)
+
+
+@pytest.fixture
+def example_1():
+    return dict(EXAMPLE_1)
+
+
+@pytest.fixture
+def example_2():
+    return dict(EXAMPLE_2)

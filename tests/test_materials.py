@@ -1,0 +1,49 @@
+import pytest
+
+from nylonflex.materials import (
+    NYLON_PARAMETERS,
+    SILICONE_PARAMETERS,
+    nylon_parameters,
+    silicone_parameters,
+)
+
+
+@pytest.mark.parametrize("name,mu0", [
+    # MODEL.md section 9, column mu_0 (printed to 3 digits from rounded mu, alpha)
+    ("tc5005", 22.9e3), ("ecoflex_00_30", 17.3e3), ("dragon_skin_10", 50.1e3),
+    ("elastosil_m4601", 220e3)])
+def test_initial_shear_modulus_matches_model_table(name, mu0):
+    assert silicone_parameters(name).initial_shear_modulus == pytest.approx(mu0, rel=5e-3)
+
+
+def test_every_value_has_a_source():
+    for name, p in SILICONE_PARAMETERS.items():
+        assert set(p["sources"]) >= {"mu", "alpha"}, name
+    for name, p in NYLON_PARAMETERS.items():
+        numeric = {k for k, v in p.items() if k not in ("description", "sources")}
+        assert numeric <= set(p["sources"]), (name, numeric - set(p["sources"]))
+        # each source carries its tag S/D/P/K (MODEL.md section 9)
+        assert all(s.split(":")[0].strip("/ ")[0] in "SDPKM" for s in p["sources"].values())
+
+
+def test_override_field_by_field():
+    s = silicone_parameters({"set": "tc5005", "mu": [50e3, 10e3]})
+    assert s.mu == (50e3, 10e3) and s.alpha == (0.2975, 2.770)
+    assert s.name == "tc5005+override"
+    n = nylon_parameters("silver_nylon66", fibre_diameter=0.3e-3)
+    assert n.fibre_diameter == 0.3e-3 and n.t_max == pytest.approx(423.15)
+
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: silicone_parameters("rubber"), r"silicone: unknown set 'rubber'; accepted"),
+    (lambda: nylon_parameters("kevlar"), r"nylon: unknown set 'kevlar'"),
+    (lambda: silicone_parameters("tc5005", shore=3), r"silicone.shore: unknown field"),
+    (lambda: silicone_parameters("tc5005", mu=[-1e3, 0]), r"silicone.mu: initial shear"),
+    (lambda: nylon_parameters("silver_nylon66", fibre_diameter=-1),
+     r"nylon.fibre_diameter: must be > 0"),
+    (lambda: nylon_parameters("silver_nylon66", stroke_max_table=(0.1, 0.2, 1.3, 0.4)),
+     r"nylon.stroke_max_table"),
+])
+def test_bad_material_names_the_field(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()

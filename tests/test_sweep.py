@@ -1,0 +1,279 @@
+"""The sweep end to end: config -> cube file, round trip, resume, refusals, CLI."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from nylonflex.cli import main
+from nylonflex.config import parse_config
+from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
+from nylonflex.sweep import _bytes_per_radius, plan_slabs, run_sweep
+from nylonflex.variables import VARIABLES
+
+SMALL = {
+    "name": "small",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 9, "units": "mm"},
+        "wall_thickness": {"values": [1, 3, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"values": [5, 20], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 40, "num": 5, "units": "kPa"}},
+    "slab_megabytes": 1,
+}
+
+
+def stable(ds):
+    """The dataset without the attributes that differ between two runs."""
+    ds = ds.copy()
+    ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS}
+    return ds
+
+
+def write_config(tmp_path, raw, name="cfg.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(raw))
+    return path
+
+
+def test_round_trip_file_equals_memory(tmp_path):
+    cfg = parse_config(SMALL)
+    mem = run_sweep(cfg)
+    disk = run_sweep(cfg, tmp_path / "cube.h5")
+    assert disk.attrs["complete"] == "true"
+    xr.testing.assert_equal(mem, disk.load())
+    for name in disk.variables:
+        assert disk[name].attrs["units"] and disk[name].attrs["long_name"], name
+        if name in VARIABLES:
+            assert disk[name].attrs["units"] == VARIABLES[name].units
+
+
+def test_cube_is_readable_by_h5py_and_netcdf4_with_units_and_provenance(tmp_path):
+    netCDF4 = pytest.importorskip("netCDF4")
+    cfg = parse_config(SMALL)
+    path = tmp_path / "cube.h5"
+    run_sweep(cfg, path).close()
+    with netCDF4.Dataset(path) as nc:
+        for name, var in nc.variables.items():
+            assert var.units, name
+        assert nc.variables["tip_force_max"].units == "N"
+        assert nc.variables["limit"].flag_meanings == "stroke_limited strength_limited"
+    with h5py.File(path, "r") as f:
+        assert f["tip_force_max"].compression == "gzip"
+        assert f["tip_force_max"].chunks is not None
+        attrs = dict(f.attrs)
+    for key in ("config_yaml", "config_sha256", "nylonflex_version", "numba_version",
+                "numpy_version", "silicone_parameters", "nylon_parameters", "quadrature",
+                "run_seconds", "designs_per_second"):
+        assert key in attrs, key
+    assert yaml.safe_load(attrs["config_yaml"])["grid"]["radius"][0] == 0.005
+    assert "Marechal" in attrs["silicone_parameters"]
+
+
+def test_slabs_bound_memory():
+    cfg = parse_config({**SMALL, "slab_megabytes": 1})
+    slabs, chunk = plan_slabs(cfg)
+    assert slabs[0][0] == 0 and slabs[-1][1] == 9
+    big = parse_config({**SMALL, "grid": {**SMALL["grid"],
+                                          "radius": {"start": 5, "stop": 25, "num": 4000}}})
+    slabs, chunk = plan_slabs(big)
+    per_radius = _bytes_per_radius(big)
+    assert len(slabs) > 1 and slabs[-1][1] == 4000
+    assert all((i1 - i0) * per_radius <= 2**20 for i0, i1 in slabs)
+    assert all((i1 - i0) % chunk == 0 for i0, i1 in slabs[:-1])
+
+
+def _journaled(out):
+    return len(Journal(out).done())
+
+
+def _kill_halfway(cmd, out, sig, at_least=3):
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if _journaled(out) >= at_least:
+            proc.send_signal(sig)
+            break
+        time.sleep(0.005)
+    proc.communicate(timeout=120)
+    return proc.returncode
+
+
+BIGGER = {**SMALL, "name": "bigger",
+          "grid": {**SMALL["grid"], "radius": {"start": 5, "stop": 25, "num": 160},
+                   "wall_thickness": {"start": 1, "stop": 6, "num": 30},
+                   "wrap_angle": {"values": [3, 5, 8, 12, 20, 30]}}}
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
+def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
+    cfg_path = write_config(tmp_path, BIGGER)
+    out = tmp_path / "run" / "cube.h5"
+    cmd = [sys.executable, "-m", "nylonflex", "sweep", str(cfg_path), "--out", str(out),
+           "--quiet", "--no-charts"]
+    rc = _kill_halfway(cmd, out, sig)
+    if rc == 0:
+        pytest.skip("the sweep finished before it could be killed")
+    done = _journaled(out)
+    assert done >= 3
+    if sig == signal.SIGKILL:
+        # a killed run never leaves a file that reads as complete
+        assert not out.exists()
+        with pytest.raises(ValueError, match="--resume"):
+            open_cube(out)
+    else:
+        # a stopped run leaves an incomplete cube that can be read where it is done
+        with pytest.warns(UserWarning, match="incomplete"):
+            part = open_cube(out)
+        assert part.attrs["complete"] == "false"
+        assert 0 < int(part["slab_done"].sum()) < 160
+        part.close()
+    # without --resume the journal is protected
+    assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet"]) == 2
+    assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--resume",
+                 "--no-charts"]) == 0
+    resumed = open_cube(out)
+    assert resumed.attrs["resumed_slabs"] == str(done)
+    whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")
+    xr.testing.assert_identical(stable(resumed), stable(whole))
+    assert not Journal(out).dir.exists()
+
+
+def test_resume_refuses_a_changed_config(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    cfg = parse_config(SMALL)
+    Journal(out).start({"name": "small", "config_sha256": "0" * 64, "slabs": []})
+    path = write_config(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--out", str(out), "--resume", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "config changed" in err and err.count("\n") == 1
+    assert cfg.sha256[:12] in err
+
+
+def test_second_sweep_on_the_same_output_is_refused(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    path = write_config(tmp_path, SMALL)
+    with exclusive(out):
+        assert main(["sweep", str(path), "--out", str(out), "--quiet"]) == 1
+    assert "another sweep is writing" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_resume_of_a_complete_cube_does_nothing(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    path = write_config(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--out", str(out), "--no-charts"]) == 0
+    before = out.stat().st_mtime_ns
+    assert main(["sweep", str(path), "--out", str(out), "--resume", "--no-charts"]) == 0
+    assert out.stat().st_mtime_ns == before
+    assert "already complete" in capsys.readouterr().err
+
+
+def _mutate(raw, path, value):
+    import copy
+
+    raw = copy.deepcopy(raw)
+    node = raw
+    for key in path[:-1]:
+        node = node[key]
+    if value is KeyError:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    return raw
+
+
+@pytest.mark.parametrize("path,value,match", [
+    (("grid", "radius", "colour"), "red", r"grid.radius.colour: unknown key"),
+    (("grid", "wall_thickness"), KeyError, r"grid.wall_thickness: missing key"),
+    (("grid", "radius", "units"), "kPa", r"grid.radius.units: unit 'kPa' is not a length"),
+    (("grid", "radius", "units"), "furlong", r"grid.radius.units: unknown unit 'furlong'"),
+    (("grid", "radius", "start"), "five", r"grid.radius.start: expected a number"),
+    (("grid", "radius", "stop"), 900, r"grid.radius.stop: must be in \[0.5, 200\] mm, got 900 mm"),
+    (("grid", "coil_index", "values"), [1.1, 2.5], r"grid.coil_index.values\[1\]: must be in \[1.1, 1.7\], got 2.5"),
+    (("grid", "wrap_angle", "values"), [], r"grid.wrap_angle.values: needs at least one"),
+    (("grid", "length", "values"), [90, 70], r"grid.length: values must be strictly incr"),
+    (("curves", "pressure", "stop"), 500, r"curves.pressure.stop: must be in \[0, 100\] kPa, got 500 kPa"),
+    (("curves", "stroke", "stop"), 1.2, r"curves.stroke.stop: must be in \[0, 0.5\], got 1.2"),
+    (("silicone",), "jelly", r"silicone: unknown set 'jelly'"),
+    (("nylon",), {"set": "silver_nylon66", "colour": 1}, r"nylon.colour: unknown field"),
+    (("name",), "../x", r"name: letters, digits"),
+    (("charts",), ["fig99"], r"charts.0: must be one of"),
+])
+def test_bad_config_exits_2_with_one_line_and_no_file(tmp_path, capsys, path, value, match):
+    import re
+
+    cfg_path = write_config(tmp_path, _mutate(SMALL, path, value))
+    out = tmp_path / "cube.h5"
+    assert main(["sweep", str(cfg_path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert re.search(match, err), err
+    assert not out.exists() and not Journal(out).dir.exists()
+
+
+def test_config_file_errors(tmp_path, capsys):
+    assert main(["sweep", str(tmp_path / "nope.yaml")]) == 2
+    assert "no such config file" in capsys.readouterr().err
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: [unclosed\n")
+    assert main(["sweep", str(bad)]) == 2
+    assert "not valid YAML" in capsys.readouterr().err
+    assert main(["sweep", str(write_config(tmp_path, SMALL)), "--set", "grid.radius.num"]) == 2
+    assert "expected KEY=VALUE" in capsys.readouterr().err
+
+
+def test_set_overrides_a_config_key(tmp_path):
+    path = write_config(tmp_path, SMALL)
+    out = tmp_path / "cube.h5"
+    assert main(["sweep", str(path), "--out", str(out), "--quiet", "--no-charts",
+                 "--set", "grid.radius.num=3", "--set", "grid.length.values=[80mm]",
+                 "--workers", "1"]) == 0
+    ds = open_cube(out)
+    assert ds.sizes["radius"] == 3 and ds["length"].values.tolist() == [0.08]
+    assert ds.attrs["workers"] == "1"
+
+
+def test_default_output_under_sweeps(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = write_config(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--quiet", "--no-charts"]) == 0
+    assert (tmp_path / "sweeps" / "small" / "cube.h5").is_file()
+
+
+def test_info_describes_a_cube(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    run_sweep(parse_config(SMALL), out).close()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "complete" in text and "radius" in text and "5 .. 25 mm" in text
+    assert "nylonflex_version" in text
+
+
+@pytest.mark.parametrize("content", [b"", b"not a cube at all", None])
+def test_a_file_that_is_not_a_cube_is_refused(tmp_path, capsys, content):
+    path = tmp_path / "x.h5"
+    if content is None:
+        with h5py.File(path, "w") as f:
+            f["a"] = np.arange(3)
+    else:
+        path.write_bytes(content)
+    assert main(["info", str(path)]) == 2
+    assert "not a nylonflex cube" in capsys.readouterr().err
+
+
+def test_workers_out_of_range(tmp_path, capsys):
+    path = write_config(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--out", str(tmp_path / "c.h5"), "--workers", "0"]) == 2
+    assert "--workers: must be in [1," in capsys.readouterr().err
