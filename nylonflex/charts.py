@@ -310,6 +310,8 @@ def _examples(ax, ds, var, t, length=None, corner="upper left"):
               "wrap_angle": _nearest(ds, "wrap_angle", _WRAP_DEFAULT)}
         point = ds[[var, "tip_force_max", "limit"]].sel(**at)
         x, y = float(_disp("radius", at["radius"])), float(_disp(var, point[var]))
+        if not np.isfinite(y):  # an incomplete cube without this design
+            continue
         ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
         text = f"paper example: {_eq('radius', at['radius'])}, " \
                f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}"

@@ -1,0 +1,481 @@
+"""``nylonflex query``: ask a saved cube about designs, with units, in bounded memory.
+
+A query picks designs three ways, which combine:
+
+* ``--at radius=7.5mm,coil_index=1.7``: fixes the named axes. A value on the grid (within a
+  tiny tolerance) is read as is ("grid point"); between grid points the design variables
+  are interpolated linearly in each axis ("interpolated"). Axes not named keep all their
+  grid values, so a partial ``--at`` lists a slice of the cube (one row per design); naming
+  all five axes gives one design. Outside the grid is refused.
+* ``--where "tip_force_max >= 0.5 N"``: conditions on axes or design variables, with units;
+  several are ANDed.
+* ``--sort NAME`` (``--sort=-NAME`` or ``--sort NAME:desc`` descending; ties keep grid
+  order) and ``--limit N``.
+
+The cube is read in slabs of radii, so memory stays bounded on a cube of any size; only the
+matching rows (at most ``--limit`` when sorting) are kept.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import re
+import sys
+import warnings
+
+import numpy as np
+
+from .units import InputError, from_si, parse_quantity
+from .variables import AXES, DESIGN, VARIABLES
+
+__all__ = ["Condition", "QueryResult", "parse_at", "parse_where", "query_cube",
+           "query_command"]
+
+#: Columns of every row: the five axes, then the design variables (registry order).
+COLUMNS = (*AXES, *DESIGN)
+_FIELDS = ", ".join(COLUMNS)
+# Values this close (relative to the axis span) to a grid value are that grid value.
+_GRID_RTOL = 1e-6
+# Slab size when scanning a cube: about this many float64 values per variable.
+_SLAB_VALUES = 2**20
+_LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1}
+
+
+# ---------------------------------------------------------------------------- parsing
+def _quantity(name, text, field):
+    v = VARIABLES[name]
+    if name == "limit" and str(text).strip().lower() in _LIMIT_WORDS:
+        return float(_LIMIT_WORDS[str(text).strip().lower()])
+    return parse_quantity(text, field, v.kind, v.display)
+
+
+def parse_at(text) -> dict:
+    """Parse ``"radius=7.5mm,wall_thickness=2mm"`` into ``{axis: SI value}``.
+
+    Bare numbers are in the axis's display unit (mm, deg; none for ``coil_index``).
+
+    Raises
+    ------
+    InputError
+        Not ``NAME=VALUE``, an unknown axis, a repeated axis or a bad value.
+    """
+    out = {}
+    for part in [p for p in str(text).split(",") if p.strip()]:
+        if "=" not in part:
+            raise InputError(f"--at: expected NAME=VALUE, got {part.strip()!r}; names: "
+                             f"{', '.join(AXES)}")
+        name, value = (s.strip() for s in part.split("=", 1))
+        if name not in AXES:
+            raise InputError(f"--at: unknown axis {name!r}; accepted: {', '.join(AXES)}")
+        if name in out:
+            raise InputError(f"--at: {name} given twice")
+        out[name] = float(_quantity(name, value, f"--at {name}"))
+    if not out:
+        raise InputError(f"--at: expected NAME=VALUE,...; names: {', '.join(AXES)}")
+    return out
+
+
+class Condition:
+    """One ``--where`` condition: ``name op value`` with ``value`` in SI."""
+
+    _OPS = {"<=": np.less_equal, ">=": np.greater_equal, "<": np.less, ">": np.greater,
+            "==": None, "=": None, "!=": None}
+    _PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
+
+    def __init__(self, text: str):
+        m = self._PATTERN.match(str(text))
+        if not m:
+            raise InputError(f"--where: expected 'NAME OP VALUE [UNIT]' with OP one of "
+                             f"<, <=, ==, !=, >=, >, got {text!r}")
+        self.name, op, value = m.groups()
+        if self.name not in COLUMNS:
+            raise InputError(f"--where: unknown name {self.name!r}; accepted: {_FIELDS}")
+        self.op = "==" if op == "=" else op
+        self.value = float(_quantity(self.name, value, f"--where {self.name}"))
+        self.text = str(text).strip()
+
+    def mask(self, x: np.ndarray) -> np.ndarray:
+        """True where ``x`` [SI] meets the condition (NaN never does)."""
+        if self.op in ("==", "!="):
+            # equality to a typed value up to its float noise (7.5 mm, 8 deg, 1)
+            near = np.isclose(x, self.value, rtol=1e-9, atol=1e-12 * max(1.0, abs(self.value)))
+            return near if self.op == "==" else ~near & ~np.isnan(x)
+        return self._OPS[self.op](x, self.value)
+
+    def __repr__(self):
+        return f"Condition({self.text!r})"
+
+
+def parse_where(texts) -> list[Condition]:
+    """Parse ``--where`` strings (ANDed) into :class:`Condition` objects."""
+    return [Condition(t) for t in texts or ()]
+
+
+def _parse_sort(text):
+    if not text:
+        return None, False
+    name = text.strip()
+    descending = name.startswith("-")
+    name = name.lstrip("-+").strip()
+    # "NAME:desc" too: argparse reads "--sort -NAME" as an option (write --sort=-NAME)
+    if ":" in name:
+        name, order = (s.strip() for s in name.split(":", 1))
+        if order not in ("asc", "desc"):
+            raise InputError(f"--sort: order must be 'asc' or 'desc', got {order!r}")
+        descending = order == "desc"
+    if name not in COLUMNS:
+        raise InputError(f"--sort: unknown name {name!r}; accepted: {_FIELDS} "
+                         "(prefix '-' for descending)")
+    return name, descending
+
+
+# ---------------------------------------------------------------------------- the grid
+def _locate(ds, name, value):
+    """Where ``value`` [SI] sits on axis ``name``: ``(i0, i1, weight of i1, on_grid)``.
+
+    Raises
+    ------
+    InputError
+        The value lies outside the axis's range (the message gives it in display units).
+    """
+    grid = ds[name].values.astype(float)
+    lo, hi = float(grid.min()), float(grid.max())
+    tol = _GRID_RTOL * max(hi - lo, abs(hi), abs(lo), 1e-300)
+    near = int(np.argmin(np.abs(grid - value)))
+    if abs(grid[near] - value) <= tol:
+        return near, near, 0.0, True
+    if not lo - tol <= value <= hi + tol:
+        v = VARIABLES[name]
+        unit = "" if v.display == "1" else f" {v.display}"
+        shown = ", ".join(f"{x:g}" for x in from_si(grid, v.display)) if grid.size <= 8 \
+            else f"{from_si(lo, v.display):g} .. {from_si(hi, v.display):g}"
+        raise InputError(f"--at: {name}={from_si(value, v.display):g}{unit} is outside the "
+                         f"cube's grid; {name} takes {shown}{unit}")
+    if np.any(np.diff(grid) <= 0):  # a grid the sweep wrote is increasing; be safe
+        raise InputError(f"--at: the cube's {name} axis is not increasing; cannot interpolate")
+    i1 = int(np.searchsorted(grid, value))
+    i0 = i1 - 1
+    return i0, i1, float((value - grid[i0]) / (grid[i1] - grid[i0])), False
+
+
+# ---------------------------------------------------------------------------- the scan
+class QueryResult:
+    """Rows of a query: ``data`` maps each column to an SI array.
+
+    Attributes
+    ----------
+    data : dict of str to numpy.ndarray
+        One array per column of :data:`COLUMNS`, SI.
+    point : str or None
+        ``"grid point"`` or ``"interpolated"`` for an ``--at`` query, else None.
+    interpolated : list of str
+        The ``--at`` axes that were interpolated.
+    matched : int or None
+        Designs that met the conditions (None when the scan stopped early).
+    single : bool
+        The query named one design (all five axes in ``--at``).
+    """
+
+    def __init__(self, data, point, interpolated, matched, single, at):
+        self.data, self.point, self.interpolated = data, point, interpolated
+        self.matched, self.single, self.at = matched, single, at
+
+    def __len__(self):
+        return len(self.data[COLUMNS[0]])
+
+
+def _slab_rows(ds, at_loc, r0, r1):
+    """Rows (SI arrays by column) of radius indices [r0, r1) after ``--at`` selection."""
+    # read each given axis's bracketing pair (one index on a grid point), then collapse it
+    index = {name: slice(i0, i1 + 1) for name, (i0, i1, _, _) in at_loc.items()
+             if name != "radius"}
+    index["radius"] = slice(r0, r1)
+    sub = ds[list(DESIGN)].isel(index).load()
+    sub = sub.astype(float)  # limit: int8 (float when masked); NaN marks unknown below
+    for name, (i0, i1, w, on_grid) in at_loc.items():
+        if on_grid or i0 == i1:
+            sub = sub.isel({name: 0})
+            continue
+        a, b = sub.isel({name: 0}), sub.isel({name: 1})
+        mixed = (a["limit"] != b["limit"]) | a["limit"].isnull() | b["limit"].isnull()
+        if name == "length":
+            # F* = M*/L and theta* = kappa(p*) L (MODEL.md s. 8): interpolate the
+            # length-free M* and kappa*, exact along this axis, then scale back
+            la, lb = (float(ds["length"].values[k]) for k in at_loc["length"][:2])
+            length = la * (1.0 - w) + lb * w
+            a["tip_force_max"], b["tip_force_max"] = (a["tip_force_max"] * la,
+                                                      b["tip_force_max"] * lb)
+            a["bend_angle_max"], b["bend_angle_max"] = (a["bend_angle_max"] / la,
+                                                        b["bend_angle_max"] / lb)
+        sub = a * (1.0 - w) + b * w
+        if name == "length":
+            sub["tip_force_max"] = sub["tip_force_max"] / length
+            sub["bend_angle_max"] = sub["bend_angle_max"] * length
+        # a limit between two grid points is known only where both agree
+        sub["limit"] = a["limit"].where(~mixed)
+    dims = [d for d in AXES if d in sub.dims]
+    shape = [sub.sizes[d] for d in dims]
+    rows = {}
+    for name in AXES:
+        if name in sub.dims:
+            axis_shape = [-1 if d == name else 1 for d in dims]
+            coord = sub[name].values.astype(float).reshape(axis_shape)
+            rows[name] = np.broadcast_to(coord, shape).reshape(-1)
+        else:
+            rows[name] = np.full(int(np.prod(shape)), at_value(at_loc, name, ds))
+    for name in DESIGN:
+        rows[name] = sub[name].transpose(*dims).values.reshape(-1)
+    return rows
+
+
+def at_value(at_loc, name, ds):
+    """SI value of an ``--at`` axis after location (the grid value on a grid point)."""
+    i0, i1, w, on_grid = at_loc[name]
+    grid = ds[name].values.astype(float)
+    return float(grid[i0]) if on_grid else float(grid[i0] * (1 - w) + grid[i1] * w)
+
+
+def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
+    """Designs of a cube selected by ``--at``, filtered by ``--where``, sorted, limited.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab).
+    at : dict or str, optional
+        ``{axis: SI value}`` or the ``--at`` text.
+    where : sequence of str or Condition
+        Conditions, ANDed.
+    sort : str, optional
+        Column to sort by, ``-NAME`` for descending; ties keep grid order.
+    limit : int, optional
+        At most this many rows.
+
+    Returns
+    -------
+    QueryResult
+
+    Raises
+    ------
+    InputError
+        Bad names, units or values, or an ``--at`` point outside the grid.
+    """
+    if isinstance(at, str):
+        at = parse_at(at)
+    at = dict(at or {})
+    conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
+    sort_name, descending = _parse_sort(sort)
+    if limit is not None and limit < 0:
+        raise InputError(f"--limit: must be 0 or more, got {limit}")
+    at_loc = {name: _locate(ds, name, value) for name, value in at.items()}
+    interpolated = [name for name, loc in at_loc.items() if not loc[3]]
+
+    # radius slabs: the --at bracket, or the whole axis cut to bounded memory
+    if "radius" in at_loc:
+        i0, i1 = at_loc["radius"][:2]
+        slabs = [(i0, i1 + 1)]
+    else:
+        other = 1
+        for name in AXES[1:]:
+            other *= 2 if name in at_loc else ds.sizes[name]
+        step = max(1, _SLAB_VALUES // max(other, 1))
+        slabs = [(r, min(r + step, ds.sizes["radius"]))
+                 for r in range(0, ds.sizes["radius"], step)]
+    done = ds["slab_done"].values.astype(bool) if "slab_done" in ds else None
+
+    kept = {name: np.empty(0) for name in COLUMNS}
+    matched = 0
+    early = False
+    for r0, r1 in slabs:
+        if done is not None and "radius" not in at_loc and not done[r0:r1].any():
+            continue  # an incomplete cube: nothing computed here
+        rows = _slab_rows(ds, at_loc, r0, r1)
+        mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
+        for c in conditions:
+            mask &= c.mask(rows[c.name])
+        if not conditions and done is not None and "radius" not in at_loc:
+            mask &= ~np.isnan(rows["tip_force_max"])  # skip masked, uncomputed radii
+        n = int(mask.sum())
+        matched += n
+        kept = {name: np.concatenate([kept[name], rows[name][mask]]) for name in COLUMNS}
+        if limit is not None and sort_name is not None:
+            kept = _sorted(kept, sort_name, descending, limit)
+        elif limit is not None and len(kept[COLUMNS[0]]) >= limit:
+            early = (r1 < slabs[-1][1])  # grid order: the first `limit` matches are final
+            break
+    if sort_name is not None:
+        kept = _sorted(kept, sort_name, descending, limit)
+    elif limit is not None:
+        kept = {name: v[:limit] for name, v in kept.items()}
+    point = None
+    if at_loc:
+        point = "interpolated" if interpolated else "grid point"
+    return QueryResult(kept, point, interpolated, None if early else matched,
+                       single=len(at_loc) == len(AXES), at=at)
+
+
+def _sorted(rows, name, descending, limit):
+    key = rows[name]
+    # stable, NaN last either way; descending keeps ties in grid order too
+    order = np.argsort(-key if descending else key, kind="stable")
+    if limit is not None:
+        order = order[:limit]
+    return {k: v[order] for k, v in rows.items()}
+
+
+# ---------------------------------------------------------------------------- output
+def _display(name, x):
+    v = VARIABLES[name]
+    return from_si(x, v.display)
+
+
+def _unit(name):
+    return VARIABLES[name].display
+
+
+def _sig3(x) -> str:
+    """Three significant figures, trailing zeros kept, no exponent in the usual range."""
+    if x is None or not np.isfinite(x):
+        return "nan"
+    if x == 0:
+        return "0"
+    mag = math.floor(math.log10(abs(x)))
+    if -4 <= mag < 6:
+        digits = max(0, 2 - mag)
+        return f"{x:.{digits}f}"
+    return f"{x:.2e}"
+
+
+def _cell(name, x) -> str:
+    if name == "limit":
+        return {0.0: "stroke", 1.0: "strength"}.get(float(x), "boundary") \
+            if np.isfinite(x) else "boundary"
+    value = float(_display(name, x))
+    if name in AXES:
+        return f"{value:.6g}"
+    return _sig3(value)
+
+
+def _describe_at(res) -> str:
+    parts = []
+    for name, value in res.at.items():
+        unit = _unit(name)
+        parts.append(f"{name}={float(_display(name, value)):g}"
+                     + ("" if unit == "1" else f" {unit}"))
+    note = res.point
+    if res.interpolated:
+        note += " (linear in " + ", ".join(res.interpolated) + ")"
+    return ", ".join(parts) + f": {note}"
+
+
+def format_table(res) -> str:
+    """Aligned text in display units: a key/value list for one design, else a table."""
+    out = io.StringIO()
+    n = len(res)
+    if res.single and n == 1:
+        print(f"design at {_describe_at(res)}", file=out)
+        for name in DESIGN:
+            x = res.data[name][0]
+            unit = _unit(name)
+            text = _cell(name, x)
+            if name == "limit":
+                text = {"stroke": "stroke-limited (full range of motion)",
+                        "strength": "strength-limited (the nylon's strength cuts in)",
+                        "boundary": "between grid points that disagree: refine the grid"
+                        }[text]
+            elif unit != "1":
+                text += f" {unit}"
+            print(f"  {name:<16} {text}", file=out)
+        return out.getvalue()
+    if res.at:
+        print(f"at {_describe_at(res)}", file=out)
+    heads = list(COLUMNS)
+    units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
+    cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
+    widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
+              enumerate(zip(heads, units))] if cells else [max(len(h), len(u)) for h, u in
+                                                          zip(heads, units)]
+    print("  ".join(h.rjust(w) for h, w in zip(heads, widths)), file=out)
+    print("  ".join(u.rjust(w) for u, w in zip(units, widths)), file=out)
+    for r in cells:
+        print("  ".join(c.rjust(w) for c, w in zip(r, widths)), file=out)
+    shown = f"{n} design{'s' if n != 1 else ''}"
+    if res.matched is None:
+        print(f"{shown} (the first matches in grid order)", file=out)
+    elif res.matched != n:
+        print(f"{shown} of {res.matched} matching", file=out)
+    else:
+        print(shown, file=out)
+    return out.getvalue()
+
+
+def _json_value(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _records(res):
+    units = {name: VARIABLES[name].units for name in COLUMNS}
+    records = []
+    for i in range(len(res)):
+        rec = {}
+        if res.point:
+            rec["point"] = res.point
+        for name in COLUMNS:
+            x = res.data[name][i]
+            rec[name] = (None if not np.isfinite(x) else int(x)) if name == "limit" \
+                else _json_value(x)
+        rec["units"] = units
+        records.append(rec)
+    return records
+
+
+def format_json(res) -> str:
+    """One JSON object for one design, else a list; SI values with a ``units`` map."""
+    records = _records(res)
+    doc = records[0] if res.single and len(records) == 1 else records
+    return json.dumps(doc, indent=1) + "\n"
+
+
+def format_csv(res) -> str:
+    """CSV in SI, one row per design; the header names the units (``radius [m]``)."""
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    head = ([] if not res.point else ["point"]) + \
+        [f"{n} [{VARIABLES[n].units}]" for n in COLUMNS]
+    w.writerow(head)
+    for i in range(len(res)):
+        row = [] if not res.point else [res.point]
+        for name in COLUMNS:
+            x = res.data[name][i]
+            if name == "limit":
+                row.append("" if not np.isfinite(x) else int(x))
+            else:
+                row.append("" if not np.isfinite(x) else repr(float(x)))
+        w.writerow(row)
+    return out.getvalue()
+
+
+def query_command(args) -> int:
+    """``nylonflex query CUBE``: print the designs asked for (INTERFACE.md)."""
+    from .storage import open_cube
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = open_cube(args.cube)
+    for w in caught:  # an incomplete cube: say so in one line and query what is there
+        print(f"nylonflex query: warning: {w.message}", file=sys.stderr)
+    try:
+        res = query_cube(ds, at=parse_at(args.at) if args.at else None,
+                         where=parse_where(args.where), sort=args.sort, limit=args.limit)
+        if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
+            raise InputError("--at: this design is not in the cube yet (an incomplete "
+                             "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
+    finally:
+        ds.close()
+    fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
+    sys.stdout.write(fmt(res))
+    return 0

@@ -1,0 +1,161 @@
+"""Charts: every figure is drawn from a cube, labelled in display units, titled with its
+slice, and written as PNG, PDF and SVG without a display."""
+
+import ast
+import math
+from pathlib import Path
+
+import pytest
+
+from nylonflex import charts
+from nylonflex.cli import main
+from nylonflex.config import CHARTS, parse_config
+from nylonflex.storage import open_cube
+from nylonflex.sweep import run_sweep
+
+DEG = math.pi / 180.0
+SMALL = {
+    "name": "small",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 9, "units": "mm"},
+        "wall_thickness": {"values": [1, 2, 4, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.5, 1.7]},
+        "wrap_angle": {"values": [5, 8, 20], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 11},
+               "pressure": {"start": 0, "stop": 40, "num": 9, "units": "kPa"}},
+    "charts": ["fig12b", "design_map"],
+}
+
+#: chart -> units its axes must show (the registry's display units).
+UNITS = {"fig12a": ["[N]"], "fig12b": ["[mm]", "[N mm]"], "fig12c": ["[mm]", "[deg]", "[%]"],
+         "fig4": ["[kPa]"], "fig6": ["[kPa]", "[deg]"], "fig7": ["[kPa]", "[N]"],
+         "design_map": ["[mm]", "[N]"]}
+
+
+@pytest.fixture(scope="module")
+def cube(tmp_path_factory):
+    path = tmp_path_factory.mktemp("charts") / "cube.h5"
+    run_sweep(parse_config(SMALL), out=path).close()
+    return path
+
+
+@pytest.fixture(scope="module")
+def ds(cube):
+    ds = open_cube(cube)
+    yield ds
+    ds.close()
+
+
+def test_chart_names_are_the_configs():
+    assert tuple(charts.CHARTS) == CHARTS
+
+
+@pytest.mark.parametrize("name", CHARTS)
+def test_labels_carry_units_and_title_names_the_slice(ds, name):
+    import matplotlib.pyplot as plt
+
+    fig = charts.CHARTS[name](ds)
+    try:
+        labels = [ax.get_xlabel() + " " + ax.get_ylabel() for ax in fig.axes]
+        labels += [ax.get_label() for ax in fig.axes]
+        text = " ".join(labels)
+        for unit in UNITS[name]:
+            assert unit in text, (name, unit, labels)
+        assert any(ax.get_xlabel() for ax in fig.axes) and any(ax.get_ylabel()
+                                                               for ax in fig.axes)
+        title = fig._suptitle.get_text()
+        assert title and ("Figure" in title or "Design map" in title)
+        slice_text = title + " ".join(ax.get_title() for ax in fig.axes)
+        # each chart says which slice it shows: a fixed value with its unit
+        assert any(s in slice_text for s in ("mm", "deg", "same for every design")), name
+    finally:
+        plt.close(fig)
+
+
+def test_every_chart_is_written_as_png(ds, tmp_path):
+    paths = charts.draw_charts(ds, None, tmp_path, "png")
+    assert [p.name for p in paths] == [f"{n}.png" for n in CHARTS]
+    for p in paths:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("fmt, magic", [("pdf", b"%PDF"), ("svg", b"<?xml")])
+def test_pdf_and_svg(ds, tmp_path, fmt, magic):
+    (path,) = charts.draw_charts(ds, ["fig12c"], tmp_path / "out", fmt)
+    assert path == tmp_path / "out" / f"fig12c.{fmt}"
+    assert path.read_bytes().startswith(magic)
+    if fmt == "svg":  # text stays text: labels are searchable in the file
+        assert "maximum bend angle [deg]" in path.read_text()
+
+
+def test_slice_follows_the_paper(ds):
+    import matplotlib.pyplot as plt
+
+    fig = charts.fig12c(ds)
+    assert "L = 90 mm" in fig._suptitle.get_text()
+    assert {ax.get_title() for ax in fig.axes} >= {"wall thickness t = 2 mm",
+                                                   "wall thickness t = 6 mm"}
+    plt.close(fig)
+    fig = charts.design_map(ds, length=70e-3, wrap_angle=20 * DEG, coil_index=1.5)
+    assert "L = 70 mm, \u03c8 = 20 deg" in fig._suptitle.get_text()
+    assert [ax.get_title() for ax in fig.axes if ax.get_title()] == ["C = 1.5"]
+    plt.close(fig)
+
+
+def test_chart_command_beside_the_cube(cube, capsys):
+    rc = main(["chart", str(cube), "--figure", "fig4", "fig12a", "--format", "svg"])
+    out = capsys.readouterr().out.split()
+    assert rc == 0
+    assert out == [str(cube.parent / "fig4.svg"), str(cube.parent / "fig12a.svg")]
+    assert all(Path(p).is_file() for p in out)
+
+
+def test_chart_command_refusals(cube, tmp_path, capsys):
+    assert main(["chart", str(cube), "--figure", "fig99"]) == 2
+    assert "unknown chart 'fig99'; accepted: fig12a" in capsys.readouterr().err
+    bad = tmp_path / "x.h5"
+    bad.write_bytes(b"nope")
+    assert main(["chart", str(bad)]) == 2
+    assert "not a nylonflex cube" in capsys.readouterr().err
+    afile = tmp_path / "file.txt"
+    afile.write_text("")
+    assert main(["chart", str(cube), "--out", str(afile)]) == 2
+
+
+def test_sweep_draws_the_configs_charts(tmp_path, capsys, monkeypatch):
+    import yaml
+
+    cfg = tmp_path / "small.yaml"
+    cfg.write_text(yaml.safe_dump(SMALL))
+    rc = main(["sweep", str(cfg), "--out", str(tmp_path / "s" / "cube.h5"), "--quiet"])
+    out = capsys.readouterr().out
+    assert rc == 0
+    for name in SMALL["charts"]:
+        assert (tmp_path / "s" / f"{name}.png").is_file() and f"{name}.png" in out
+
+
+def test_charts_read_the_dataset_only():
+    # layers (STYLE.md): charts never compute physics; matplotlib is imported lazily
+    tree = ast.parse(Path(charts.__file__).read_text())
+    imported = {(n.module or "") for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+    imported |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+    assert not any("physics" in m or "kernels" in m or "sweep" in m for m in imported)
+    top = {a.name for n in tree.body if isinstance(n, ast.Import) for a in n.names}
+    top |= {n.module for n in tree.body if isinstance(n, ast.ImportFrom)}
+    assert not any(m and m.startswith("matplotlib") for m in top)
+
+
+def test_incomplete_cube_draws_with_a_warning(cube, tmp_path, capsys):
+    import h5py
+
+    part = tmp_path / "part.h5"
+    part.write_bytes(cube.read_bytes())
+    with h5py.File(part, "r+") as f:
+        f.attrs["complete"] = "false"
+        f["slab_done"][5:] = 0
+    rc = main(["chart", str(part), "--figure", "fig12b", "design_map"])
+    captured = capsys.readouterr()
+    assert rc == 0 and "incomplete" in captured.err
+    assert (tmp_path / "design_map.png").is_file()

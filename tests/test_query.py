@@ -1,0 +1,299 @@
+"""``nylonflex query``: grid points, interpolation, filters, formats and refusals.
+
+Expected numbers come from MODEL.md section 8 (the paper's worked examples, 1.20 N and
+0.150 N) and from :func:`nylonflex.design_limits` (the exact value at any design).
+"""
+
+import csv
+import io
+import json
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+import nylonflex as nf
+from nylonflex import query
+from nylonflex.cli import main
+from nylonflex.config import parse_config
+from nylonflex.storage import open_cube
+from nylonflex.sweep import run_sweep
+from nylonflex.units import InputError
+
+DEG = math.pi / 180.0
+EXAMPLE_1 = dict(radius=20e-3, wall_thickness=6e-3, length=90e-3, coil_index=1.1,
+                 wrap_angle=8 * DEG)
+EXAMPLE_2 = dict(radius=7.5e-3, wall_thickness=2e-3, length=70e-3, coil_index=1.7,
+                 wrap_angle=8 * DEG)
+AT_2 = "radius=7.5mm,wall_thickness=2mm,length=70mm,coil_index=1.7,wrap_angle=8deg"
+
+SMALL = {
+    "name": "small",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 9, "units": "mm"},  # 2.5 mm steps
+        "wall_thickness": {"values": [2, 4, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"values": [5, 8, 20], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 11},
+               "pressure": {"start": 0, "stop": 40, "num": 9, "units": "kPa"}},
+}
+
+
+@pytest.fixture(scope="module")
+def cube(tmp_path_factory):
+    path = tmp_path_factory.mktemp("query") / "cube.h5"
+    run_sweep(parse_config(SMALL), out=path).close()
+    return path
+
+
+@pytest.fixture(scope="module")
+def ds(cube):
+    ds = open_cube(cube)
+    yield ds
+    ds.close()
+
+
+def run(capsys, *argv):
+    rc = main(["query", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+# ---------------------------------------------------------------------------- --at
+def test_paper_example_2_prints_0150_newton(cube, capsys):
+    # MODEL.md s. 8: (7.5 mm, 2 mm, 70 mm, C 1.7, psi 8 deg) gives 0.150 N, stroke-limited
+    rc, out, _ = run(capsys, cube, "--at", AT_2)
+    assert rc == 0
+    assert "grid point" in out
+    assert "tip_force_max    0.150 N" in out
+    assert "stroke-limited" in out
+
+
+def test_paper_example_1_bare_numbers_mean_mm_and_deg(cube, capsys):
+    # MODEL.md s. 8: (20 mm, 6 mm, 90 mm, C 1.1) gives 1.20 N with a full range of motion
+    rc, out, _ = run(capsys, cube, "--at",
+                     "radius=20,wall_thickness=6,length=90,coil_index=1.1,wrap_angle=8")
+    assert rc == 0
+    assert "1.20 N" in out and "full range of motion" in out
+
+
+def test_grid_point_is_the_stored_value(ds):
+    res = query.query_cube(ds, at=EXAMPLE_2)
+    assert res.point == "grid point" and res.interpolated == [] and len(res) == 1
+    stored = ds["tip_force_max"].sel(EXAMPLE_2, method="nearest").item()
+    assert res.data["tip_force_max"][0] == stored
+
+
+def test_interpolated_radius_within_1_percent_of_design_limits(tmp_path):
+    # the radius spacing of configs/fig12.yaml (0.5 mm) around the paper's example 2
+    fine = dict(SMALL, grid={"radius": {"start": 5, "stop": 10, "num": 11, "units": "mm"},
+                             "wall_thickness": {"values": [2], "units": "mm"},
+                             "length": {"values": [70], "units": "mm"},
+                             "coil_index": {"values": [1.7]},
+                             "wrap_angle": {"values": [8], "units": "deg"}})
+    ds = run_sweep(parse_config(fine), out=tmp_path / "fine.h5")
+    at = dict(EXAMPLE_2, radius=7.8e-3)  # between the 7.5 and 8 mm grid radii
+    res = query.query_cube(ds, at=at)
+    ds.close()
+    assert res.point == "interpolated" and res.interpolated == ["radius"]
+    exact = nf.design_limits(**at)
+    for name in ("tip_force_max", "torque_max", "bend_angle_max", "pressure_max"):
+        assert res.data[name][0] == pytest.approx(exact[name], rel=0.01), name
+    assert res.data["limit"][0] == exact["limit"] == 0
+
+
+def test_length_interpolation_is_exact(ds):
+    # F* = M*/L and theta* = kappa L (MODEL.md s. 8): exact along L, whatever the spacing
+    at = dict(EXAMPLE_1, length=77e-3)
+    res = query.query_cube(ds, at=at)
+    exact = nf.design_limits(**at)
+    for name in ("tip_force_max", "bend_angle_max", "torque_max"):
+        assert res.data[name][0] == pytest.approx(exact[name], rel=1e-9), name
+
+
+def test_limit_between_disagreeing_grid_points_is_unknown(ds):
+    lim = ds["limit"].sel(wall_thickness=2e-3, length=70e-3, coil_index=1.7,
+                          wrap_angle=20 * DEG).values
+    i = int(np.argmax(lim[1:] != lim[:-1]))  # last radius before the limit flips
+    a = ds["radius"].values
+    res = query.query_cube(ds, at=dict(EXAMPLE_2, wrap_angle=20 * DEG,
+                                       radius=0.5 * (a[i] + a[i + 1])))
+    assert np.isnan(res.data["limit"][0])
+    assert "boundary" in query.format_table(res) or "disagree" in query.format_table(res)
+
+
+def test_partial_at_lists_every_value_of_the_free_axes(ds):
+    res = query.query_cube(ds, at={"radius": 7.5e-3, "coil_index": 1.7})
+    assert len(res) == 3 * 2 * 3  # wall x length x wrap angle
+    assert np.all(res.data["radius"] == pytest.approx(7.5e-3))
+    assert set(np.round(res.data["wrap_angle"] / DEG, 6)) == {5.0, 8.0, 20.0}
+
+
+@pytest.mark.parametrize("at, match", [
+    ("radius=30mm", r"radius=30 mm is outside the cube's grid; radius takes 5 \.\. 25 mm"),
+    ("coil_index=2", r"coil_index=2 is outside .* 1\.1, 1\.7"),
+    ("wrap_angle=1deg", r"wrap_angle=1 deg is outside"),
+    ("radius=7.5kPa", r"--at radius: unit 'kPa' is not a length"),
+    ("radius", r"expected NAME=VALUE"),
+    ("size=3", r"unknown axis 'size'"),
+    ("radius=7.5,radius=8", r"radius given twice"),
+])
+def test_at_refusals(cube, capsys, at, match):
+    import re
+
+    rc, out, err = run(capsys, cube, "--at", at)
+    assert rc == 2 and out == ""
+    assert re.search(match, err), err
+    assert len(err.strip().splitlines()) == 1
+
+
+# ---------------------------------------------------------------------------- --where
+def _brute(ds, mask):
+    """Designs meeting ``mask`` (a boolean DataArray over the axes), as a set of tuples."""
+    d = ds[["tip_force_max"]].load().where(mask).to_dataframe().dropna()
+    return {tuple(np.round(k, 9)) for k in d.index}
+
+
+def test_where_matches_a_brute_force_filter(ds):
+    res = query.query_cube(ds, where=["tip_force_max >= 0.5 N", "radius <= 15 mm"])
+    got = {tuple(np.round([res.data[a][i] for a in query.AXES], 9)) for i in range(len(res))}
+    load = ds.load()
+    expect = _brute(load, (load["tip_force_max"] >= 0.5) & (load["radius"] <= 15e-3))
+    assert got == expect and res.matched == len(expect) > 0
+
+
+def test_where_units_are_converted(ds):
+    in_n = query.query_cube(ds, where=["tip_force_max >= 0.5 N"])
+    in_mn = query.query_cube(ds, where=["tip_force_max>=500mN"])
+    assert in_n.matched == in_mn.matched
+    deg = query.query_cube(ds, where=["wrap_angle == 8 deg"])
+    bare = query.query_cube(ds, where=["wrap_angle == 8"])  # bare: the display unit, deg
+    assert deg.matched == bare.matched == 9 * 3 * 2 * 2
+
+
+def test_where_limit_words_and_range_fraction(ds):
+    words = query.query_cube(ds, where=["limit == strength"])
+    numbers = query.query_cube(ds, where=["limit == 1"])
+    full = query.query_cube(ds, where=["range_fraction == 1"])
+    n = int(np.prod([ds.sizes[a] for a in query.AXES]))
+    assert words.matched == numbers.matched > 0
+    assert full.matched + words.matched == n  # full range exactly when stroke-limited
+
+
+def test_smallest_designs_giving_half_a_newton(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--where", "tip_force_max >= 0.5 N", "--sort", "radius",
+                     "--limit", "5")
+    assert rc == 0
+    lines = out.strip().splitlines()
+    assert lines[0].split()[:2] == ["radius", "wall_thickness"] and "[mm]" in lines[1]
+    rows = [line.split() for line in lines[2:7]]
+    assert len(rows) == 5 and lines[7].startswith("5 designs of")
+    assert all(float(r[9]) >= 0.5 for r in rows)  # tip_force_max column [N]
+    radii = [float(r[0]) for r in rows]
+    assert radii == sorted(radii)
+    with open_cube(cube) as ds:
+        smallest = float(ds["radius"].where(ds["tip_force_max"] >= 0.5).min()) * 1e3
+    assert radii[0] == pytest.approx(smallest)
+
+
+@pytest.mark.parametrize("where, match", [
+    ("tip_force_max >= 0.5 kPa", r"--where tip_force_max: unit 'kPa' is not a force"),
+    ("grip >= 1 N", r"unknown name 'grip'; accepted: radius"),
+    ("tip_force_max about 1", r"expected 'NAME OP VALUE"),
+    ("radius <= big", r"--where radius: expected a number"),
+])
+def test_where_refusals(cube, capsys, where, match):
+    import re
+
+    rc, _, err = run(capsys, cube, "--where", where)
+    assert rc == 2 and re.search(match, err), err
+
+
+# ---------------------------------------------------------------------------- --sort
+def test_sort_descending_and_ties_in_grid_order(ds):
+    res = query.query_cube(ds, sort="-tip_force_max", limit=4)
+    assert list(res.data["tip_force_max"]) == sorted(res.data["tip_force_max"], reverse=True)
+    assert res.data["tip_force_max"][0] == float(ds["tip_force_max"].max())
+    same = query.query_cube(ds, sort="tip_force_max:desc", limit=4)
+    assert np.array_equal(same.data["tip_force_max"], res.data["tip_force_max"])
+    ties = query.query_cube(ds, sort="coil_index", limit=3)  # all C = 1.1: grid order
+    assert list(ties.data["radius"]) == [5e-3] * 3
+    assert list(ties.data["wrap_angle"]) == pytest.approx([5 * DEG, 8 * DEG, 20 * DEG])
+
+
+def test_sort_refusals(ds):
+    with pytest.raises(InputError, match="--sort: unknown name 'size'"):
+        query.query_cube(ds, sort="size")
+    with pytest.raises(InputError, match="order must be 'asc' or 'desc'"):
+        query.query_cube(ds, sort="radius:up")
+    with pytest.raises(InputError, match="--limit"):
+        query.query_cube(ds, limit=-1)
+
+
+def test_slabs_give_the_same_answer(ds, monkeypatch):
+    whole = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use",
+                             limit=7)
+    monkeypatch.setattr(query, "_SLAB_VALUES", 50)  # one radius per slab
+    cut = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use", limit=7)
+    for name in query.COLUMNS:
+        np.testing.assert_array_equal(whole.data[name], cut.data[name])
+    assert whole.matched == cut.matched
+    first = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], limit=2)
+    assert len(first) == 2 and first.matched is None  # stopped early, in grid order
+
+
+# ---------------------------------------------------------------------------- formats
+def test_json_one_object_in_si_with_units(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--at", AT_2, "--format", "json")
+    doc = json.loads(out)
+    assert rc == 0 and isinstance(doc, dict)
+    assert doc["point"] == "grid point" and doc["limit"] == 0
+    assert doc["radius"] == pytest.approx(7.5e-3)
+    assert doc["tip_force_max"] == pytest.approx(0.150, abs=5e-4)
+    assert doc["units"]["tip_force_max"] == "N" and doc["units"]["wrap_angle"] == "rad"
+
+
+def test_json_list_for_many(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--where", "radius == 5 mm", "--limit", "3",
+                     "--format", "json")
+    doc = json.loads(out)
+    assert rc == 0 and isinstance(doc, list) and len(doc) == 3
+    assert all(d["units"]["radius"] == "m" and d["radius"] == 5e-3 for d in doc)
+
+
+def test_csv_in_si(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--at", "radius=8.6mm,coil_index=1.7,length=70",
+                     "--format", "csv")
+    rows = list(csv.reader(io.StringIO(out)))
+    assert rc == 0 and rows[0][:3] == ["point", "radius [m]", "wall_thickness [m]"]
+    assert len(rows) == 1 + 3 * 3
+    assert {r[0] for r in rows[1:]} == {"interpolated"}
+    assert float(rows[1][1]) == pytest.approx(8.6e-3)
+
+
+# ---------------------------------------------------------------------------- the file
+def test_not_a_cube_and_missing_file(tmp_path, capsys):
+    bad = tmp_path / "bad.h5"
+    bad.write_text("not hdf5")
+    rc, _, err = run(capsys, bad)
+    assert rc == 2 and "not a nylonflex cube" in err
+    rc, _, err = run(capsys, tmp_path / "none.h5")
+    assert rc == 2 and "no such cube" in err
+
+
+def test_incomplete_cube_is_queried_where_complete(cube, tmp_path, capsys):
+    part = tmp_path / "part.h5"
+    part.write_bytes(cube.read_bytes())
+    with h5py.File(part, "r+") as f:  # as a sweep stopped after the first 3 radii leaves it
+        f.attrs["complete"] = "false"
+        f["slab_done"][3:] = 0
+    rc, out, err = run(capsys, part, "--where", "tip_force_max >= 0 N")
+    assert rc == 0 and "incomplete" in err and "warning" in err
+    assert out.strip().splitlines()[-1] == f"{3 * 3 * 2 * 2 * 3} designs"
+    rc, out, err = run(capsys, part, "--at", AT_2)  # radius 7.5 mm: computed
+    assert rc == 0 and "0.150 N" in out
+    rc, out, err = run(capsys, part, "--at", AT_2.replace("7.5mm", "20mm"))
+    assert rc == 2 and "not in the cube yet" in err
