@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import dblquad
 
-import reference as ref
+from nylonflex import reference as ref
 from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
 from nylonflex.physics import bending, silicone
 
@@ -26,7 +26,7 @@ def test_pressure_moment_is_first_moment_of_the_half_disc():
 @pytest.mark.parametrize("a,t,kappa", [(5e-3, 1e-3, 3.0), (25e-3, 6e-3, 40.0),
                                        (12e-3, 2e-3, 150.0)])
 def test_material_moment_matches_adaptive_quadrature(name, a, t, kappa):
-    # MODEL.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12 (tests/reference)
+    # MODEL.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12 (nylonflex.reference)
     mu, alpha = silicone_parameters(name).arrays()
     expected = ref.material_moment(kappa, a, t, t, mu, alpha)
     assert bending.material_moment(kappa, a, t, None, name) == pytest.approx(expected,

@@ -1,0 +1,136 @@
+"""``nylonflex bench``: the kernels against the scipy reference, side by side in one run.
+
+Timings on shared machines are noisy, so the figures that matter are the ratios measured in
+the same process: the per-design speed-up over the adaptive-quadrature reference.
+"""
+
+from __future__ import annotations
+
+import math
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .config import parse_config
+
+#: The benchmark grid of issue 3: 100 x 40 x 10 x 5 x 10 = 2,000,000 designs with curves.
+FULL = {"radius": 100, "wall_thickness": 40, "length": 10, "coil_index": 5, "wrap_angle": 10,
+        "stroke": 51, "pressure": 41, "reference_designs": 6}
+QUICK = {"radius": 12, "wall_thickness": 6, "length": 4, "coil_index": 3, "wrap_angle": 4,
+         "stroke": 11, "pressure": 9, "reference_designs": 2}
+
+
+def bench_config(sizes: dict):
+    """The benchmark's design space (the fig12 ranges, sizes from ``sizes``)."""
+    return parse_config({
+        "name": "bench",
+        "grid": {
+            "radius": {"start": 5, "stop": 25, "num": sizes["radius"], "units": "mm"},
+            "wall_thickness": {"start": 1, "stop": 6, "num": sizes["wall_thickness"],
+                               "units": "mm"},
+            "length": {"start": 40, "stop": 150, "num": sizes["length"], "units": "mm"},
+            "coil_index": {"start": 1.1, "stop": 1.7, "num": sizes["coil_index"]},
+            "wrap_angle": {"start": 2, "stop": 30, "num": sizes["wrap_angle"], "units": "deg"},
+        },
+        "curves": {"stroke": {"start": 0, "stop": 0.1, "num": sizes["stroke"]},
+                   "pressure": {"start": 0, "stop": 40, "num": sizes["pressure"],
+                                "units": "kPa"}},
+    })
+
+
+def _reference_design(cfg, a, t, c, psi):
+    """One design's s*, kappa(s_max) and kappa* by scipy quadrature and brentq."""
+    from . import reference as ref
+    from .physics.chamber import chamber_pressure
+    from .physics.nylon import nylon_force_limit, stroke_max
+
+    mu, alpha = cfg.silicone.arrays()
+    s_max = float(stroke_max(c, cfg.nylon))
+    s = ref.stroke_limit(float(nylon_force_limit(c, cfg.nylon)), s_max, a, t, t, psi, c, mu,
+                         alpha, cfg.nylon.fibre_diameter)
+    k_full = ref.curvature(float(chamber_pressure(s_max)), a, t, t, mu, alpha)
+    k = k_full if s == s_max else ref.curvature(float(chamber_pressure(s)), a, t, t, mu, alpha)
+    return s, k_full, k
+
+
+def _solve_count(ds) -> int:
+    """Angle solves the kernel makes: curve points, full-stroke and strength-limited ones."""
+    na, nt, nc = ds.sizes["radius"], ds.sizes["wall_thickness"], ds.sizes["coil_index"]
+    strength = int((ds["limit"].isel(length=0) == 1).sum())
+    return na * nt * (ds.sizes["pressure"] + nc) + strength
+
+
+def run_bench(quick: bool = False, out=sys.stdout) -> dict:
+    """Time compile, kernels, the end-to-end sweep and the reference; print and return."""
+    from .sweep import compute_slab, plan_slabs, run_sweep
+
+    sizes = QUICK if quick else FULL
+    cfg = bench_config(sizes)
+    say = lambda msg: print(msg, file=out, flush=True)  # noqa: E731
+    say(f"nylonflex bench{' --quick' if quick else ''}: {cfg.n_designs:,} designs "
+        f"({' x '.join(str(n) for n in cfg.shape)}), curves {sizes['stroke']} strokes x "
+        f"{sizes['pressure']} pressures")
+
+    t0 = time.perf_counter()
+    compute_slab(cfg, 0, 1)
+    t_compile = time.perf_counter() - t0
+    say(f"  compile or load cache      {t_compile:8.2f} s")
+
+    slabs, _ = plan_slabs(cfg)
+    t0 = time.perf_counter()
+    for i0, i1 in slabs:
+        compute_slab(cfg, i0, i1)
+    t_kernel = time.perf_counter() - t0
+
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        ds = run_sweep(cfg, Path(tmp) / "cube.h5")
+        t_total = time.perf_counter() - t0
+        solves = _solve_count(ds)
+        size_mb = (Path(tmp) / "cube.h5").stat().st_size / 2**20
+        ds.close()
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+    rng = np.random.default_rng(12)
+    n_ref = sizes["reference_designs"]
+    designs = [(rng.uniform(5e-3, 25e-3), rng.uniform(1e-3, 6e-3), rng.uniform(1.1, 1.7),
+                math.radians(rng.uniform(2, 30))) for _ in range(n_ref)]
+    t0 = time.perf_counter()
+    for d in designs:
+        _reference_design(cfg, *d)
+    t_ref = (time.perf_counter() - t0) / n_ref
+
+    per_design = t_total / cfg.n_designs
+    result = {
+        "designs": cfg.n_designs,
+        "compile_s": t_compile,
+        "kernel_s": t_kernel,
+        "kernel_designs_per_s": cfg.n_designs / t_kernel,
+        "sweep_s": t_total,
+        "sweep_designs_per_s": cfg.n_designs / t_total,
+        "angle_solves": solves,
+        "angle_solves_per_s": solves / t_kernel,
+        "reference_s_per_design": t_ref,
+        "speedup": t_ref / per_design,
+        "peak_rss_mb": peak_mb,
+        "cube_mb": size_mb,
+    }
+    say(f"  kernels only               {t_kernel:8.2f} s  {result['kernel_designs_per_s']:>12,.0f}"
+        f" designs/s  {result['angle_solves_per_s']:>10,.0f} angle solves/s")
+    say(f"  sweep end to end (+ HDF5)  {t_total:8.2f} s  {result['sweep_designs_per_s']:>12,.0f}"
+        f" designs/s  cube {size_mb:.0f} MB")
+    say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
+    say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
+        "same run)")
+    say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")
+    return result
+
+
+def bench_command(args) -> int:
+    """``nylonflex bench [--quick]``."""
+    run_bench(quick=args.quick)
+    return 0
