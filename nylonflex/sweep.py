@@ -311,7 +311,7 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
                 bar.update((i1 - i0) * per_radius)
             todo = [k for k in range(len(slabs)) if k not in keep]
             if scheduler is None:
-                results = ((k, compute_slab(cfg, *slabs[k])) for k in todo)
+                results = _local_results(cfg, slabs, todo)
             else:
                 results = runner.map_slabs(cfg, slabs, todo)
             for k, arrays in results:
@@ -353,6 +353,25 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     log(f"stopped: {len(done_slabs)} of {len(slabs)} slabs saved in {journal.dir}; "
         f"{out} is marked incomplete. Finish with --resume.")
     raise KeyboardInterrupt
+
+
+def _local_results(cfg, slabs, todo):
+    """Yield ``(k, arrays)`` slab by slab, computing slab k+1 while the caller writes k.
+
+    The kernel releases the GIL, so compression and journaling overlap the next slab's
+    arithmetic; at most two slabs are in memory.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(1, thread_name_prefix="nylonflex-slab") as pool:
+        pending = None
+        for k in todo:
+            future = pool.submit(compute_slab, cfg, *slabs[k])
+            if pending is not None:
+                yield pending[0], pending[1].result()
+            pending = (k, future)
+        if pending is not None:
+            yield pending[0], pending[1].result()
 
 
 def _is_main_thread():
