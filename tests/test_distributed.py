@@ -23,21 +23,22 @@ import nylonflex as nf  # noqa: E402
 from nylonflex.cli import main  # noqa: E402
 from nylonflex.distributed import DaskRunner, _normalise_address  # noqa: E402
 from nylonflex.storage import VOLATILE_ATTRS, Journal  # noqa: E402
+from nylonflex.sweep import plan_slabs  # noqa: E402
 from nylonflex.units import InputError  # noqa: E402
 
-# Six slabs: plan_slabs never cuts a slab finer than ~18 MB of output (whole radius
-# chunks), so the grid is that big; the long stroke axis makes bytes without much compute.
+# Eighteen slabs of about 1 MB, some 50 ms of work each: enough tasks for both workers and
+# a window to kill a run half-way, in a few seconds in all.
 CONFIG = """\
 name: dist
 grid:
-  radius:         {start: 5, stop: 25, num: 240, units: mm}
-  wall_thickness: {values: [1, 2, 3, 4, 6], units: mm}
-  length:         {values: [60, 90, 120], units: mm}
-  coil_index:     {values: [1.1, 1.4, 1.7]}
-  wrap_angle:     {values: [4, 8, 16], units: deg}
+  radius:         {start: 5, stop: 25, num: 160, units: mm}
+  wall_thickness: {start: 1, stop: 6, num: 10, units: mm}
+  length:         {values: [60, 90]}
+  coil_index:     {values: [1.1, 1.25, 1.4, 1.55, 1.7]}
+  wrap_angle:     {start: 2, stop: 30, num: 10, units: deg}
 curves:
-  stroke:   {start: 0, stop: 0.1, num: 1201}
-  pressure: {start: 0, stop: 40, num: 11, units: kPa}
+  stroke:   {start: 0, stop: 0.1, num: 11}
+  pressure: {start: 0, stop: 40, num: 21, units: kPa}
 slab_megabytes: 1
 """
 
@@ -45,7 +46,8 @@ slab_megabytes: 1
 @pytest.fixture(scope="module")
 def cluster():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as c:
+                                  host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                  worker_dashboard_address="127.0.0.1:0") as c:
         yield c
 
 
@@ -84,8 +86,8 @@ def _numba_threads_started():
 
 def test_cluster_cube_identical_to_local(cluster, config_path, local_cube, tmp_path):
     cfg = nf.load_config(config_path)
-    slabs, _ = nf.sweep.plan_slabs(cfg)
-    assert len(slabs) >= 6  # several tasks, so both workers take part
+    slabs, _ = plan_slabs(cfg)
+    assert len(slabs) >= 10  # several tasks, so both workers take part
     out = tmp_path / "cube.h5"
     nf.run_sweep(cfg, out, scheduler=cluster.scheduler_address).close()
     _assert_same_cube(out, local_cube)
@@ -109,7 +111,7 @@ def test_killed_cluster_run_resumes(cluster, config_path, local_cube, tmp_path):
     os.kill(proc.pid, signal.SIGKILL)
     _, err = proc.communicate()
     assert proc.returncode == -signal.SIGKILL, err.decode()
-    n_slabs = len(nf.sweep.plan_slabs(nf.load_config(config_path))[0])
+    n_slabs = len(plan_slabs(nf.load_config(config_path))[0])
     saved = journal.done()
     assert 1 <= len(saved) < n_slabs and not out.exists()
 
