@@ -98,10 +98,21 @@ def _run(args) -> int:
     raise AssertionError(args.command)
 
 
+def _join_negative_values(argv):
+    """``--sort -tip_force_max`` means descending; argparse would read ``-tip...`` as a flag."""
+    out = list(argv)
+    for i, item in enumerate(out[:-1]):
+        if item == "--sort" and out[i + 1].startswith("-") and out[i + 1][1:2].isalpha():
+            out[i:i + 2] = [f"--sort={out[i + 1]}"]
+            return _join_negative_values(out)
+    return out
+
+
 def main(argv=None) -> int:
     """Entry point of the ``nylonflex`` console script."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(_join_negative_values(argv))
     if args.command is None:
         parser.print_help()
         return EXIT_OK

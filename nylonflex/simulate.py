@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -297,23 +296,6 @@ def _quantity(raw, path, kind, unit, lo=None, hi=None, *, lo_open=False, show=No
     return value
 
 
-_OHM = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(ohm|Ohm|Ω)?\s*$")
-
-
-def _resistance(raw, path) -> float:
-    """An electrical resistance in ohm (``"1.5 ohm"`` or a bare number) [ohm], >= 0."""
-    if isinstance(raw, (int, float)) and not isinstance(raw, bool):
-        value = float(raw)
-    else:
-        m = _OHM.match(str(raw))
-        if not m:
-            raise InputError(f"{path}: expected a resistance like '1.5 ohm', got {raw!r}")
-        value = float(m.group(1))
-    if not (math.isfinite(value) and 0.0 <= value <= 1e4):
-        raise InputError(f"{path}: must be in [0, 10000] ohm, got {raw!r}")
-    return value
-
-
 def _integer(raw, path, lo, hi) -> int:
     if isinstance(raw, bool) or not isinstance(raw, int) or not lo <= raw <= hi:
         raise InputError(f"{path}: must be an integer in [{lo}, {hi}], got {raw!r}")
@@ -470,7 +452,8 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
     supply = _section(raw, {}, "supply", "supply")
     voltage = _quantity(supply["voltage"], "supply.voltage", "voltage", "V", 0.0, 1000.0,
                         lo_open=True)
-    r_int = _resistance(supply["internal_resistance"], "supply.internal_resistance")
+    r_int = _quantity(supply["internal_resistance"], "supply.internal_resistance", "resistance",
+                      "ohm", 0.0, 1e4)
     tm = _section(raw, {}, "time", "time")
     duration = _quantity(tm["duration"], "time.duration", "time", "s", 0.0, 10 * 86400.0,
                          lo_open=True)

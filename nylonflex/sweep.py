@@ -9,7 +9,6 @@ size, whatever the grid, and an interrupted sweep loses at most the slab in prog
 from __future__ import annotations
 
 import datetime as _dt
-import math
 import os
 import platform
 import signal
@@ -28,7 +27,7 @@ from .physics.nylon import nylon_force_limit, stroke_max
 from .physics.wrap import muscle_width
 from .storage import CubeFile, Journal, cube_attrs, exclusive
 from .units import InputError
-from .variables import AXES, CURVES, DESIGN
+from .variables import CURVES, DESIGN
 
 __all__ = ["compute_slab", "default_output", "plan_slabs", "run_sweep", "sweep_command"]
 

@@ -43,6 +43,8 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "V": ("voltage", 1.0, 0.0),
     "W": ("power", 1.0, 0.0),
     "A": ("current", 1.0, 0.0),
+    "ohm": ("resistance", 1.0, 0.0),
+    "kohm": ("resistance", 1e3, 0.0),
     "mA": ("current", 1e-3, 0.0),
     "1": ("dimensionless", 1.0, 0.0),
     "%": ("dimensionless", 1e-2, 0.0),
@@ -50,7 +52,7 @@ UNITS: dict[str, tuple[str, float, float]] = {
 
 _ALIASES = {"Nm": "N m", "N*m": "N m", "N.m": "N m", "Nmm": "N mm", "C": "degC",
             "celsius": "degC", "degrees": "deg", "degree": "deg", "": "1", "-": "1",
-            "mNm": "mN m"}
+            "mNm": "mN m", "Ohm": "ohm", "\u03a9": "ohm"}
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
