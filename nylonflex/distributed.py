@@ -10,7 +10,8 @@ a local run does, so resume and the cube's format are the same.
 
 Memory stays bounded by the slab size whatever the grid: at most :data:`IN_FLIGHT_PER_THREAD`
 slabs per worker thread are submitted at a time, a finished slab stays on its worker until
-the client fetches it, and the client holds one slab at a time.
+the client fetches it, and the client holds three slabs at most: the one being written,
+the one it hands over next, and one being fetched meanwhile.
 
 Both paths run the same compiled loop body on the same slab boundaries, and every element
 of a slab is computed by a deterministic sequence of floating-point operations that depends
@@ -24,6 +25,7 @@ from __future__ import annotations
 import re
 import uuid
 from collections.abc import Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 
 from .units import InputError
 
@@ -116,6 +118,7 @@ class DaskRunner:
                              "'dask scheduler'") from None
         self._pending: set = set()
         self._used: set[str] = set()
+        self._fetcher = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-fetch")
         try:
             self._check_workers(worker_wait)
         except BaseException:
@@ -181,21 +184,32 @@ class DaskRunner:
             done.add(fut)
             return True
 
-        capacity = self._capacity()
-        while len(self._pending) < capacity and submit():
-            pass
-        for fut in done:
-            k = fut.slab
-            arrays = fut.result()
-            self._used.update(self._who_ran(fut))
-            self._pending.discard(fut)
-            fut.release()
-            del fut
+        def top_up():
             capacity = self._capacity()
             while len(self._pending) < capacity and submit():
                 pass
-            yield k, arrays
-            del arrays
+
+        def finish(fut, fetch):
+            arrays = fetch.result()
+            self._used.update(self._who_ran(fut))
+            self._pending.discard(fut)
+            fut.release()
+            top_up()
+            return fut.slab, arrays
+
+        # While the caller writes one slab, the next finished one is fetched in a thread.
+        top_up()
+        fetching = None
+        while fetching is not None or not done.is_empty():
+            if fetching is not None and not done.has_ready():
+                yield finish(*fetching)  # nothing else finished: don't wait for it
+                fetching = None
+                continue
+            fut = next(done)
+            started = (fut, self._fetcher.submit(fut.result))
+            if fetching is not None:
+                yield finish(*fetching)
+            fetching = started
 
     def _who_ran(self, fut) -> set[str]:
         # the worker that holds the result ran the task (results are not replicated)
@@ -215,3 +229,4 @@ class DaskRunner:
             self._pending.clear()
         finally:
             client.close()
+            self._fetcher.shutdown(wait=False, cancel_futures=True)
