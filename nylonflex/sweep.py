@@ -236,13 +236,14 @@ def _sweep_in_memory(cfg, workers, quiet):
 
 
 def _check_resume(cfg, out, journal, resume, log):
-    """Decide what to keep. Returns the set of journaled slabs to reuse."""
+    """Decide what to keep: ``None`` (nothing to do), or the journal's slab plan and the
+    indices of its finished slabs (an empty plan means: start afresh)."""
     manifest = journal.read_manifest() if journal.exists() else None
     if manifest is not None and not resume:
         raise InputError(f"{out}: an interrupted run of '{manifest.get('name')}' is in "
                          f"{journal.dir}; add --resume to finish it, or delete that folder")
     if not resume:
-        return set()
+        return [], set()
     if manifest is None:
         attrs = cube_attrs(out)
         if attrs and attrs.get("config_sha256") != cfg.sha256:
@@ -253,34 +254,56 @@ def _check_resume(cfg, out, journal, resume, log):
             log(f"{out} is already complete; nothing to resume")
             return None
         log("nothing to resume; starting the sweep")
-        return set()
+        return [], set()
     if manifest.get("config_sha256") != cfg.sha256:
         raise InputError(f"--resume: the config changed since the interrupted run "
                          f"(sha256 {manifest.get('config_sha256', '?')[:12]} vs "
                          f"{cfg.sha256[:12]}); delete {journal.dir} to start over")
-    return journal.done()
+    # the journal's own slab plan: slab_megabytes may differ now (it is not in the hash)
+    slabs = [tuple(int(i) for i in s) for s in manifest.get("slabs", [])]
+    edges = [i for s in slabs for i in s]
+    if not slabs or edges[0] != 0 or edges[-1] != cfg.shape[0] or \
+            any(a != b for a, b in zip(edges[1:-1:2], edges[2::2])):
+        raise InputError(f"--resume: {journal.manifest} is damaged; delete {journal.dir} "
+                         "to start over")
+    return slabs, journal.done() & set(range(len(slabs)))
 
 
 def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     journal = Journal(out)
-    keep = _check_resume(cfg, out, journal, resume, log)
-    if keep is None:
+    decision = _check_resume(cfg, out, journal, resume, log)
+    if decision is None:
         return
-    slabs, chunk = plan_slabs(cfg)
-    keep = {k for k in keep if k < len(slabs)}
+    slabs, keep = decision
+    planned, chunk = plan_slabs(cfg)
+    if slabs:
+        chunk = min([chunk] + [i1 - i0 for i0, i1 in slabs])
+        log(f"resuming: {len(keep)} of {len(slabs)} slabs already done")
+    else:
+        slabs = planned
+    # connect (and fail) before anything is written
+    runner = None
     if scheduler is None:
-        n_workers = _set_workers(workers)
-        runner_info = {"scheduler": "local (numba threads)", "workers": str(n_workers)}
+        runner_info = {"scheduler": "local (numba threads)",
+                       "workers": str(_set_workers(workers))}
     else:
         from .distributed import DaskRunner
 
         runner = DaskRunner(scheduler)
         runner_info = runner.info()
-    if not keep:
-        journal.start({"name": cfg.name, "config_sha256": cfg.sha256,
-                       "slabs": [list(s) for s in slabs], "nylonflex_version": __version__})
-    elif keep:
-        log(f"resuming: {len(keep)} of {len(slabs)} slabs already done")
+    try:
+        if not keep:
+            journal.start({"name": cfg.name, "config_sha256": cfg.sha256,
+                           "slabs": [list(s) for s in slabs],
+                           "nylonflex_version": __version__})
+        _write_slabs(cfg, out, journal, slabs, keep, chunk, runner, runner_info, quiet, log)
+    finally:
+        if runner is not None:
+            runner.close()
+
+
+def _write_slabs(cfg, out, journal, slabs, keep, chunk, runner, runner_info, quiet, log):
+    """Journal and write every slab not in ``keep``; finish or mark the cube incomplete."""
     building = out.with_name(out.name + ".building")
     attrs = provenance(cfg)
     cube = CubeFile(building, _coords(cfg), attrs, chunk)
@@ -309,7 +332,7 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
                 done_slabs.add(k)
                 bar.update((i1 - i0) * per_radius)
             todo = [k for k in range(len(slabs)) if k not in keep]
-            if scheduler is None:
+            if runner is None:
                 results = _local_results(cfg, slabs, todo)
             else:
                 results = runner.map_slabs(cfg, slabs, todo)
@@ -327,8 +350,7 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     finally:
         if in_main:
             signal.signal(signal.SIGTERM, previous)
-        if scheduler is not None:
-            runner.close()
+        if runner is not None:
             runner_info = runner.info()  # counts workers that joined during the run
     seconds = time.perf_counter() - t0
     complete = stopped is None and len(done_slabs) == len(slabs)

@@ -277,3 +277,26 @@ def test_workers_out_of_range(tmp_path, capsys):
     path = write_config(tmp_path, SMALL)
     assert main(["sweep", str(path), "--out", str(tmp_path / "c.h5"), "--workers", "0"]) == 2
     assert "--workers: must be in [1," in capsys.readouterr().err
+
+
+def test_resume_keeps_the_journal_slab_plan_when_slab_size_changes(tmp_path):
+    # slab_megabytes is not part of the config hash: a resume must use the journal's plan
+    cfg_path = write_config(tmp_path, BIGGER)
+    out = tmp_path / "run" / "cube.h5"
+    cmd = [sys.executable, "-m", "nylonflex", "sweep", str(cfg_path), "--out", str(out),
+           "--quiet", "--no-charts"]
+    if _kill_halfway(cmd, out, signal.SIGKILL) == 0:
+        pytest.skip("the sweep finished before it could be killed")
+    assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--resume",
+                 "--no-charts", "--set", "slab_megabytes=7"]) == 0
+    whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")
+    xr.testing.assert_identical(stable(open_cube(out)), stable(whole))
+
+
+def test_a_damaged_journal_is_refused(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    cfg = parse_config(SMALL)
+    Journal(out).start({"name": "small", "config_sha256": cfg.sha256, "slabs": [[0, 4]]})
+    path = write_config(tmp_path, SMALL)
+    assert main(["sweep", str(path), "--out", str(out), "--resume", "--quiet"]) == 2
+    assert "damaged" in capsys.readouterr().err

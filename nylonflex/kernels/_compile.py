@@ -9,8 +9,10 @@ run the same source lines.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import types
+from pathlib import Path
 
 import numba
 
@@ -18,6 +20,35 @@ import numba
 #: run starts warm; ``fastmath`` stays off: the kernels must match the physics to 1e-9.
 JIT_OPTIONS = {"cache": os.environ.get("NYLONFLEX_NO_CACHE") is None, "nogil": True,
                "error_model": "numpy", "fastmath": False}
+
+
+
+def _source_digest() -> str:
+    """Digest of every physics and kernel source file.
+
+    Numba's cache checks only the timestamp of the file that holds the kernel, not of the
+    formulas it inlines from other files, so an edited formula could run stale machine code.
+    Keying the cache folder on all the sources the kernels are compiled from closes that hole.
+    """
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for sub in ("physics", "kernels"):
+        for path in sorted((root / sub).glob("*.py")):
+            digest.update(path.name.encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def _cache_dir() -> str:
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
+        "nylonflex", "numba")
+    return os.path.join(base, _source_digest())
+
+
+# Set before any kernel is decorated: numba reads it when a dispatcher's cache is created.
+# An unwritable folder makes numba fall back to its usual __pycache__ locations.
+numba.config.CACHE_DIR = _cache_dir()
 
 _COMPILED: dict[types.FunctionType, numba.core.registry.CPUDispatcher] = {}
 

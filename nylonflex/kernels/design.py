@@ -7,6 +7,7 @@ nothing is computed twice that a design axis does not change:
 - per (a, t): the bend-angle curve over pressure (Newton warm-started along the sorted
   pressure axis), independent of C, psi and L;
 - per (a, t, C): the curvature at the full stroke p(s_max(C));
+- per stroke: p(s) and S_theta(s), shared by every design's nylon-force curve;
 - per (a, t, C, psi): the stroke limit and, only for strength-limited designs, one more
   curvature solve (warm-started from the full-stroke one); the nylon-force curve;
 - per L: a multiply (theta = kappa L, F = M/L).
@@ -16,12 +17,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from ..physics.bending import NEWTON_RTOL, _curvature, _pressure_moment
 from ..physics.chamber import _gauge_pressure
 from ..physics.limits import _design_values, _stroke_state
-from ..physics.wrap import _nylon_force_and_slope, _pitch
+from ..physics.silicone import _stress_and_slope
+from ..physics.wrap import _pitch, _wrap_force
 from ._compile import jit_kernel
 
 #: Number of float design variables in ``out_design``: DESIGN_VARIABLES without ``limit``.
@@ -45,6 +48,12 @@ def _design_slab(radius, wall, length, coil_s_max, coil_force_limit, coil_width,
     npsi = wrap.shape[0]
     ns = stroke.shape[0]
     npr = pressure.shape[0]
+    # p(s) and S_theta(s) depend on the stroke only: once per stroke, not per design
+    stroke_pressure = np.empty(ns)
+    stroke_hoop = np.empty(ns)
+    for js in range(ns):
+        stroke_pressure[js] = _gauge_pressure(stroke[js], p_atm)
+        stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
     for k in prange(na * nt):
         ia = k // nt
         it = k % nt
@@ -74,8 +83,8 @@ def _design_slab(radius, wall, length, coil_s_max, coil_force_limit, coil_width,
                     out_design[6, ia, it, il, ic, ip] = v[7]
                     out_design[7, ia, it, il, ic, ip] = v[8]
                 for js in range(ns):
-                    out_nylon_force[ia, it, ic, ip, js] = _nylon_force_and_slope(
-                        stroke[js], a, t, lever, mu, alpha, p_atm)[0]
+                    out_nylon_force[ia, it, ic, ip, js] = _wrap_force(
+                        stroke_pressure[js], stroke_hoop[js], a, t, lever)
         kappa = 0.0
         for jp in range(npr):
             moment = _pressure_moment(pressure[jp], a, b)

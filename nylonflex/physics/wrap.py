@@ -43,14 +43,24 @@ def _pitch(radius, wall_thickness, base_thickness, wrap_angle, width):
 
 
 @formula
+def _wrap_force(pressure, hoop_stress, radius, wall_thickness, lever):
+    """F_n = (p a + |S_theta| t) pitch / cos psi [N] from the pressure and hoop stress.
+
+    ``lever`` = pitch / cos psi [m]. Kernels call it with p(s) and S_theta(s) computed once
+    per stroke, since neither depends on the design.
+    """
+    return (pressure * radius + abs(hoop_stress) * wall_thickness) * lever
+
+
+@formula
 def _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm):
-    """F_n(s) = (p(s) a + |S_theta(s)| t) lever [N] and dF_n/ds; lever = pitch / cos psi."""
+    """F_n(s) (MODEL.md section 4) [N] and dF_n/ds [N]; lever = pitch / cos psi [m]."""
     p = _gauge_pressure(stroke, p_atm)
     dp = _gauge_pressure_slope(stroke, p_atm)
     s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
     # d|S|/ds = sign(S) dS/dl dl/ds with dl/ds = -1
     sign = 1.0 if s_theta >= 0.0 else -1.0
-    force = (p * radius + abs(s_theta) * wall_thickness) * lever
+    force = _wrap_force(p, s_theta, radius, wall_thickness, lever)
     slope = (dp * radius - sign * ds_dlam * wall_thickness) * lever
     return force, slope
 
