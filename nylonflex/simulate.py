@@ -32,6 +32,7 @@ import numpy as np
 import yaml
 
 from . import __version__
+from .config import read_yaml
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.bending import NEWTON_RTOL, quadrature_nodes
 from .physics.chamber import P_ATM
@@ -497,16 +498,7 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
 
 def load_sim_config(path) -> SimConfig:
     """Read and validate a simulation config file (YAML)."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such config file")
-    try:
-        raw = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(f"{path}: not valid YAML{where}") from None
-    return parse_sim_config(raw, str(path))
+    return parse_sim_config(read_yaml(path), str(path))
 
 
 # ---------------------------------------------------------------------------------------

@@ -58,12 +58,8 @@ def is_formula(obj) -> bool:
     return isinstance(obj, types.FunctionType) and getattr(obj, "__nylonflex_formula__", False)
 
 
-def jit_formula(func):
-    """The Numba-compiled twin of a physics ``@formula`` (memoised)."""
-    if func in _COMPILED:
-        return _COMPILED[func]
-    if not is_formula(func):
-        raise TypeError(f"{func.__qualname__} is not a physics @formula")
+def _with_compiled_formulas(func, qualname):
+    """A copy of ``func`` whose global formulas are their compiled twins."""
     namespace = dict(func.__globals__)
     for name in func.__code__.co_names:
         if is_formula(namespace.get(name)):
@@ -71,9 +67,18 @@ def jit_formula(func):
     clone = types.FunctionType(func.__code__, namespace, func.__name__, func.__defaults__,
                                func.__closure__)
     clone.__module__ = func.__module__
-    clone.__qualname__ = func.__qualname__
+    clone.__qualname__ = qualname
     clone.__doc__ = func.__doc__
-    _COMPILED[func] = numba.njit(**JIT_OPTIONS)(clone)
+    return clone
+
+
+def jit_formula(func):
+    """The Numba-compiled twin of a physics ``@formula`` (memoised)."""
+    if func not in _COMPILED:
+        if not is_formula(func):
+            raise TypeError(f"{func.__qualname__} is not a physics @formula")
+        clone = _with_compiled_formulas(func, func.__qualname__)
+        _COMPILED[func] = numba.njit(**JIT_OPTIONS)(clone)
     return _COMPILED[func]
 
 
@@ -85,15 +90,7 @@ def jit_kernel(func=None, *, parallel=False):
     """
 
     def wrap(f):
-        namespace = dict(f.__globals__)
-        for name in f.__code__.co_names:
-            if is_formula(namespace.get(name)):
-                namespace[name] = jit_formula(namespace[name])
-        clone = types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__,
-                                   f.__closure__)
-        clone.__module__ = f.__module__
-        clone.__qualname__ = f.__qualname__ + ("_parallel" if parallel else "")
-        clone.__doc__ = f.__doc__
+        clone = _with_compiled_formulas(f, f.__qualname__ + ("_parallel" if parallel else ""))
         return numba.njit(parallel=parallel, **JIT_OPTIONS)(clone)
 
     return wrap if func is None else wrap(func)

@@ -9,6 +9,8 @@ without the physics layer importing Numba.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..materials import ZERO_CELSIUS  # noqa: F401  (one definition)
@@ -42,6 +44,21 @@ def check(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False, unit="
         raise ValueError(f"{name}: must be {_range(lo, hi, lo_open, hi_open)}{_unit(unit)}, "
                          f"got {got:g}")
     return arr
+
+
+def check_section(radius, wall_thickness, base_thickness=None):
+    """Checked a, t, b [m] of the cross-section; b = t when None (MODEL.md s. 1 [choice])."""
+    a = check("radius", radius, 0.0, lo_open=True, unit="m")
+    t = check("wall_thickness", wall_thickness, 0.0, lo_open=True, unit="m")
+    b = t if base_thickness is None else check("base_thickness", base_thickness, 0.0,
+                                               lo_open=True, unit="m")
+    return a, t, b
+
+
+def check_wrap_angle(wrap_angle):
+    """Checked helix angle psi [rad], in (0, pi/2)."""
+    return check("wrap_angle", wrap_angle, 0.0, math.pi / 2, lo_open=True, hi_open=True,
+                 unit="rad")
 
 
 def _unit(unit):

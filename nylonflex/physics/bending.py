@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from ..materials import silicone_parameters
-from ._formula import check, formula, scalar_or_array
+from ._formula import check, check_section, formula, scalar_or_array
 from .silicone import _stress_and_slope
 
 __all__ = [
@@ -138,14 +138,6 @@ def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
     return k
 
 
-def _check_section(radius, wall_thickness, base_thickness):
-    a = check("radius", radius, 0.0, lo_open=True, unit="m")
-    t = check("wall_thickness", wall_thickness, 0.0, lo_open=True, unit="m")
-    b = t if base_thickness is None else check("base_thickness", base_thickness, 0.0,
-                                               lo_open=True, unit="m")
-    return a, t, b
-
-
 def pressure_moment(pressure, radius, base_thickness):
     """Moment of the chamber pressure about the neutral axis M_P [N m].
 
@@ -195,7 +187,7 @@ def material_moment(curvature_value, radius, wall_thickness, base_thickness=None
     MODEL.md section 6 [choice]: nominal stress integrated over the undeformed section.
     """
     k = check("curvature", curvature_value, 0.0, unit="1/m")
-    a, t, b = _check_section(radius, wall_thickness, base_thickness)
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
     mu, alpha = silicone_parameters(silicone).arrays()
     nodes = quadrature_nodes(orders)
     f = np.vectorize(lambda *x: _material_moment(*x, mu, alpha, *nodes)[0], otypes=[float])
@@ -230,7 +222,7 @@ def curvature(pressure, radius, wall_thickness, base_thickness=None, silicone="t
     Paper eqs. (13)-(15); Polygerinos et al. 2015; MODEL.md section 6.
     """
     p = check("pressure", pressure, 0.0, unit="Pa")
-    a, t, b = _check_section(radius, wall_thickness, base_thickness)
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
     mu, alpha = silicone_parameters(silicone).arrays()
     nodes = quadrature_nodes(orders)
 

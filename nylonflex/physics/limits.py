@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
-from ._formula import check, formula, scalar_or_array
+from ._formula import check, check_section, check_wrap_angle, formula, scalar_or_array
 from .bending import NEWTON_RTOL, _curvature, _pressure_moment, quadrature_nodes
 from .chamber import P_ATM, _gauge_pressure
 from .wrap import _nylon_force_and_slope, _pitch
@@ -105,15 +105,10 @@ def _design_values(s, limit, p, moment, kappa, force, kappa_full, force_limit, l
 
 def _inputs(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness, ny):
     lo, hi = ny.coil_index_range
-    a = check("radius", radius, 0.0, lo_open=True, unit="m")
-    t = check("wall_thickness", wall_thickness, 0.0, lo_open=True, unit="m")
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
     L = check("length", length, 0.0, lo_open=True, unit="m")
     c = check("coil_index", coil_index, lo, hi, unit="-")
-    psi = check("wrap_angle", wrap_angle, 0.0, math.pi / 2, lo_open=True, hi_open=True,
-                unit="rad")
-    b = t if base_thickness is None else check("base_thickness", base_thickness, 0.0,
-                                               lo_open=True, unit="m")
-    return a, t, L, c, psi, b
+    return a, t, L, c, check_wrap_angle(wrap_angle), b
 
 
 def stroke_limit(radius, wall_thickness, coil_index, wrap_angle, base_thickness=None,

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
-from ._formula import check, formula, scalar_or_array
+from ._formula import check, check_section, check_wrap_angle, formula, scalar_or_array
 from .chamber import P_ATM, _gauge_pressure, _gauge_pressure_slope
 from .silicone import _stress_and_slope
 
@@ -65,16 +65,9 @@ def _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_a
     return force, slope
 
 
-def _geometry(radius, wall_thickness, base_thickness, wrap_angle=None):
-    a = check("radius", radius, 0.0, lo_open=True, unit="m")
-    t = check("wall_thickness", wall_thickness, 0.0, lo_open=True, unit="m")
-    b = t if base_thickness is None else check("base_thickness", base_thickness, 0.0,
-                                               lo_open=True, unit="m")
-    if wrap_angle is None:
-        return a, t, b
-    psi = check("wrap_angle", wrap_angle, 0.0, math.pi / 2, lo_open=True, hi_open=True,
-                unit="rad")
-    return a, t, b, psi
+def _geometry(radius, wall_thickness, base_thickness, wrap_angle):
+    return (*check_section(radius, wall_thickness, base_thickness),
+            check_wrap_angle(wrap_angle))
 
 
 def outer_perimeter(radius, wall_thickness, base_thickness=None):
@@ -89,7 +82,7 @@ def outer_perimeter(radius, wall_thickness, base_thickness=None):
     base_thickness : float or array, optional
         Bottom layer thickness b [m], > 0; b = t when None (MODEL.md section 1 [choice]).
     """
-    a, t, b = _geometry(radius, wall_thickness, base_thickness)
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
     return scalar_or_array(_outer_perimeter(a, t, b))
 
 
