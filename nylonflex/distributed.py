@@ -55,13 +55,19 @@ def _normalise_address(address) -> str:
 
 
 def _versions() -> dict:
-    """The versions that decide a slab's bits: nylonflex's model, Numba's code, NumPy's."""
+    """What decides a slab's bits: nylonflex's version and model sources, Numba, NumPy.
+
+    ``model`` is the digest of the physics and kernel sources, so an edited formula on one
+    side is caught even where the version number did not change.
+    """
     import numba
     import numpy
 
     from . import __version__
+    from .kernels._compile import _source_digest
 
-    return {"nylonflex": __version__, "numba": numba.__version__, "numpy": numpy.__version__}
+    return {"nylonflex": __version__, "model": _source_digest(), "numba": numba.__version__,
+            "numpy": numpy.__version__}
 
 
 def _mismatch(expected: dict, got: dict) -> str:

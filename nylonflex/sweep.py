@@ -116,6 +116,8 @@ def provenance(cfg: ResolvedConfig) -> dict:
     import xarray
     import yaml
 
+    from .kernels._compile import _source_digest
+
     def material(m):
         d = {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(m).items()
              if k != "sources"}
@@ -130,6 +132,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
         "config_yaml": cfg.text,
         "config_sha256": cfg.sha256,
         "nylonflex_version": __version__,
+        "model_sources_sha256": _source_digest(),
         "numba_version": numba.__version__,
         "numpy_version": np.__version__,
         "xarray_version": xarray.__version__,
