@@ -654,7 +654,19 @@ CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
 assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 
 
-def draw_charts(ds, names, out_dir, fmt="png") -> list[Path]:
+#: Axes each chart draws along: a cube with a single value there cannot show it.
+NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
+         "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
+         "design_map": ("radius", "wall_thickness")}
+
+
+def _unmet(ds, name):
+    short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
+    return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
+            "has 1") if short else None
+
+
+def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
     """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
 
     Parameters
@@ -667,6 +679,9 @@ def draw_charts(ds, names, out_dir, fmt="png") -> list[Path]:
         Folder for the images (created if missing).
     fmt : {"png", "pdf", "svg"}
         Image format.
+    on_skip : callable, optional
+        Receives a one-line message for each chart the cube cannot show (an axis it plots
+        along has a single value); a warning by default.
 
     Returns
     -------
@@ -691,6 +706,15 @@ def draw_charts(ds, names, out_dir, fmt="png") -> list[Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     for name in names:
+        reason = _unmet(ds, name)
+        if reason:
+            if on_skip is None:
+                import warnings
+
+                warnings.warn(reason, stacklevel=2)
+            else:
+                on_skip(reason)
+            continue
         with plt.rc_context(_RC):
             fig = CHARTS[name](ds)
             path = out_dir / f"{name}.{fmt}"
@@ -721,7 +745,8 @@ def chart_command(args) -> int:
     if out.exists() and not out.is_dir():
         raise InputError(f"--out: {out} is a file; give a folder for the images")
     try:
-        for path in draw_charts(ds, args.figure, out, args.format):
+        skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
+        for path in draw_charts(ds, args.figure, out, args.format, on_skip=skip):
             print(path)
     finally:
         ds.close()

@@ -421,7 +421,8 @@ def sweep_command(args) -> int:
     if cfg.charts and not args.no_charts:
         from .charts import draw_charts
 
-        for path in draw_charts(ds, cfg.charts, out.parent, "png"):
+        skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
+        for path in draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip):
             print(path)
     ds.close()
     return 0

@@ -159,3 +159,24 @@ def test_incomplete_cube_draws_with_a_warning(cube, tmp_path, capsys):
     captured = capsys.readouterr()
     assert rc == 0 and "incomplete" in captured.err
     assert (tmp_path / "design_map.png").is_file()
+
+
+def test_a_cube_with_single_value_axes_skips_what_it_cannot_draw(tmp_path, capsys):
+    from nylonflex.cli import main
+
+    raw = {"name": "one",
+           "grid": {"radius": {"values": [10], "units": "mm"},
+                    "wall_thickness": {"values": [2, 3], "units": "mm"},
+                    "length": {"values": [90], "units": "mm"},
+                    "coil_index": {"values": [1.3]},
+                    "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"values": [0.0, 0.05]},
+                      "pressure": {"values": [10], "units": "kPa"}}}
+    out = tmp_path / "cube.h5"
+    run_sweep(parse_config(raw), out).close()
+    assert main(["chart", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "design_map skipped: it needs at least 2 values of radius" in captured.err
+    assert "fig6 skipped" in captured.err and "fig12b skipped" in captured.err
+    assert (tmp_path / "fig4.png").is_file() and (tmp_path / "fig12a.png").is_file()
+    assert not (tmp_path / "design_map.png").exists()
