@@ -489,6 +489,13 @@ def _curve_panel(ax, ds, var, name, values, fixed):
     ax.legend(loc="upper left", title=VARIABLES[name].long_name)
 
 
+def _held_design(ds, radius, wall_thickness, length):
+    """The grid design nearest (a, t, L) [m], by default 10 mm, 2 mm, 90 mm."""
+    return (_nearest(ds, "radius", 10e-3 if radius is None else radius),
+            _nearest(ds, "wall_thickness", 2e-3 if wall_thickness is None else wall_thickness),
+            _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length))
+
+
 def fig6(ds, *, radius=None, wall_thickness=None, length=None):
     """Figure 6(b, c): bend angle against pressure, for radius 6-14 mm and wall 1-4 mm.
 
@@ -507,9 +514,7 @@ def fig6(ds, *, radius=None, wall_thickness=None, length=None):
     -------
     matplotlib.figure.Figure
     """
-    a = _nearest(ds, "radius", 10e-3 if radius is None else radius)
-    t = _nearest(ds, "wall_thickness", 2e-3 if wall_thickness is None else wall_thickness)
-    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    a, t, length = _held_design(ds, radius, wall_thickness, length)
     fig, axes = _figure(1, 2, size=(9.0, 4.2))
     _curve_panel(axes[0][0], ds, "bend_angle", "radius",
                  _spread(ds, "radius", 6e-3, 14e-3, 5),
@@ -537,9 +542,7 @@ def fig7(ds, *, radius=None, wall_thickness=None, length=None):
     -------
     matplotlib.figure.Figure
     """
-    a = _nearest(ds, "radius", 10e-3 if radius is None else radius)
-    t = _nearest(ds, "wall_thickness", 2e-3 if wall_thickness is None else wall_thickness)
-    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    a, t, length = _held_design(ds, radius, wall_thickness, length)
     fig, axes = _figure(1, 3, size=(11.0, 4.0), sharey=True)
     _curve_panel(axes[0][0], ds, "tip_force", "radius", _spread(ds, "radius", 6e-3, 14e-3, 5),
                  {"wall_thickness": t, "length": length})

@@ -32,6 +32,21 @@ def _config_reference_kind(ds, j=0):
         return ""
 
 
+def _design_line(ds, j=0):
+    """``"control: a 7.5 mm, t 2 mm, L 70 mm, C 1.7, psi 8 deg, 12 V"`` from the config."""
+    import yaml
+
+    try:
+        cfg = yaml.safe_load(ds.attrs["config"])
+        d = cfg["actuators"][j]["design"]
+        return (f"{cfg['name']}: a {d['radius'] * 1e3:g} mm, t {d['wall_thickness'] * 1e3:g} mm, "
+                f"L {d['length'] * 1e3:g} mm, C {d['coil_index']:g}, "
+                f"\u03c8 {math.degrees(d['wrap_angle']):.3g} deg, "
+                f"{cfg['supply']['voltage']:g} V")
+    except Exception:  # noqa: BLE001 - a chart without the design line still draws
+        return ""
+
+
 def _running_mean(t, x, window):
     """Mean of ``x`` over the last ``window`` seconds at each time (a display aid)."""
     dt = t[1] - t[0] if t.size > 1 else 1.0
@@ -78,7 +93,7 @@ def figure9(ds, path):
     else:
         title = f"Tracking: RMS error {math.degrees(a.get('rms_error', math.nan)):.2f} deg " \
                 f"({100 * a.get('rms_error_fraction', math.nan):.1f} % of the span)"
-    ax.set_title(title, fontsize=10)
+    ax.set_title(f"{_design_line(ds)}\n{title}", fontsize=10)
     ax.legend(loc="lower right", fontsize=8)
     power = ds["power"].values
     # bang-bang at 10 ms is a blur at this scale: show the switching faintly and its 1 s mean
