@@ -93,7 +93,7 @@ class SweepConfig(_Strict):
     base_thickness: Union[Literal["wall"], FixedThickness] = "wall"
     curves: Curves
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
-    slab_megabytes: float = 64.0
+    slab_megabytes: float = 16.0
 
     @model_validator(mode="after")
     def _name(self):

@@ -63,6 +63,9 @@ def test_curvature_matches_slow_reference(name):
 
 
 @pytest.mark.slow
+# near p = 10 Pa quad reports roundoff at epsrel 1e-12 (the strains are ~1e-6); the bracket
+# check of brentq and the 1e-9 comparison still hold
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
 @settings(max_examples=25, deadline=None)
 @given(st.sampled_from(SETS), st.floats(5e-3, 25e-3), st.floats(1e-3, 6e-3),
        st.floats(10.0, 60e3), st.floats(1e-3, 10e-3))  # p = 0 is exact, tested above
