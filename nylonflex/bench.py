@@ -57,6 +57,26 @@ def _reference_design(cfg, a, t, c, psi):
     return s, k_full, k
 
 
+def _closed_loop_seconds(duration: float) -> tuple[float, float]:
+    """Loop time [s] of the figure-9 closed loop over ``duration`` [s] at 10 ms, and the
+    whole run's (tables and output included), once compiled."""
+    from .simulate import parse_sim_config, run_simulation
+
+    cfg = parse_sim_config({
+        "name": "bench",
+        "design": {"radius": "7.5 mm", "wall_thickness": "2 mm", "length": "70 mm",
+                   "coil_index": 1.7, "wrap_angle": "8 deg"},
+        "supply": {"voltage": "12 V"},
+        "time": {"duration": f"{duration} s", "step": "10 ms"},
+        "reference": {"kind": "sine", "mean": "85 deg", "amplitude": "30 deg",
+                      "frequency": "0.04 Hz"},
+    })
+    run_simulation(cfg)  # compile or load the cache
+    t0 = time.perf_counter()
+    ds = run_simulation(cfg)
+    return float(ds.attrs["loop_time"]), time.perf_counter() - t0
+
+
 def _solve_count(ds) -> int:
     """Angle solves the kernel makes: curve points, full-stroke and strength-limited ones."""
     na, nt, nc = ds.sizes["radius"], ds.sizes["wall_thickness"], ds.sizes["coil_index"]
@@ -104,6 +124,9 @@ def run_bench(quick: bool = False, out=sys.stdout) -> dict:
         _reference_design(cfg, *d)
     t_ref = (time.perf_counter() - t0) / n_ref
 
+    sim_duration = 60.0 if quick else 3600.0
+    t_loop, t_sim = _closed_loop_seconds(sim_duration)
+
     per_design = t_total / cfg.n_designs
     result = {
         "designs": cfg.n_designs,
@@ -116,6 +139,8 @@ def run_bench(quick: bool = False, out=sys.stdout) -> dict:
         "angle_solves_per_s": solves / t_kernel,
         "reference_s_per_design": t_ref,
         "speedup": t_ref / per_design,
+        "closed_loop_s": t_loop,
+        "closed_loop_run_s": t_sim,
         "peak_rss_mb": peak_mb,
         "cube_mb": size_mb,
     }
@@ -126,6 +151,8 @@ def run_bench(quick: bool = False, out=sys.stdout) -> dict:
     say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
     say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
         "same run)")
+    say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
+        f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")
     return result
 
