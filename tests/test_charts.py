@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import pytest
+from conftest import write_cube
 
 from nylonflex import charts
 from nylonflex.cli import main
@@ -36,9 +37,7 @@ UNITS = {"fig12a": ["[N]"], "fig12b": ["[mm]", "[N mm]"], "fig12c": ["[mm]", "[d
 
 @pytest.fixture(scope="module")
 def cube(tmp_path_factory):
-    path = tmp_path_factory.mktemp("charts") / "cube.h5"
-    run_sweep(parse_config(SMALL), out=path).close()
-    return path
+    return write_cube(tmp_path_factory.mktemp("charts"), SMALL)
 
 
 @pytest.fixture(scope="module")

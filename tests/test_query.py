@@ -7,11 +7,11 @@ Expected numbers come from MODEL.md section 8 (the paper's worked examples, 1.20
 import csv
 import io
 import json
-import math
 
 import h5py
 import numpy as np
 import pytest
+from conftest import DEG, EXAMPLE_1, EXAMPLE_2, write_cube
 
 import nylonflex as nf
 from nylonflex import query
@@ -21,11 +21,6 @@ from nylonflex.storage import open_cube
 from nylonflex.sweep import run_sweep
 from nylonflex.units import InputError
 
-DEG = math.pi / 180.0
-EXAMPLE_1 = dict(radius=20e-3, wall_thickness=6e-3, length=90e-3, coil_index=1.1,
-                 wrap_angle=8 * DEG)
-EXAMPLE_2 = dict(radius=7.5e-3, wall_thickness=2e-3, length=70e-3, coil_index=1.7,
-                 wrap_angle=8 * DEG)
 AT_2 = "radius=7.5mm,wall_thickness=2mm,length=70mm,coil_index=1.7,wrap_angle=8deg"
 
 SMALL = {
@@ -44,9 +39,7 @@ SMALL = {
 
 @pytest.fixture(scope="module")
 def cube(tmp_path_factory):
-    path = tmp_path_factory.mktemp("query") / "cube.h5"
-    run_sweep(parse_config(SMALL), out=path).close()
-    return path
+    return write_cube(tmp_path_factory.mktemp("query"), SMALL)
 
 
 @pytest.fixture(scope="module")
