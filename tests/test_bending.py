@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import dblquad
 
@@ -87,6 +87,9 @@ def test_curvature_solves_the_moment_balance_without_a_guess():
        st.lists(st.floats(0.0, 60e3), min_size=2, max_size=6, unique=True))
 def test_angle_monotone_in_pressure(name, a, t, pressures):
     p = np.sort(pressures)
+    # strictly increasing for pressures a float can tell apart through M_P (hypothesis
+    # found 5e-324 Pa: its moment underflows to zero, and so does the angle)
+    assume(np.all(np.diff(p) > 1e-9 * p[-1]) and p[1] > 1e-9)
     theta = bending.bend_angle(p, a, t, 0.1, None, name)
     assert np.all(np.diff(theta) > 0)
 
