@@ -1,8 +1,9 @@
 """The design cube on disk: NetCDF4/HDF5 written through h5netcdf, read with xarray.
 
-Durability: a sweep journals every finished slab of radii as its own small ``.npz`` file in
+Durability: a sweep journals every finished slab of radii as its own ``.npz`` file in
 ``<cube>.parts/`` (written to a temporary name, then renamed, so a slab file is whole or
-absent) and writes the same slab into ``<cube>.building``. Only a finished run renames
+absent; it holds the slab's compressed chunks, see :meth:`CubeFile.encode`) and writes the
+same slab into ``<cube>.building``. Only a finished run renames
 the building file to ``<cube>``: a killed run never leaves a file that reads as complete.
 ``--resume`` keeps the journal's slabs (if the config hash matches) and computes the rest.
 A run stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete = "false"`` and a
@@ -78,25 +79,53 @@ class CubeFile:
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def write(self, i0: int, i1: int, arrays: dict):
-        """Write the variables of radii [i0, i1) (and those without a radius dim).
+        """Write the variables of radii [i0, i1) (and those without a radius dim)."""
+        self.write_encoded(i0, i1, self.encode(i0, arrays))
 
-        Chunks that lie wholly inside the slab are shuffled and deflated by a small thread
-        pool (zlib releases the GIL) and stored with ``write_direct_chunk``; HDF5 would
-        compress them one by one in this thread. Anything else goes through HDF5.
+    def encode(self, i0: int, arrays: dict) -> dict:
+        """The slab of radii from ``i0`` as it will be stored: a flat dict of arrays.
+
+        Chunks that lie wholly inside the slab are shuffled and deflated here, by a small
+        thread pool (zlib releases the GIL; HDF5 would compress them one by one in the
+        writing thread), as ``NAME:offsets``, ``NAME:sizes`` and ``NAME:bytes``; anything
+        else stays a plain array under its name. The journal keeps exactly this, so a slab
+        is compressed once and its journal file is as small as its share of the cube.
         """
-        jobs = []
+        out, jobs = {}, []
         for name, data in arrays.items():
             var = self.f.variables[name]
-            if not (var.dimensions and var.dimensions[0] == "radius"):
-                var[...] = data
-                continue
             dset = var._h5ds
-            if self._aligned(dset, i0, i1):
-                jobs.extend((dset, off, fut) for off, fut in self._compress(dset, i0, data))
+            i1 = i0 + (np.shape(data)[0] if var.dimensions else 0)
+            if var.dimensions and var.dimensions[0] == "radius" and \
+                    self._aligned(dset, i0, i1):
+                jobs.append((name, list(self._compress(dset, i0, data))))
             else:
-                var[i0:i1] = data
-        for dset, offset, future in jobs:
-            dset.id.write_direct_chunk(offset, future.result())
+                out[name] = np.asarray(data)
+        for name, chunks in jobs:
+            blobs = [future.result() for _, future in chunks]
+            out[f"{name}:offsets"] = np.array([off for off, _ in chunks], dtype=np.int64)
+            out[f"{name}:sizes"] = np.array([len(b) for b in blobs], dtype=np.int64)
+            out[f"{name}:bytes"] = np.frombuffer(b"".join(blobs), dtype=np.uint8)
+        return out
+
+    def write_encoded(self, i0: int, i1: int, encoded: dict):
+        """Store what :meth:`encode` made for the radii [i0, i1)."""
+        for key, value in encoded.items():
+            name, _, part = key.partition(":")
+            var = self.f.variables[name]
+            if part == "offsets":
+                sizes = encoded[f"{name}:sizes"]
+                blob = encoded[f"{name}:bytes"]
+                ends = np.cumsum(sizes)
+                for offset, end, size in zip(value, ends, sizes):
+                    var._h5ds.id.write_direct_chunk(tuple(int(x) for x in offset),
+                                                    blob[end - size:end].tobytes())
+            elif part:
+                continue  # sizes and bytes go with their offsets
+            elif var.dimensions and var.dimensions[0] == "radius":
+                var[i0:i1] = value
+            else:
+                var[...] = value
         self.f.variables["slab_done"][i0:i1] = 1
 
     @staticmethod

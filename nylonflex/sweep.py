@@ -239,14 +239,15 @@ def _sweep_in_memory(cfg, workers, quiet):
 
 
 def _check_resume(cfg, out, journal, resume, log):
-    """Decide what to keep: ``None`` (nothing to do), or the journal's slab plan and the
-    indices of its finished slabs (an empty plan means: start afresh)."""
+    """Decide what to keep: ``None`` (nothing to do), or the journal's slab plan, its chunk
+    length along radius and the indices of its finished slabs (an empty plan: start
+    afresh)."""
     manifest = journal.read_manifest() if journal.exists() else None
     if manifest is not None and not resume:
         raise InputError(f"{out}: an interrupted run of '{manifest.get('name')}' is in "
                          f"{journal.dir}; add --resume to finish it, or delete that folder")
     if not resume:
-        return [], set()
+        return [], None, set()
     if manifest is None:
         attrs = cube_attrs(out)
         if attrs and attrs.get("config_sha256") != cfg.sha256:
@@ -257,19 +258,23 @@ def _check_resume(cfg, out, journal, resume, log):
             log(f"{out} is already complete; nothing to resume")
             return None
         log("nothing to resume; starting the sweep")
-        return [], set()
+        return [], None, set()
     if manifest.get("config_sha256") != cfg.sha256:
         raise InputError(f"--resume: the config changed since the interrupted run "
                          f"(sha256 {manifest.get('config_sha256', '?')[:12]} vs "
                          f"{cfg.sha256[:12]}); delete {journal.dir} to start over")
     # the journal's own slab plan: slab_megabytes may differ now (it is not in the hash)
+    # the journal's own slab plan and chunking: slab_megabytes may differ now (it is not in
+    # the hash), and journaled slabs hold compressed chunks of the recorded shape
     slabs = [tuple(int(i) for i in s) for s in manifest.get("slabs", [])]
     edges = [i for s in slabs for i in s]
+    chunk = manifest.get("radius_chunk")
     if not slabs or edges[0] != 0 or edges[-1] != cfg.shape[0] or \
-            any(a != b for a, b in zip(edges[1:-1:2], edges[2::2])):
+            any(a != b for a, b in zip(edges[1:-1:2], edges[2::2])) or \
+            not isinstance(chunk, int) or chunk < 1:
         raise InputError(f"--resume: {journal.manifest} is damaged; delete {journal.dir} "
                          "to start over")
-    return slabs, journal.done() & set(range(len(slabs)))
+    return slabs, chunk, journal.done() & set(range(len(slabs)))
 
 
 def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
@@ -277,13 +282,11 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     decision = _check_resume(cfg, out, journal, resume, log)
     if decision is None:
         return
-    slabs, keep = decision
-    planned, chunk = plan_slabs(cfg)
+    slabs, chunk, keep = decision
     if slabs:
-        chunk = min([chunk] + [i1 - i0 for i0, i1 in slabs])
         log(f"resuming: {len(keep)} of {len(slabs)} slabs already done")
     else:
-        slabs = planned
+        slabs, chunk = plan_slabs(cfg)
     # connect (and fail) before anything is written
     runner = None
     if scheduler is None:
@@ -297,7 +300,7 @@ def _sweep_to_file(cfg, out, resume, workers, scheduler, quiet, log):
     try:
         if not keep:
             journal.start({"name": cfg.name, "config_sha256": cfg.sha256,
-                           "slabs": [list(s) for s in slabs],
+                           "slabs": [list(s) for s in slabs], "radius_chunk": chunk,
                            "nylonflex_version": __version__})
         _write_slabs(cfg, out, journal, slabs, keep, chunk, runner, runner_info, quiet, log)
     finally:
@@ -331,7 +334,7 @@ def _write_slabs(cfg, out, journal, slabs, keep, chunk, runner, runner_info, qui
         with _progress(cfg.n_designs, quiet) as bar:
             for k in sorted(keep):
                 i0, i1 = slabs[k]
-                cube.write(i0, i1, journal.load(k))
+                cube.write_encoded(i0, i1, journal.load(k))
                 done_slabs.add(k)
                 bar.update((i1 - i0) * per_radius)
             todo = [k for k in range(len(slabs)) if k not in keep]
@@ -341,8 +344,9 @@ def _write_slabs(cfg, out, journal, slabs, keep, chunk, runner, runner_info, qui
                 results = runner.map_slabs(cfg, slabs, todo)
             for k, arrays in results:
                 i0, i1 = slabs[k]
-                journal.save(k, arrays)
-                cube.write(i0, i1, arrays)
+                encoded = cube.encode(i0, arrays)
+                journal.save(k, encoded)
+                cube.write_encoded(i0, i1, encoded)
                 done_slabs.add(k)
                 computed += (i1 - i0) * per_radius
                 bar.update((i1 - i0) * per_radius)
