@@ -300,3 +300,20 @@ def test_a_damaged_journal_is_refused(tmp_path, capsys):
     path = write_config(tmp_path, SMALL)
     assert main(["sweep", str(path), "--out", str(out), "--resume", "--quiet"]) == 2
     assert "damaged" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", [["sweep"], ["frobnicate"], ["query", "x", "--format", "xml"],
+                                  ["sweep", "c.yaml", "--workers", "two"]])
+def test_command_line_usage_errors_are_one_line_exit_2(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "error:" in err and "--help" in err
+
+
+def test_version_and_help(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and "nylonflex 0." in capsys.readouterr().out
+    assert main([]) == 0 and "sweep" in capsys.readouterr().out
