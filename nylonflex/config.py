@@ -29,8 +29,9 @@ CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map")
 
 Number = Union[float, str]
 
-#: axis -> (kind, default unit, accepted SI range lo, hi, display unit for messages)
-_AXIS_RULES = {
+#: quantity -> (kind, default unit, accepted SI range lo, hi, display unit for messages);
+#: the design's plausible range (MODEL.md section 1), for sweeps and simulations alike
+DESIGN_RANGES = {
     "radius": ("length", "mm", 0.5e-3, 0.2, "mm"),
     "wall_thickness": ("length", "mm", 0.1e-3, 0.05, "mm"),
     "length": ("length", "mm", 1e-3, 2.0, "mm"),
@@ -38,8 +39,15 @@ _AXIS_RULES = {
     "wrap_angle": ("angle", "deg", math.radians(0.1), math.radians(80.0), "deg"),
     "stroke": ("dimensionless", "1", 0.0, 0.5, "1"),
     "pressure": ("pressure", "kPa", 0.0, 100e3, "kPa"),
+    "base_thickness": ("length", "mm", 0.1e-3, 0.05, "mm"),
 }
 _MAX_POINTS = 100_000
+
+
+def valid_name(name) -> bool:
+    """A run name usable as a folder under sweeps/: letters, digits, '-', '_', '.'."""
+    return isinstance(name, str) and bool(name) and not name.startswith(".") and \
+        all(ch.isalnum() or ch in "-_." for ch in name)
 
 
 class _Strict(BaseModel):
@@ -97,8 +105,7 @@ class SweepConfig(_Strict):
 
     @model_validator(mode="after")
     def _name(self):
-        if not self.name or not all(ch.isalnum() or ch in "-_." for ch in self.name) \
-                or self.name.startswith("."):
+        if not valid_name(self.name):
             raise ValueError("name: letters, digits, '-', '_' and '.' only")
         if not 1.0 <= self.slab_megabytes <= 4096.0:
             raise ValueError("slab_megabytes: must be in [1, 4096]")
@@ -147,12 +154,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         "grid": {k: [float(x) for x in v] for k, v in cfg.axes.items()},
         "curves": {k: [float(x) for x in v] for k, v in cfg.curves.items()},
         "base_thickness": "wall" if cfg.base_thickness is None else cfg.base_thickness,
-        "silicone": {"name": cfg.silicone.name, "mu": list(cfg.silicone.mu),
-                     "alpha": list(cfg.silicone.alpha)},
-        "nylon": {"name": cfg.nylon.name,
-                  **{k: (list(v) if isinstance(v, tuple) else v)
-                     for k, v in vars(cfg.nylon).items()
-                     if k not in ("name", "description", "sources")}},
+        "silicone": cfg.silicone.to_dict(),
+        "nylon": cfg.nylon.to_dict(),
         "units": "SI (m, rad, Pa; stroke and coil_index dimensionless)",
     }
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
@@ -175,7 +178,7 @@ def _pydantic_message(err: ValidationError) -> str:
 
 
 def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
-    kind, unit, lo, hi, shown = _AXIS_RULES[name]
+    kind, unit, lo, hi, shown = DESIGN_RANGES[name]
     units = axis.units or unit
     to_si(1.0, units, f"{path}.units", kind)
     if name == "coil_index":
@@ -233,10 +236,11 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
         base = None
     else:
         units = cfg.base_thickness.units or "mm"
+        _, _, lo, hi, _ = DESIGN_RANGES["base_thickness"]
         base = parse_quantity(cfg.base_thickness.value, "base_thickness.value", "length", units)
-        if not 0.1e-3 <= base <= 0.05:
-            raise InputError(f"base_thickness.value: must be in [0.1, 50] mm, got "
-                             f"{base * 1e3:g} mm")
+        if not lo <= base <= hi:
+            raise InputError(f"base_thickness.value: must be in [{lo * 1e3:g}, {hi * 1e3:g}] "
+                             f"mm, got {base * 1e3:g} mm")
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, raw=copy.deepcopy(raw))

@@ -157,6 +157,10 @@ class Silicone:
         """``(mu, alpha)`` as float64 arrays, the form the formula functions take."""
         return np.asarray(self.mu, dtype=float), np.asarray(self.alpha, dtype=float)
 
+    def to_dict(self) -> dict:
+        """The set's name and values, lists for tuples (for YAML provenance)."""
+        return _values(self)
+
 
 @dataclass(frozen=True)
 class Nylon:
@@ -217,6 +221,16 @@ class Nylon:
     def coil_index_range(self) -> tuple[float, float]:
         """Smallest and largest coil index of the table [-]."""
         return self.coil_index_table[0], self.coil_index_table[-1]
+
+    def to_dict(self) -> dict:
+        """The set's name and values, lists for tuples (for YAML provenance)."""
+        return _values(self)
+
+
+def _values(material) -> dict:
+    return {f.name: (list(v) if isinstance(v, tuple) else v)
+            for f in fields(material) if f.name not in ("description", "sources")
+            for v in (getattr(material, f.name),)}
 
 
 def _resolve(kind, table, value, overrides):

@@ -32,12 +32,12 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .config import read_yaml
+from .config import DESIGN_RANGES, read_yaml, valid_name
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.bending import NEWTON_RTOL, quadrature_nodes
-from .physics.chamber import P_ATM
+from .physics.chamber import P_ATM, chamber_pressure
 from .physics.nylon import _stroke_scale, nylon_force_limit, stroke
-from .physics.thermal import steady_temperature
+from .physics.thermal import muscle_resistance, steady_temperature
 from .physics.wrap import muscle_length, nylon_force
 from .units import InputError, from_si, parse_quantity
 
@@ -131,16 +131,6 @@ _REFERENCE_KEYS = {
     "schedule": {"kind", "times", "angles", "interpolation"},
 }
 
-#: name -> (kind, default unit, lo, hi) in SI; the design's plausible range (MODEL.md 1).
-_DESIGN_RULES = {
-    "radius": ("length", "mm", 0.5e-3, 0.2),
-    "wall_thickness": ("length", "mm", 0.1e-3, 0.05),
-    "length": ("length", "mm", 1e-3, 2.0),
-    "wrap_angle": ("angle", "deg", math.radians(0.1), math.radians(80.0)),
-    "base_thickness": ("length", "mm", 0.1e-3, 0.05),
-}
-
-
 @dataclass(frozen=True)
 class Reference:
     """A reference angle schedule, SI.
@@ -226,12 +216,8 @@ def _resolved_doc(cfg: SimConfig) -> dict:
             "design": {k: getattr(a, k) for k in ("radius", "wall_thickness", "length",
                                                   "coil_index", "wrap_angle",
                                                   "base_thickness")},
-            "silicone": {"name": a.silicone.name, "mu": list(a.silicone.mu),
-                         "alpha": list(a.silicone.alpha)},
-            "nylon": {"name": a.nylon.name,
-                      **{k: (list(v) if isinstance(v, tuple) else v)
-                         for k, v in vars(a.nylon).items()
-                         if k not in ("name", "description", "sources")}},
+            "silicone": a.silicone.to_dict(),
+            "nylon": a.nylon.to_dict(),
             "initial_temperature": a.initial_temperature,
             "sensor": {"noise": a.noise, "seed": a.seed},
             "estimator": {"table_points": a.table_points,
@@ -386,7 +372,7 @@ def _actuator(top: dict, own: dict, path: str, duration: float, dt: float, index
     d = _section(top, own, "design", f"{pre}design")
     vals = {}
     for key in ("radius", "wall_thickness", "length", "wrap_angle"):
-        kind, unit, lo, hi = _DESIGN_RULES[key]
+        kind, unit, lo, hi, _ = DESIGN_RANGES[key]
         vals[key] = _quantity(d[key], f"{pre}design.{key}", kind, unit, lo, hi)
     lo, hi = ny.coil_index_range
     vals["coil_index"] = _quantity(d["coil_index"], f"{pre}design.coil_index",
@@ -395,7 +381,7 @@ def _actuator(top: dict, own: dict, path: str, duration: float, dt: float, index
     if b == "wall":
         vals["base_thickness"] = vals["wall_thickness"]
     else:
-        kind, unit, lo, hi = _DESIGN_RULES["base_thickness"]
+        kind, unit, lo, hi, _ = DESIGN_RANGES["base_thickness"]
         vals["base_thickness"] = _quantity(b, f"{pre}design.base_thickness", kind, unit, lo,
                                            hi)
     t0_raw = own.get("initial_temperature", top.get("initial_temperature"))
@@ -447,8 +433,7 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
                          f"...)")
     _known(raw, _TOP_KEYS, "")
     name = raw.get("name")
-    if not isinstance(name, str) or not name or name.startswith(".") or \
-            not all(ch.isalnum() or ch in "-_." for ch in name):
+    if not valid_name(name):
         raise InputError(f"name: letters, digits, '-', '_' and '.' only, got {name!r}")
     supply = _section(raw, {}, "supply", "supply")
     voltage = _quantity(supply["voltage"], "supply.voltage", "voltage", "V", 0.0, 1000.0,
@@ -517,7 +502,7 @@ def _top_temperature(cfg: SimConfig, a: ActuatorSpec) -> float:
     [T_amb, max(T(0), T_ss(E))] (with others on, the supply only sags).
     """
     lm = _muscle_length(a)
-    r = a.nylon.resistance_per_length * lm
+    r = float(muscle_resistance(lm, a.nylon))
     v = cfg.supply_voltage * r / (r + cfg.internal_resistance)
     return max(a.initial_temperature, float(steady_temperature(v, lm, a.nylon)))
 
@@ -648,7 +633,7 @@ def run_simulation(cfg: SimConfig):
                                     np.asarray(ny.stroke_max_table), ny.t_amb, ny.t_max,
                                     ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
         s_top = float(stroke(top, a.coil_index, ny))
-        p_top = P_ATM * (1.0 / (1.0 - s_top) ** 2 - 1.0) * (1.0 + 1e-9)
+        p_top = float(chamber_pressure(s_top)) * (1.0 + 1e-9)
         dpp, plant, slope, dpe, est = _tables(a, max(p_top, 1.0))
         reach.append(plant[-1])
         for key, val in (("lm", lm), ("r", ny.resistance_per_length),

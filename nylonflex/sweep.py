@@ -119,9 +119,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
     from .kernels._compile import _source_digest
 
     def material(m):
-        d = {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(m).items()
-             if k != "sources"}
-        d["sources"] = dict(m.sources)
+        d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}
         return yaml.safe_dump(d, sort_keys=False, width=100)
 
     return {
