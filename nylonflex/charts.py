@@ -167,8 +167,7 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
     """
     radii = [_nearest(ds, "radius", r) for r in radii] if radii else \
         _pick_few(ds, "radius", 5)
-    walls = [_nearest(ds, "wall_thickness", t) for t in walls] if walls else \
-        sorted({_nearest(ds, "wall_thickness", t) for t in (2e-3, 6e-3)})
+    walls = _example_walls(ds, walls)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
     psis = [_nearest(ds, "wrap_angle", w) for w in wrap_angles] if wrap_angles else \
         _pick_few(ds, "wrap_angle", 4)
@@ -229,7 +228,7 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
     return fig
 
 
-def _cut_ins(ds, var, scale_name, sel, coils, psis):
+def _cut_ins(ds, var, sel, coils, psis):
     """Where each wrap angle's strength limit cuts in, per coil index.
 
     Returns ``{psi: [(radius, value) of the last grid design with a full range of motion,
@@ -242,7 +241,7 @@ def _cut_ins(ds, var, scale_name, sel, coils, psis):
         for c in coils:
             cut = ds[[var, "limit"]].sel(coil_index=c, wrap_angle=w, **sel)
             lim = cut["limit"].values
-            value = _disp(scale_name, cut[var].values)
+            value = _disp(var, cut[var].values)
             hits = np.flatnonzero((lim[:-1] == 0) & (lim[1:] == 1))
             if hits.size:
                 points.append((x[hits[0]], value[hits[0]]))
@@ -263,7 +262,7 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
         solid = np.where(stroke_limited.any(axis=0), np.nanmax(
             np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
         ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
-    for j, (w, points) in enumerate(_cut_ins(ds, var, var, sel, coils, psis).items()):
+    for j, (w, points) in enumerate(_cut_ins(ds, var, sel, coils, psis).items()):
         if not points:
             continue
         px, py = np.array(points).T
@@ -335,7 +334,7 @@ def _examples(ax, ds, var, t, length=None, corner="upper left"):
                     bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.6"})
 
 
-def _walls_12bc(ds, walls):
+def _example_walls(ds, walls):
     if walls:
         return [_nearest(ds, "wall_thickness", t) for t in walls]
     # the walls of the paper's two examples: 2 mm and 6 mm
@@ -362,7 +361,7 @@ def fig12b(ds, *, walls=None, length=None):
     -------
     matplotlib.figure.Figure
     """
-    walls = _walls_12bc(ds, walls)
+    walls = _example_walls(ds, walls)
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     coils = [float(c) for c in ds["coil_index"].values]
     psis = [float(w) for w in ds["wrap_angle"].values]
@@ -404,7 +403,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
     -------
     matplotlib.figure.Figure
     """
-    walls = _walls_12bc(ds, walls)
+    walls = _example_walls(ds, walls)
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
     coils = [float(c) for c in ds["coil_index"].values]
