@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from .config import CHARTS as _CHART_NAMES
-from .units import InputError, from_si
-from .variables import VARIABLES, display_label
+from .units import InputError
+from .variables import VARIABLES, display_label, to_display
 
 __all__ = ["CHARTS", "FORMATS", "chart_command", "design_map", "draw_charts", "fig4", "fig6",
            "fig7", "fig12a", "fig12b", "fig12c"]
@@ -62,15 +62,12 @@ def _figure(nrows=1, ncols=1, size=(6.0, 4.2), **kw):
     return fig, axes
 
 
-def _disp(name, values):
-    """SI values of a registered name in its display unit."""
-    return from_si(np.asarray(values, dtype=float), VARIABLES[name].display)
 
 
 def _text(name, si) -> str:
     """``"90 mm"``, ``"8 deg"``, ``"1.7"``: a value of a registered name for a title."""
     v = VARIABLES[name]
-    value = float(_disp(name, si))
+    value = float(to_display(name, si))
     unit = "" if v.display == "1" else (" deg" if v.display == "deg" else f" {v.display}")
     return f"{value:.4g}{unit}"
 
@@ -176,8 +173,8 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
 
     # F_n does not depend on the coil index (MODEL.md s. 4): read it at the first one
     force = ds["nylon_force"].isel(coil_index=0)
-    stroke = _disp("stroke", ds["stroke"].values)
-    f_lim = _disp("nylon_force_limit", ds["nylon_force_limit"].values)
+    stroke = to_display("stroke", ds["stroke"].values)
+    f_lim = to_display("nylon_force_limit", ds["nylon_force_limit"].values)
     s_max = _stroke_max(ds)
     coils = ds["coil_index"].values
 
@@ -189,12 +186,12 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
     for i, a in enumerate(radii):
         for j, t in enumerate(walls):
             y = force.sel(radius=a, wall_thickness=t, wrap_angle=psi).values
-            left.plot(stroke, _disp("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
+            left.plot(stroke, to_display("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
                       ls=styles[j % len(styles)])
     left.set_title(f"radius and wall at {_eq('wrap_angle', psi)}")
     for i, w in enumerate(psis):
         y = force.sel(radius=a_r, wall_thickness=t_r, wrap_angle=w).values
-        right.plot(stroke, _disp("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
+        right.plot(stroke, to_display("nylon_force", y), color=_COLOURS[i % len(_COLOURS)],
                    label=_eq("wrap_angle", w))
     right.set_title(f"wrap angle at {_eq('radius', a_r)}, {_eq('wall_thickness', t_r)}")
 
@@ -234,14 +231,14 @@ def _cut_ins(ds, var, sel, coils, psis):
     Returns ``{psi: [(radius, value) of the last grid design with a full range of motion,
     one per coil index that reaches its limit inside the grid]}`` in display units.
     """
-    x = _disp("radius", ds["radius"].values)
+    x = to_display("radius", ds["radius"].values)
     out = {}
     for w in psis:
         points = []
         for c in coils:
             cut = ds[[var, "limit"]].sel(coil_index=c, wrap_angle=w, **sel)
             lim = cut["limit"].values
-            value = _disp(var, cut[var].values)
+            value = to_display(var, cut[var].values)
             hits = np.flatnonzero((lim[:-1] == 0) & (lim[1:] == 1))
             if hits.size:
                 points.append((x[hits[0]], value[hits[0]]))
@@ -253,10 +250,10 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
     """Fig. 12(b,c) panel: ``var`` against radius per coil index (solid while
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
     designs with a full range of motion."""
-    x = _disp("radius", ds["radius"].values)
+    x = to_display("radius", ds["radius"].values)
     for k, c in enumerate(coils):
         cut = ds[[var, "limit"]].sel(coil_index=c, **sel)
-        value = _disp(var, cut[var].transpose("wrap_angle", "radius").values)
+        value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
         stroke_limited = cut["limit"].transpose("wrap_angle", "radius").values == 0
         # stroke-limited values are the same for every wrap angle (s* = s_max(C))
         solid = np.where(stroke_limited.any(axis=0), np.nanmax(
@@ -308,7 +305,7 @@ def _examples(ax, ds, var, t, length=None, corner="upper left"):
               "coil_index": _nearest(ds, "coil_index", c_ex),
               "wrap_angle": _nearest(ds, "wrap_angle", _WRAP_DEFAULT)}
         point = ds[[var, "tip_force_max", "limit"]].sel(**at)
-        x, y = float(_disp("radius", at["radius"])), float(_disp(var, point[var]))
+        x, y = float(to_display("radius", at["radius"])), float(to_display(var, point[var]))
         if not np.isfinite(y):  # an incomplete cube without this design
             continue
         ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
@@ -410,7 +407,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
     psis = [float(w) for w in ds["wrap_angle"].values]
     fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
                         height_ratios=(3, 2))
-    x = _disp("radius", ds["radius"].values)
+    x = to_display("radius", ds["radius"].values)
     for col, t in enumerate(walls):
         sel = {"wall_thickness": t, "length": length}
         top, bottom = axes[0][col], axes[1][col]
@@ -451,8 +448,8 @@ def fig4(ds):
     """
     fig, axes = _figure(1, 1, size=(5.6, 4.3))
     ax = axes[0][0]
-    stroke = _disp("stroke", ds["stroke"].values)
-    p = _disp("chamber_pressure", ds["chamber_pressure"].values)
+    stroke = to_display("stroke", ds["stroke"].values)
+    p = to_display("chamber_pressure", ds["chamber_pressure"].values)
     ax.plot(stroke, p, color=_COLOURS[0], lw=2.0, label="p(s), Boyle's law")
     s_max = _stroke_max(ds)
     for k, c in enumerate(ds["coil_index"].values):
@@ -475,10 +472,10 @@ def fig4(ds):
 
 
 def _curve_panel(ax, ds, var, name, values, fixed):
-    pressure = _disp("pressure", ds["pressure"].values)
+    pressure = to_display("pressure", ds["pressure"].values)
     for i, v in enumerate(values):
         y = ds[var].sel({name: v, **fixed}).values
-        ax.plot(pressure, _disp(var, y), color=_COLOURS[i % len(_COLOURS)],
+        ax.plot(pressure, to_display(var, y), color=_COLOURS[i % len(_COLOURS)],
                 label=_eq(name, v))
     ax.set_xlim(pressure[0], pressure[-1])
     ax.set_ylim(bottom=0)
@@ -590,18 +587,18 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
                         sharex=True, sharey=True)
     cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi)
-    force = _disp("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
+    force = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
     top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
     levels = _nice_levels(top)
-    x = _disp("radius", ds["radius"].values)
-    y = _disp("wall_thickness", ds["wall_thickness"].values)
+    x = to_display("radius", ds["radius"].values)
+    y = to_display("wall_thickness", ds["wall_thickness"].values)
     mappable = None
     for i, ax in enumerate(axes.flat):
         if i >= len(coils):
             ax.set_visible(False)
             continue
         c = coils[i]
-        f = _disp("tip_force_max", cut["tip_force_max"].sel(coil_index=c)
+        f = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=c)
                   .transpose("wall_thickness", "radius").values)
         lim = cut["limit"].sel(coil_index=c).transpose("wall_thickness", "radius").values
         mappable = ax.contourf(x, y, f, levels=levels, cmap="viridis", extend="max")
@@ -616,7 +613,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
         for a, t_ex, l_ex, c_ex in _EXAMPLES:
             if (abs(_nearest(ds, "length", l_ex) - length) < 1e-12
                     and abs(_nearest(ds, "coil_index", c_ex) - c) < 1e-12):
-                ax.plot(_disp("radius", a), _disp("wall_thickness", t_ex), "*", ms=13,
+                ax.plot(to_display("radius", a), to_display("wall_thickness", t_ex), "*", ms=13,
                         mfc="gold", mec="k", clip_on=False, zorder=6)
         ax.set_title(_eq("coil_index", c))
         ax.grid(False)
@@ -732,17 +729,11 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
 
 def chart_command(args) -> int:
     """``nylonflex chart CUBE``: draw charts of a saved cube (beside it by default)."""
-    import warnings
-
-    from .storage import open_cube
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        ds = open_cube(args.cube)
     import sys
 
-    for w in caught:
-        print(f"nylonflex chart: warning: {w.message}", file=sys.stderr)
+    from .storage import open_cube_for
+
+    ds = open_cube_for("chart", args.cube)
     out = Path(args.out) if args.out else Path(args.cube).parent
     if out.exists() and not out.is_dir():
         raise InputError(f"--out: {out} is a file; give a folder for the images")

@@ -24,12 +24,11 @@ import json
 import math
 import re
 import sys
-import warnings
 
 import numpy as np
 
 from .units import InputError, from_si, parse_quantity
-from .variables import AXES, DESIGN, VARIABLES
+from .variables import AXES, DESIGN, VARIABLES, to_display
 
 __all__ = ["Condition", "QueryResult", "parse_at", "parse_where", "query_cube",
            "query_command"]
@@ -327,9 +326,6 @@ def _sorted(rows, name, descending, limit):
 
 
 # ---------------------------------------------------------------------------- output
-def _display(name, x):
-    v = VARIABLES[name]
-    return from_si(x, v.display)
 
 
 def _unit(name):
@@ -353,7 +349,7 @@ def _cell(name, x) -> str:
     if name == "limit":
         return {0.0: "stroke", 1.0: "strength"}.get(float(x), "boundary") \
             if np.isfinite(x) else "boundary"
-    value = float(_display(name, x))
+    value = float(to_display(name, x))
     if name in AXES:
         return f"{value:.6g}"
     return _sig3(value)
@@ -363,7 +359,7 @@ def _describe_at(res) -> str:
     parts = []
     for name, value in res.at.items():
         unit = _unit(name)
-        parts.append(f"{name}={float(_display(name, value)):g}"
+        parts.append(f"{name}={float(to_display(name, value)):g}"
                      + ("" if unit == "1" else f" {unit}"))
     note = res.point
     if res.interpolated:
@@ -461,13 +457,9 @@ def format_csv(res) -> str:
 
 def query_command(args) -> int:
     """``nylonflex query CUBE``: print the designs asked for (INTERFACE.md)."""
-    from .storage import open_cube
+    from .storage import open_cube_for
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        ds = open_cube(args.cube)
-    for w in caught:  # an incomplete cube: say so in one line and query what is there
-        print(f"nylonflex query: warning: {w.message}", file=sys.stderr)
+    ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
     try:
         res = query_cube(ds, at=parse_at(args.at) if args.at else None,
                          where=parse_where(args.where), sort=args.sort, limit=args.limit)

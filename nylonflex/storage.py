@@ -298,10 +298,19 @@ def open_cube(path, *, quiet: bool = False):
     return ds
 
 
+def open_cube_for(command: str, path):
+    """:func:`open_cube` for a CLI command: an incomplete cube's warning as one stderr line."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = open_cube(path)
+    for w in caught:
+        print(f"nylonflex {command}: warning: {w.message}", file=sys.stderr)
+    return ds
+
+
 def info_command(args) -> int:
     """``nylonflex info CUBE``: dims, ranges, provenance and completeness."""
-    from .variables import VARIABLES
-    from .units import from_si
+    from .variables import VARIABLES, to_display
 
     path = Path(args.cube)
     with warnings.catch_warnings():
@@ -320,7 +329,7 @@ def info_command(args) -> int:
     print("axes", file=out)
     for name in (*AXES, "stroke", "pressure"):
         v = VARIABLES[name]
-        vals = from_si(ds[name].values, v.display)
+        vals = to_display(name, ds[name].values)
         unit = "" if v.display == "1" else f" {v.display}"
         print(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})", file=out)
     print("variables", file=out)

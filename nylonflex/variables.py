@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "VARIABLES", "Variable", "display_label"]
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "VARIABLES", "Variable", "display_label",
+           "to_display"]
 
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
 
@@ -119,6 +120,13 @@ CURVES = {v.name: v for v in [
 ]}
 
 VARIABLES = {**COORDS, **DESIGN, **CURVES}
+
+
+def to_display(name: str, si):
+    """SI values of a registered name in its display unit (mm, deg, kPa, ...)."""
+    from .units import from_si
+
+    return from_si(np.asarray(si, dtype=float), VARIABLES[name].display)
 
 
 def display_label(name: str) -> str:
