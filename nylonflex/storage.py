@@ -51,6 +51,13 @@ def _chunks(dims, sizes, radius_chunk):
     return tuple(int(x) for x in shape)
 
 
+def slab_done_attrs() -> dict:
+    """Attributes of the ``slab_done`` mask, in-memory and on-disk cubes alike."""
+    return {"units": "1", "long_name": "radius computed",
+            "description": "1 where this radius's slab is in the cube",
+            "flag_values": np.array([0, 1], np.int8), "flag_meanings": "missing done"}
+
+
 class CubeFile:
     """Writes one cube file slab by slab (h5netcdf; gzip level 1 with shuffle)."""
 
@@ -71,10 +78,7 @@ class CubeFile:
                                        **_COMPRESSION)
             v.attrs.update(var.attrs())
         done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
-        done.attrs.update({"units": "1", "long_name": "radius computed",
-                           "description": "1 where this radius's slab is in the cube",
-                           "flag_values": np.array([0, 1], np.int8),
-                           "flag_meanings": "missing done"})
+        done.attrs.update(slab_done_attrs())
         self.f.attrs.update(attrs)
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 

@@ -25,7 +25,7 @@ from .physics.chamber import P_ATM, chamber_pressure
 from .physics.limits import DESIGN_VARIABLES, STROKE_RTOL
 from .physics.nylon import nylon_force_limit, stroke_max
 from .physics.wrap import muscle_width
-from .storage import CubeFile, Journal, cube_attrs, exclusive
+from .storage import CubeFile, Journal, cube_attrs, exclusive, slab_done_attrs
 from .units import InputError
 from .variables import CURVES, DESIGN
 
@@ -231,8 +231,7 @@ def _sweep_in_memory(cfg, workers, quiet):
         {name: (v.dims, data[name], v.attrs()) for name, v in {**DESIGN, **CURVES}.items()},
         coords={name: (name, values, COORDS[name].attrs()) for name, values in coords.items()},
         attrs={**provenance(cfg), "complete": "true"})
-    ds["slab_done"] = ("radius", np.ones(sizes["radius"], np.int8),
-                       {"units": "1", "long_name": "radius computed"})
+    ds["slab_done"] = ("radius", np.ones(sizes["radius"], np.int8), slab_done_attrs())
     return ds
 
 
