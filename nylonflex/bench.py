@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import resource
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -84,13 +83,16 @@ def _solve_count(ds) -> int:
     return na * nt * (ds.sizes["pressure"] + nc) + strength
 
 
-def run_bench(quick: bool = False, out=sys.stdout) -> dict:
-    """Time compile, kernels, the end-to-end sweep and the reference; print and return."""
+def run_bench(quick: bool = False, log=None) -> dict:
+    """Time compile, kernels, the end-to-end sweep and the reference.
+
+    ``log`` receives each line of the report as it is measured; the figures are returned.
+    """
     from .sweep import compute_slab, plan_slabs, run_sweep
 
     sizes = QUICK if quick else FULL
     cfg = bench_config(sizes)
-    say = lambda msg: print(msg, file=out, flush=True)  # noqa: E731
+    say = log or (lambda msg: None)
     say(f"nylonflex bench{' --quick' if quick else ''}: {cfg.n_designs:,} designs "
         f"({' x '.join(str(n) for n in cfg.shape)}), curves {sizes['stroke']} strokes x "
         f"{sizes['pressure']} pressures")
@@ -155,9 +157,3 @@ def run_bench(quick: bool = False, out=sys.stdout) -> dict:
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")
     return result
-
-
-def bench_command(args) -> int:
-    """``nylonflex bench [--quick]``."""
-    run_bench(quick=args.quick)
-    return 0

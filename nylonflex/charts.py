@@ -20,7 +20,7 @@ from .config import CHARTS as _CHART_NAMES
 from .units import InputError
 from .variables import VARIABLES, display_label, to_display
 
-__all__ = ["CHARTS", "FORMATS", "chart_command", "design_map", "draw_charts", "fig4", "fig6",
+__all__ = ["CHARTS", "FORMATS", "design_map", "draw_charts", "fig4", "fig6",
            "fig7", "fig12a", "fig12b", "fig12c"]
 
 #: Image formats a chart can be written in.
@@ -725,22 +725,3 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
             plt.close(fig)
         written.append(path)
     return written
-
-
-def chart_command(args) -> int:
-    """``nylonflex chart CUBE``: draw charts of a saved cube (beside it by default)."""
-    import sys
-
-    from .storage import open_cube_for
-
-    ds = open_cube_for("chart", args.cube)
-    out = Path(args.out) if args.out else Path(args.cube).parent
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out: {out} is a file; give a folder for the images")
-    try:
-        skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
-        for path in draw_charts(ds, args.figure, out, args.format, on_skip=skip):
-            print(path)
-    finally:
-        ds.close()
-    return 0

@@ -23,15 +23,14 @@ import io
 import json
 import math
 import re
-import sys
 
 import numpy as np
 
 from .units import InputError, from_si, parse_quantity
 from .variables import AXES, DESIGN, VARIABLES, to_display
 
-__all__ = ["Condition", "QueryResult", "parse_at", "parse_where", "query_cube",
-           "query_command"]
+__all__ = ["Condition", "QueryResult", "format_csv", "format_json", "format_table",
+           "parse_at", "parse_where", "query_cube"]
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
@@ -453,21 +452,3 @@ def format_csv(res) -> str:
                 row.append("" if not np.isfinite(x) else repr(float(x)))
         w.writerow(row)
     return out.getvalue()
-
-
-def query_command(args) -> int:
-    """``nylonflex query CUBE``: print the designs asked for (INTERFACE.md)."""
-    from .storage import open_cube_for
-
-    ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
-    try:
-        res = query_cube(ds, at=parse_at(args.at) if args.at else None,
-                         where=parse_where(args.where), sort=args.sort, limit=args.limit)
-        if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
-            raise InputError("--at: this design is not in the cube yet (an incomplete "
-                             "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
-    finally:
-        ds.close()
-    fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
-    sys.stdout.write(fmt(res))
-    return 0

@@ -51,7 +51,7 @@ __all__ = [
     "parse_sim_config",
     "reference_signal",
     "run_simulation",
-    "simulate_command",
+    "summary",
     "step_metrics",
     "write_simulation",
 ]
@@ -780,26 +780,3 @@ def summary(cfg: SimConfig, ds) -> list[str]:
     if cfg.gripper:
         lines.append(f"  supply current peak {1e3 * ds.attrs['supply_current_max']:.0f} mA")
     return lines
-
-
-def simulate_command(args) -> int:
-    """``nylonflex simulate CONFIG [--out PATH] [--no-charts]``: run, write, chart, summarise.
-
-    Returns
-    -------
-    int
-        0 when done (bad input raises :class:`InputError`, which the CLI turns into exit 2).
-    """
-    cfg = load_sim_config(args.config)
-    out = Path(args.out) if args.out else Path("sweeps") / cfg.name / "sim.h5"
-    ds = run_simulation(cfg)
-    write_simulation(ds, out)
-    written = [str(out)]
-    if not getattr(args, "no_charts", False):
-        from .charts_sim import draw_simulation_charts
-
-        written += [str(p) for p in draw_simulation_charts(ds, out.parent, stem=out.stem)]
-    for line in summary(cfg, ds):
-        print(line)
-    print(f"  wrote {', '.join(written)}")
-    return 0

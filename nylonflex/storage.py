@@ -17,7 +17,6 @@ import itertools
 import json
 import os
 import shutil
-import sys
 import warnings
 import zlib
 from concurrent.futures import ThreadPoolExecutor
@@ -28,7 +27,7 @@ import numpy as np
 from .units import InputError
 from .variables import AXES, COORDS, CURVES, DESIGN
 
-__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "CubeFile", "Journal", "info_command",
+__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "CubeFile", "Journal", "cube_summary",
            "open_cube"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
@@ -302,49 +301,41 @@ def open_cube(path, *, quiet: bool = False):
     return ds
 
 
-def open_cube_for(command: str, path):
-    """:func:`open_cube` for a CLI command: an incomplete cube's warning as one stderr line."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        ds = open_cube(path)
-    for w in caught:
-        print(f"nylonflex {command}: warning: {w.message}", file=sys.stderr)
-    return ds
-
-
-def info_command(args) -> int:
-    """``nylonflex info CUBE``: dims, ranges, provenance and completeness."""
+def cube_summary(path) -> list[str]:
+    """Lines that describe a cube: dims, ranges, variables, provenance, completeness."""
     from .variables import VARIABLES, to_display
 
-    path = Path(args.cube)
+    path = Path(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = open_cube(path, quiet=True)
     a = ds.attrs
-    out = sys.stdout
+    out = []
     complete = a.get("complete") == "true"
     done = int(ds["slab_done"].sum())
-    print(f"cube      {path}", file=out)
-    print(f"name      {a.get('name')}   config sha256 {a.get('config_sha256', '')[:16]}", file=out)
-    print(f"status    {'complete' if complete else 'INCOMPLETE'} "
-          f"({done}/{ds.sizes['radius']} radii)", file=out)
+    out.append(f"cube      {path}")
+    out.append(f"name      {a.get('name')}   config sha256 {a.get('config_sha256', '')[:16]}")
+    out.append(f"status    {'complete' if complete else 'INCOMPLETE'} "
+               f"({done}/{ds.sizes['radius']} radii)")
     n = int(np.prod([ds.sizes[d] for d in AXES]))
-    print(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES), file=out)
-    print("axes", file=out)
+    out.append(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES))
+    out.append("axes")
     for name in (*AXES, "stroke", "pressure"):
         v = VARIABLES[name]
         vals = to_display(name, ds[name].values)
         unit = "" if v.display == "1" else f" {v.display}"
-        print(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})", file=out)
-    print("variables", file=out)
-    for name in (*DESIGN, *CURVES):
-        print(f"  {name:<18} ({', '.join(ds[name].dims)}) [{ds[name].attrs.get('units')}] "
-              f"{ds[name].attrs.get('long_name')}", file=out)
-    print("provenance", file=out)
+        out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})")
+    out.append("variables")
+    for name in ds.data_vars:
+        if name == "slab_done":
+            continue
+        out.append(f"  {name:<18} ({', '.join(ds[name].dims)}) [{ds[name].attrs.get('units')}] "
+                   f"{ds[name].attrs.get('long_name')}")
+    out.append("provenance")
     for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
                 "quadrature", "created", "run_seconds", "designs_per_second", "workers",
                 "scheduler"):
         if key in a:
-            print(f"  {key:<18} {a[key]}", file=out)
+            out.append(f"  {key:<18} {a[key]}")
     ds.close()
-    return 0
+    return out

@@ -29,7 +29,7 @@ from .storage import CubeFile, Journal, cube_attrs, exclusive, slab_done_attrs
 from .units import InputError
 from .variables import CURVES, DESIGN
 
-__all__ = ["compute_slab", "default_output", "plan_slabs", "run_sweep", "sweep_command"]
+__all__ = ["compute_slab", "default_output", "plan_slabs", "run_sweep"]
 
 _FLOAT_DESIGN = [n for n in DESIGN_VARIABLES if n != "limit"]
 
@@ -403,27 +403,3 @@ def _is_main_thread():
     import threading
 
     return threading.current_thread() is threading.main_thread()
-
-
-def sweep_command(args) -> int:
-    """``nylonflex sweep CONFIG``: validate, sweep, write the cube and its charts."""
-    cfg = load_config(args.config, args.set)
-    out = Path(args.out) if args.out else default_output(cfg)
-    if out.exists() and out.is_dir():
-        raise InputError(f"--out: {out} is a folder; give a file path such as {out}/cube.h5")
-
-    def log(msg):
-        if not args.quiet:
-            print(msg, file=sys.stderr)
-
-    ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
-                   scheduler=args.scheduler, quiet=args.quiet, log=log)
-    print(f"{out}  {cfg.n_designs:,} designs  complete")
-    if cfg.charts and not args.no_charts:
-        from .charts import draw_charts
-
-        skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
-        for path in draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip):
-            print(path)
-    ds.close()
-    return 0

@@ -1,14 +1,12 @@
 """``nylonflex bench --quick`` as a smoke run: it runs and reports; no timing is asserted."""
 
-import io
-
 from nylonflex.bench import run_bench
 
 
 def test_quick_bench_reports_every_figure():
-    out = io.StringIO()
-    result = run_bench(quick=True, out=out)
-    text = out.getvalue()
+    lines = []
+    result = run_bench(quick=True, log=lines.append)
+    text = "\n".join(lines)
     for words in ("designs/s", "angle solves/s", "speed-up per design", "peak memory",
                   "closed loop"):
         assert words in text

@@ -1,0 +1,106 @@
+"""The ``nylonflex`` command line: argument parsing and printing, and nothing else.
+
+Each command is a module of this package with ``HELP`` (one line), ``add_arguments(parser)``
+and ``run(args) -> int``; it calls library functions that return values and prints them. No
+science lives here. Exit status: 0 done, 2 bad input (one line naming the field), 1 other
+failure. A traceback is printed only with ``--debug``.
+
+Command modules import nothing heavy at module level, so ``nylonflex --help`` stays light.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .. import __version__
+
+EXIT_OK, EXIT_FAILURE, EXIT_INPUT = 0, 1, 2
+
+#: The commands, in the order ``--help`` lists them: name -> module of this package.
+COMMANDS = {
+    "sweep": "sweep",
+    "chart": "chart",
+    "query": "query",
+    "info": "info",
+    "simulate": "simulate",
+    "bench": "bench",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse's own usage errors are bad input too: one line, 2
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _module(name):
+    return importlib.import_module(f".{COMMANDS[name]}", __name__)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of every ``nylonflex`` command (INTERFACE.md)."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    p = _Parser(prog="nylonflex", parents=[common],
+                description="Design-space sweeps of nylon-muscle soft bending actuators.")
+    p.add_argument("--version", action="version", version=f"nylonflex {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name in COMMANDS:
+        mod = _module(name)
+        sp = sub.add_parser(name, parents=[common], help=mod.HELP,
+                            description=getattr(mod, "DESCRIPTION", mod.HELP),
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+        mod.add_arguments(sp)
+    return p
+
+
+def _join_negative_values(argv):
+    """``--sort -tip_force_max`` means descending; argparse would read ``-tip...`` as a flag."""
+    out = list(argv)
+    for i, item in enumerate(out[:-1]):
+        if item == "--sort" and out[i + 1].startswith("-") and out[i + 1][1:2].isalpha():
+            out[i:i + 2] = [f"--sort={out[i + 1]}"]
+            return _join_negative_values(out)
+    return out
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``nylonflex`` console script."""
+    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(_join_negative_values(argv))
+    if args.command is None:
+        parser.print_help()
+        return EXIT_OK
+    try:
+        return _module(args.command).run(args) or EXIT_OK
+    except KeyboardInterrupt:
+        print("nylonflex: interrupted", file=sys.stderr)
+        return 130
+    except ValueError as exc:  # InputError and the physics' range checks: bad input
+        if args.debug:
+            raise
+        print(f"nylonflex {args.command}: error: {one_line(exc)}", file=sys.stderr)
+        return EXIT_INPUT
+    except Exception as exc:  # noqa: BLE001 - one line for the user, --debug for the rest
+        if args.debug:
+            raise
+        print(f"nylonflex {args.command}: failed: {type(exc).__name__}: {one_line(exc)}",
+              file=sys.stderr)
+        return EXIT_FAILURE
+
+
+def one_line(exc) -> str:
+    """An exception's message on one line (at most 500 characters)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 500 else text[:497] + "..."
+
+
+def warn(command: str, message: str):
+    """One warning line on stderr, ``nylonflex COMMAND: warning: ...``."""
+    print(f"nylonflex {command}: warning: {message}", file=sys.stderr)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,48 @@
+"""``nylonflex sweep CONFIG``: validate, sweep, write the cube and its charts."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+HELP = "evaluate a design space into a cube"
+
+
+def add_arguments(s):
+    s.add_argument("config", help="YAML config (see configs/)")
+    s.add_argument("--out", help="cube path (default sweeps/<name>/cube.h5)")
+    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a config key, e.g. grid.radius.num=81 (repeatable)")
+    s.add_argument("--resume", action="store_true", help="finish an interrupted run")
+    s.add_argument("--workers", type=int, help="local threads (default: all cores)")
+    s.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on a Dask distributed cluster, e.g. tcp://host:8786")
+    s.add_argument("--no-charts", action="store_true", help="skip the config's charts")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args) -> int:
+    from ..config import load_config
+    from ..sweep import default_output, run_sweep
+    from ..units import InputError
+
+    cfg = load_config(args.config, args.set)
+    out = Path(args.out) if args.out else default_output(cfg)
+    if out.exists() and out.is_dir():
+        raise InputError(f"--out: {out} is a folder; give a file path such as {out}/cube.h5")
+
+    def log(msg):
+        if not args.quiet:
+            print(msg, file=sys.stderr)
+
+    ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
+                   scheduler=args.scheduler, quiet=args.quiet, log=log)
+    print(f"{out}  {cfg.n_designs:,} designs  complete")
+    if cfg.charts and not args.no_charts:
+        from ..charts import draw_charts
+
+        skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
+        for path in draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip):
+            print(path)
+    ds.close()
+    return 0
