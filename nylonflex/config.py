@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import copy
 import hashlib
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Union
@@ -21,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
 
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .units import InputError, from_si, parse_quantity, to_si
+from .variables import INPUTS, VARIABLES
 
 __all__ = ["CHARTS", "SweepConfig", "apply_overrides", "load_config", "parse_config"]
 
@@ -29,17 +29,14 @@ CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map")
 
 Number = Union[float, str]
 
-#: quantity -> (kind, default unit, accepted SI range lo, hi, display unit for messages);
-#: the design's plausible range (MODEL.md section 1), for sweeps and simulations alike
+#: quantity -> (kind, default unit, accepted SI range lo, hi, display unit for messages),
+#: read off the registry (nylonflex.variables), for sweeps and simulations alike; the coil
+#: index's range is the muscle table's
 DESIGN_RANGES = {
-    "radius": ("length", "mm", 0.5e-3, 0.2, "mm"),
-    "wall_thickness": ("length", "mm", 0.1e-3, 0.05, "mm"),
-    "length": ("length", "mm", 1e-3, 2.0, "mm"),
-    "coil_index": ("dimensionless", "1", None, None, "1"),  # the nylon table decides
-    "wrap_angle": ("angle", "deg", math.radians(0.1), math.radians(80.0), "deg"),
-    "stroke": ("dimensionless", "1", 0.0, 0.5, "1"),
-    "pressure": ("pressure", "kPa", 0.0, 100e3, "kPa"),
-    "base_thickness": ("length", "mm", 0.1e-3, 0.05, "mm"),
+    name: (v.kind, v.display, v.lo, v.hi, v.display)
+    for name, v in {**VARIABLES, **INPUTS}.items()
+    if name in ("radius", "wall_thickness", "length", "coil_index", "wrap_angle", "stroke",
+                "pressure", "base_thickness")
 }
 _MAX_POINTS = 100_000
 

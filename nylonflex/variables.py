@@ -1,8 +1,14 @@
-"""One registry of every cube variable and coordinate: name, dims, units, long_name.
+"""One registry of every quantity: name, dims, units, long_name, accepted range, display unit.
 
-The sweep writes from it, storage checks against it, charts take their labels from it and
-the CLI converts units with it (after sgkit's ``variables.py``). ``display`` is the unit a
-designer reads on charts and types on the command line; the cube stays SI.
+Everything that needs to know about a quantity reads it here (after sgkit's
+``variables.py``): the physics' input checks and the pointwise evaluator (accepted ranges),
+config validation (ranges and the unit a bare number means), the engine (the order of the
+design variables, written once: :data:`DESIGN`), cube attributes, chart labels and query
+units. ``display`` is the unit a designer reads on charts and types in configs and on the
+command line; the code and the cube stay SI.
+
+This module is the bottom layer with :mod:`nylonflex.units` and :mod:`nylonflex.materials`:
+it imports nothing else of nylonflex at module level.
 """
 
 from __future__ import annotations
@@ -11,9 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "VARIABLES", "Variable", "display_label",
-           "to_display"]
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "VARIABLES", "Variable",
+           "display_label", "range_text", "slab_done_attrs", "to_display"]
 
+#: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
 
 
@@ -39,6 +46,11 @@ class Variable:
         Kind of quantity, for unit parsing (see :mod:`nylonflex.units`).
     dtype : str
         Stored dtype.
+    lo, hi : float or None
+        Accepted range of an input in SI ``units`` (None: unbounded on that side, or set
+        elsewhere, like the coil index by the muscle's table).
+    lo_open, hi_open : bool
+        The bound itself is excluded.
     """
 
     name: str
@@ -49,37 +61,60 @@ class Variable:
     display: str
     kind: str
     dtype: str = "float64"
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
 
     def attrs(self) -> dict:
-        """The attributes written to the cube."""
+        """The attributes written to the cube (CF flags for flag variables)."""
         out = {"units": self.units, "long_name": self.long_name,
                "description": self.description}
-        if self.name == "limit":
-            out["flag_values"] = np.array([0, 1], dtype=np.int8)
-            out["flag_meanings"] = "stroke_limited strength_limited"
+        if self.name in _FLAGS:
+            values, meanings = _FLAGS[self.name]
+            out["flag_values"] = np.array(values, dtype=np.int8)
+            out["flag_meanings"] = meanings
         return out
 
 
-def _v(name, dims, units, long_name, description, display, kind, dtype="float64"):
-    return Variable(name, tuple(dims), units, long_name, description, display, kind, dtype)
+#: CF flag values and meanings of the flag variables.
+_FLAGS = {"limit": ((0, 1), "stroke_limited strength_limited"),
+          "slab_done": ((0, 1), "missing done")}
+
+
+def _v(name, dims, units, long_name, description, display, kind, dtype="float64", **rng):
+    return Variable(name, tuple(dims), units, long_name, description, display, kind, dtype,
+                    **rng)
+
+
+_DEG = np.pi / 180.0
 
 
 COORDS = {v.name: v for v in [
     _v("radius", ["radius"], "m", "chamber radius", "inner radius a of the half-cylindrical "
-       "chamber (MODEL.md s. 1)", "mm", "length"),
+       "chamber (MODEL.md s. 1)", "mm", "length", lo=0.5e-3, hi=0.2),
     _v("wall_thickness", ["wall_thickness"], "m", "wall thickness",
-       "thickness t of the half-cylindrical silicone wall (MODEL.md s. 1)", "mm", "length"),
+       "thickness t of the half-cylindrical silicone wall (MODEL.md s. 1)", "mm", "length",
+       lo=0.1e-3, hi=0.05),
     _v("length", ["length"], "m", "actuator length", "actuator length L (MODEL.md s. 1)",
-       "mm", "length"),
+       "mm", "length", lo=1e-3, hi=2.0),
     _v("coil_index", ["coil_index"], "1", "coil index",
        "spring index C = D/d of the coiled muscle (MODEL.md s. 2)", "1", "dimensionless"),
     _v("wrap_angle", ["wrap_angle"], "rad", "wrap angle",
-       "helix angle psi of the wrap from the hoop direction (MODEL.md s. 4)", "deg", "angle"),
+       "helix angle psi of the wrap from the hoop direction (MODEL.md s. 4)", "deg", "angle",
+       lo=0.1 * _DEG, hi=80.0 * _DEG),
     _v("stroke", ["stroke"], "1", "muscle stroke",
        "muscle contraction s, a fraction of its ambient length (MODEL.md s. 2)", "1",
-       "dimensionless"),
+       "dimensionless", lo=0.0, hi=0.5),
     _v("pressure", ["pressure"], "Pa", "chamber pressure", "gauge pressure p of the chamber "
-       "(MODEL.md s. 3)", "kPa", "pressure"),
+       "(MODEL.md s. 3)", "kPa", "pressure", lo=0.0, hi=100e3),
+]}
+
+#: Inputs that are neither axes nor stored variables.
+INPUTS = {v.name: v for v in [
+    _v("base_thickness", [], "m", "base thickness", "thickness b of the bottom layer below "
+       "the chamber floor; b = t unless given (MODEL.md s. 1)", "mm", "length",
+       lo=0.1e-3, hi=0.05),
 ]}
 
 DESIGN = {v.name: v for v in [
@@ -111,6 +146,9 @@ CURVES = {v.name: v for v in [
        "nylon force", "tension F_n(s) in the wrap (MODEL.md s. 4)", "N", "force"),
     _v("nylon_force_limit", ["coil_index"], "N", "nylon force limit",
        "breaking force F_lim(C) = sigma_u(C) A_f (MODEL.md s. 2)", "N", "force"),
+    _v("stroke_max", ["coil_index"], "1", "maximum stroke",
+       "free stroke s_max(C) of the muscle at its highest safe temperature (MODEL.md s. 2)",
+       "1", "dimensionless"),
     _v("chamber_pressure", ["stroke"], "Pa", "chamber pressure",
        "gauge pressure p(s), Boyle (MODEL.md s. 3)", "kPa", "pressure"),
     _v("bend_angle", ["radius", "wall_thickness", "length", "pressure"], "rad", "bend angle",
@@ -119,7 +157,33 @@ CURVES = {v.name: v for v in [
        "blocked tip force M_P(p)/L (MODEL.md s. 7)", "N", "force"),
 ]}
 
+#: The mask of the radii a sweep has stored (1) or not yet (0).
+SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
+               "1 where this radius's slab is in the cube", "1", "dimensionless", "int8")
+
 VARIABLES = {**COORDS, **DESIGN, **CURVES}
+
+
+def slab_done_attrs() -> dict:
+    """Attributes of the ``slab_done`` mask, in-memory and on-disk cubes alike."""
+    return SLAB_DONE.attrs()
+
+
+def range_text(name: str, lo=None, hi=None, unit: str | None = None) -> str:
+    """``"in [0.5, 200] mm"``: the accepted range of a registered input, in ``unit``.
+
+    ``lo``/``hi`` [SI] replace the registry's bounds (the coil index's come from the
+    muscle's table); ``unit`` defaults to the display unit.
+    """
+    from .units import from_si
+
+    v = {**VARIABLES, **INPUTS}[name]
+    lo = v.lo if lo is None else lo
+    hi = v.hi if hi is None else hi
+    unit = v.display if unit is None else unit
+    shown = "" if unit == "1" else f" {unit}"
+    return (f"in {'(' if v.lo_open else '['}{from_si(lo, unit):g}, {from_si(hi, unit):g}"
+            f"{')' if v.hi_open else ']'}{shown}")
 
 
 def to_display(name: str, si):

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ..materials import ZERO_CELSIUS  # noqa: F401  (one definition)
+from ..variables import INPUTS, VARIABLES, range_text
 
 
 def formula(func):
@@ -33,7 +34,7 @@ def check(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False, unit="
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number{_unit(unit)}, got {value!r}") from None
+        raise ValueError(f"{name}: must be a number{_unit(unit)}, got {_short(value)}") from None
     bad = ~np.isfinite(arr)
     if lo is not None:
         bad |= (arr <= lo) if lo_open else (arr < lo)
@@ -46,19 +47,62 @@ def check(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False, unit="
     return arr
 
 
+#: Factors of the unit slips a design input is checked for: a value typed in mm (or deg)
+#: where the API takes metres (or radians).
+_SLIPS = {"length": (1e-3, "mm", "metres"), "angle": (math.pi / 180.0, "deg", "radians")}
+
+
+def check_input(name, value, lo=None, hi=None):
+    """``value`` as a float array after checking it against the registry's accepted range.
+
+    The range of a design input is written once, in :mod:`nylonflex.variables`; ``lo`` and
+    ``hi`` [SI] replace it where another source sets it (the coil index's table). A value
+    that would be in range in another unit (mm typed for metres, deg for radians) is named as
+    the likely slip.
+
+    Raises
+    ------
+    ValueError
+        One line: the parameter, its accepted range in SI, the bad value, the likely slip.
+    """
+    v = {**VARIABLES, **INPUTS}[name]
+    lo = v.lo if lo is None else lo
+    hi = v.hi if hi is None else hi
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: must be a number [{v.units}], got "
+                         f"{_short(value)}") from None
+    bad = ~np.isfinite(arr)
+    bad |= (arr <= lo) if v.lo_open else (arr < lo)
+    bad |= (arr >= hi) if v.hi_open else (arr > hi)
+    if np.any(bad):
+        got = float(arr[bad].flat[0])
+        msg = f"{name}: must be {range_text(name, lo, hi, v.units)}, got {got:g} {v.units}"
+        slip = _SLIPS.get(v.kind)
+        if slip and np.isfinite(got) and lo <= got * slip[0] <= hi:
+            msg += (f"; {got:g} looks like {slip[1]}: the Python API takes {slip[2]} "
+                    f"({got * slip[0]:g} {v.units})")
+        raise ValueError(msg.replace(" 1,", ",").removesuffix(" 1"))
+    return arr
+
+
+def _short(value, n=40):
+    text = repr(value)
+    return text if len(text) <= n else text[:n] + "..."
+
+
 def check_section(radius, wall_thickness, base_thickness=None):
     """Checked a, t, b [m] of the cross-section; b = t when None (MODEL.md s. 1 [choice])."""
-    a = check("radius", radius, 0.0, lo_open=True, unit="m")
-    t = check("wall_thickness", wall_thickness, 0.0, lo_open=True, unit="m")
-    b = t if base_thickness is None else check("base_thickness", base_thickness, 0.0,
-                                               lo_open=True, unit="m")
+    a = check_input("radius", radius)
+    t = check_input("wall_thickness", wall_thickness)
+    b = t if base_thickness is None else check_input("base_thickness", base_thickness)
     return a, t, b
 
 
 def check_wrap_angle(wrap_angle):
-    """Checked helix angle psi [rad], in (0, pi/2)."""
-    return check("wrap_angle", wrap_angle, 0.0, math.pi / 2, lo_open=True, hi_open=True,
-                 unit="rad")
+    """Checked helix angle psi [rad], in the registry's range."""
+    return check_input("wrap_angle", wrap_angle)
 
 
 def _unit(unit):

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
-from ._formula import check, check_section, check_wrap_angle, formula, scalar_or_array
+from ._formula import check_input, check_section, check_wrap_angle, formula, scalar_or_array
 from .bending import NEWTON_RTOL, _curvature, _pressure_moment, quadrature_nodes
 from .chamber import P_ATM, _gauge_pressure
 from .wrap import _nylon_force_and_slope, _pitch
@@ -70,7 +70,7 @@ def _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu, alpha, 
 
 @formula
 def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                  kappa_full, mu, alpha, x_base, w_base, x_phi, w_phi, p_atm):
+                  kappa_full, mu, alpha, x_base, w_base, phi_trig, w_phi, p_atm):
     """The length-free part of the design limits.
 
     ``kappa_full`` is the curvature at p(s_max) (<= 0: computed here). Returns
@@ -79,7 +79,7 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     if kappa_full <= 0.0:
         kappa_full = _curvature(
             _pressure_moment(_gauge_pressure(s_max, p_atm), radius, base_thickness),
-            radius, wall_thickness, base_thickness, mu, alpha, x_base, w_base, x_phi, w_phi,
+            radius, wall_thickness, base_thickness, mu, alpha, x_base, w_base, phi_trig, w_phi,
             0.0, NEWTON_RTOL)
     s, limit, force = _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu,
                                     alpha, p_atm, STROKE_RTOL)
@@ -90,7 +90,7 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     else:
         # p* < p(s_max): start Newton from the full-stroke curvature scaled by the moment
         kappa = _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha, x_base,
-                           w_base, x_phi, w_phi,
+                           w_base, phi_trig, w_phi,
                            kappa_full * p / _gauge_pressure(s_max, p_atm), NEWTON_RTOL)
     return s, limit, p, moment, kappa, force, kappa_full
 
@@ -106,8 +106,8 @@ def _design_values(s, limit, p, moment, kappa, force, kappa_full, force_limit, l
 def _inputs(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness, ny):
     lo, hi = ny.coil_index_range
     a, t, b = check_section(radius, wall_thickness, base_thickness)
-    L = check("length", length, 0.0, lo_open=True, unit="m")
-    c = check("coil_index", coil_index, lo, hi, unit="-")
+    L = check_input("length", length)
+    c = check_input("coil_index", coil_index, lo, hi)
     return a, t, L, c, check_wrap_angle(wrap_angle), b
 
 

@@ -1,0 +1,239 @@
+"""Sweeps on a Dask distributed cluster: slabs are tasks, the client is the single writer.
+
+:func:`nylonflex.run_sweep` with ``scheduler=`` hands the slabs still to do to a
+:class:`DaskExecutor`, the executor of the one slab loop (:mod:`.slabs`). Each task computes
+one slab of radii with the *serial* compilation of the design kernel
+(:func:`nylonflex.engine.grid.compute_slab` with ``parallel=False``): the
+cluster's worker processes and threads are the only level of parallelism, so Numba's
+threaded loops never run inside Dask's threads and never oversubscribe a worker's cores.
+Results come back to the client as they finish; the client journals and writes each one, as
+a local run does, so resume and the cube's format are the same.
+
+Memory stays bounded by the slab size whatever the grid: at most :data:`IN_FLIGHT_PER_THREAD`
+slabs per worker thread are submitted at a time, a finished slab stays on its worker until
+the client fetches it, and the client holds three slabs at most: the one being written,
+the one it hands over next, and one being fetched meanwhile.
+
+Both paths run the same compiled loop body on the same slab boundaries, and every element
+of a slab is computed by a deterministic sequence of floating-point operations that depends
+on nothing but its own indices, so a cluster's cube is identical, bit for bit, to a local
+one made with the same nylonflex, Numba and NumPy versions. Workers are checked for those
+versions before any work (and each task checks again, for workers that join later).
+"""
+
+from __future__ import annotations
+
+import re
+import uuid
+from collections.abc import Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
+
+from ..units import InputError
+
+__all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "WORKER_WAIT", "DaskRunner"]
+
+#: Seconds to wait for the scheduler to answer before refusing the address.
+CONNECT_TIMEOUT = 5.0
+#: Seconds to wait for the first worker to join a scheduler that has none.
+WORKER_WAIT = 60.0
+#: Slabs submitted per worker thread at a time: one computing, one queued behind it.
+IN_FLIGHT_PER_THREAD = 2
+
+_ADDRESS = re.compile(r"^(?:(tcp|tls|ws|wss)://)?(\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.-]+):"
+                      r"([0-9]{1,5})$")
+
+
+def _normalise_address(address) -> str:
+    """``tcp://HOST:PORT`` from what the user gave; refuse anything else in one line."""
+    if hasattr(address, "scheduler_address"):  # a LocalCluster, SLURMCluster, ...
+        address = address.scheduler_address
+    text = str(address).strip()
+    m = _ADDRESS.match(text)
+    if not m or not 0 < int(m.group(3)) < 65536:
+        raise InputError(f"--scheduler: expected a Dask scheduler address such as "
+                         f"tcp://HOST:8786, got {text!r}")
+    return f"{m.group(1) or 'tcp'}://{m.group(2)}:{int(m.group(3))}"
+
+
+def _versions() -> dict:
+    """What decides a slab's bits: nylonflex's version and model sources, Numba, NumPy.
+
+    ``model`` is the digest of the physics and kernel sources, so an edited formula on one
+    side is caught even where the version number did not change.
+    """
+    import numba
+    import numpy
+
+    from .. import __version__
+    from ..kernels._compile import source_digest
+
+    return {"nylonflex": __version__, "model": source_digest(), "numba": numba.__version__,
+            "numpy": numpy.__version__}
+
+
+def _mismatch(expected: dict, got: dict) -> str:
+    return ", ".join(f"{k} {got.get(k)} (client {v})" for k, v in expected.items()
+                     if got.get(k) != v)
+
+
+def _slab_task(cfg, i0: int, i1: int, expected: dict) -> dict:
+    """Runs on a worker: one slab with the serial kernel (one level of parallelism)."""
+    bad = _mismatch(expected, _versions())
+    if bad:
+        raise RuntimeError(f"this Dask worker runs {bad}; install the client's versions so "
+                           "that the cube is reproducible")
+    from .grid import compute_slab
+
+    return compute_slab(cfg, i0, i1, parallel=False)
+
+
+class DaskExecutor:
+    """Runs slabs as tasks on a Dask distributed scheduler.
+
+    Parameters
+    ----------
+    address : str or cluster
+        ``tcp://HOST:PORT`` (``HOST:PORT`` means tcp), or a dask cluster object such as
+        ``LocalCluster`` or dask-jobqueue's ``SLURMCluster`` (its ``scheduler_address``).
+    timeout : float
+        Seconds to wait for the scheduler to answer [s].
+    worker_wait : float
+        Seconds to wait for at least one worker to join [s].
+
+    Raises
+    ------
+    InputError
+        The address is malformed, or no scheduler answers there within ``timeout``.
+    RuntimeError
+        No worker joins within ``worker_wait``, or a worker runs other nylonflex, Numba or
+        NumPy versions than the client.
+    """
+
+    def __init__(self, address, *, timeout: float = CONNECT_TIMEOUT,
+                 worker_wait: float = WORKER_WAIT):
+        self.address = _normalise_address(address)
+        try:
+            from distributed import Client
+        except ImportError:
+            raise InputError("--scheduler: needs dask.distributed; install it with "
+                             "pip install 'nylonflex[dask]'") from None
+        try:
+            self.client = Client(self.address, timeout=timeout, set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"--scheduler: no Dask scheduler answers at {self.address} "
+                             f"within {timeout:g} s ({type(exc).__name__}); start one with "
+                             "'dask scheduler'") from None
+        self._pending: set = set()
+        self._used: set[str] = set()
+        self._fetcher = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-fetch")
+        try:
+            self._check_workers(worker_wait)
+        except BaseException:
+            self.client.close()
+            raise
+
+    def _check_workers(self, worker_wait):
+        try:
+            self.client.wait_for_workers(1, timeout=worker_wait)
+        except TimeoutError:
+            raise RuntimeError(f"no Dask worker joined {self.address} within "
+                               f"{worker_wait:g} s; start some with 'dask worker "
+                               f"{self.address} --nthreads 1'") from None
+        expected = _versions()
+        for worker, got in self.client.run(_versions).items():
+            bad = _mismatch(expected, got)
+            if bad:
+                raise RuntimeError(f"Dask worker {worker} runs {bad}; install the client's "
+                                   "versions on every worker so that the cube is "
+                                   "reproducible")
+        self._threads = self.client.nthreads()
+
+    def info(self) -> dict:
+        """Provenance for the cube: the scheduler and the number of workers.
+
+        ``workers`` counts the workers connected at the start or, if more took part
+        (workers that joined later), those that computed slabs.
+        """
+        n = max(len(self._threads), len(self._used))
+        return {"scheduler": self.address, "workers": str(n)}
+
+    def _capacity(self) -> int:
+        try:
+            self._threads = self.client.nthreads()
+        except (OSError, TimeoutError):
+            pass
+        return IN_FLIGHT_PER_THREAD * max(1, sum(self._threads.values()))
+
+    def map_slabs(self, cfg, slabs: list[tuple[int, int]],
+                  todo: Iterable[int]) -> Iterator[tuple[int, dict]]:
+        """Yield ``(k, arrays)`` for each slab index in ``todo``, as they finish.
+
+        ``arrays`` is what ``compute_slab(cfg, *slabs[k], parallel=False)`` returns,
+        computed on a worker. At most :data:`IN_FLIGHT_PER_THREAD` slabs per worker thread
+        are submitted at once; a slab is released from the cluster once yielded.
+        """
+        from distributed import as_completed
+
+        expected = _versions()
+        token = uuid.uuid4().hex[:8]
+        queue = iter(todo)
+        done = as_completed(loop=self.client.loop, with_results=False)
+
+        def submit() -> bool:
+            k = next(queue, None)
+            if k is None:
+                return False
+            i0, i1 = slabs[k]
+            fut = self.client.submit(_slab_task, cfg, i0, i1, expected, pure=False,
+                                     key=f"nylonflex-slab-{token}-{k:06d}")
+            fut.slab = k
+            self._pending.add(fut)
+            done.add(fut)
+            return True
+
+        def top_up():
+            capacity = self._capacity()
+            while len(self._pending) < capacity and submit():
+                pass
+
+        def finish(fut, fetch):
+            arrays = fetch.result()
+            self._used.update(self._who_ran(fut))
+            self._pending.discard(fut)
+            fut.release()
+            top_up()
+            return fut.slab, arrays
+
+        # While the caller writes one slab, the next finished one is fetched in a thread.
+        top_up()
+        fetching = None
+        while fetching is not None or not done.is_empty():
+            if fetching is not None and not done.has_ready():
+                yield finish(*fetching)  # nothing else finished: don't wait for it
+                fetching = None
+                continue
+            fut = next(done)
+            started = (fut, self._fetcher.submit(fut.result))
+            if fetching is not None:
+                yield finish(*fetching)
+            fetching = started
+
+    def _who_ran(self, fut) -> set[str]:
+        # the worker that holds the result ran the task (results are not replicated)
+        try:
+            return set(self.client.who_has([fut]).get(fut.key, ()))
+        except (OSError, TimeoutError):
+            return set()
+
+    def close(self):
+        """Cancel what is still queued and disconnect; the cluster itself keeps running."""
+        client = getattr(self, "client", None)
+        if client is None:
+            return
+        try:
+            if self._pending:
+                client.cancel(list(self._pending), force=True)
+            self._pending.clear()
+        finally:
+            client.close()
+            self._fetcher.shutdown(wait=False, cancel_futures=True)

@@ -1,0 +1,137 @@
+"""Writing the cube file: NetCDF4/HDF5 through h5netcdf, slab by slab, chunks compressed once."""
+
+from __future__ import annotations
+
+import itertools
+import zlib
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from ..variables import COORDS, CURVES, DESIGN, slab_done_attrs
+
+__all__ = ["CubeFile"]
+
+_COMPRESSION = {"compression": "gzip", "compression_opts": 1, "shuffle": True}
+
+
+def _chunks(dims, sizes, radius_chunk):
+    shape = [sizes[d] for d in dims]
+    if dims and dims[0] == "radius":
+        shape[0] = min(radius_chunk, shape[0])
+    # keep chunks near or under 2 MB of float64 by halving the largest trailing dims
+    while np.prod(shape) > 2**18 and max(shape[1:] or [1]) > 1:
+        j = 1 + int(np.argmax(shape[1:]))
+        shape[j] = (shape[j] + 1) // 2
+    return tuple(int(x) for x in shape)
+
+
+class CubeFile:
+    """Writes one cube file slab by slab (h5netcdf; gzip level 1 with shuffle)."""
+
+    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int):
+        import h5netcdf
+
+        self.path = Path(path)
+        self.f = h5netcdf.File(self.path, "w")
+        sizes = {name: len(values) for name, values in coords.items()}
+        self.f.dimensions = sizes
+        for name, values in coords.items():
+            v = self.f.create_variable(name, (name,), "f8", data=np.asarray(values, float))
+            v.attrs.update(COORDS[name].attrs())
+        for var in (*DESIGN.values(), *CURVES.values()):
+            fill = None if var.dtype == "int8" else np.nan
+            v = self.f.create_variable(var.name, var.dims, var.dtype, fillvalue=fill,
+                                       chunks=_chunks(var.dims, sizes, radius_chunk),
+                                       **_COMPRESSION)
+            v.attrs.update(var.attrs())
+        done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
+        done.attrs.update(slab_done_attrs())
+        self.f.attrs.update(attrs)
+        self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
+
+    def write(self, i0: int, i1: int, arrays: dict):
+        """Write the variables of radii [i0, i1) (and those without a radius dim)."""
+        self.write_encoded(i0, i1, self.encode(i0, arrays))
+
+    def encode(self, i0: int, arrays: dict) -> dict:
+        """The slab of radii from ``i0`` as it will be stored: a flat dict of arrays.
+
+        Chunks that lie wholly inside the slab are shuffled and deflated here, by a small
+        thread pool (zlib releases the GIL; HDF5 would compress them one by one in the
+        writing thread), as ``NAME:offsets``, ``NAME:sizes`` and ``NAME:bytes``; anything
+        else stays a plain array under its name. The journal keeps exactly this, so a slab
+        is compressed once and its journal file is as small as its share of the cube.
+        """
+        out, jobs = {}, []
+        for name, data in arrays.items():
+            var = self.f.variables[name]
+            dset = var._h5ds
+            i1 = i0 + (np.shape(data)[0] if var.dimensions else 0)
+            if var.dimensions and var.dimensions[0] == "radius" and \
+                    self._aligned(dset, i0, i1):
+                jobs.append((name, list(self._compress(dset, i0, data))))
+            else:
+                out[name] = np.asarray(data)
+        for name, chunks in jobs:
+            blobs = [future.result() for _, future in chunks]
+            out[f"{name}:offsets"] = np.array([off for off, _ in chunks], dtype=np.int64)
+            out[f"{name}:sizes"] = np.array([len(b) for b in blobs], dtype=np.int64)
+            out[f"{name}:bytes"] = np.frombuffer(b"".join(blobs), dtype=np.uint8)
+        return out
+
+    def write_encoded(self, i0: int, i1: int, encoded: dict):
+        """Store what :meth:`encode` made for the radii [i0, i1)."""
+        for key, value in encoded.items():
+            name, _, part = key.partition(":")
+            var = self.f.variables[name]
+            if part == "offsets":
+                sizes = encoded[f"{name}:sizes"]
+                blob = encoded[f"{name}:bytes"]
+                ends = np.cumsum(sizes)
+                for offset, end, size in zip(value, ends, sizes):
+                    var._h5ds.id.write_direct_chunk(tuple(int(x) for x in offset),
+                                                    blob[end - size:end].tobytes())
+            elif part:
+                continue  # sizes and bytes go with their offsets
+            elif var.dimensions and var.dimensions[0] == "radius":
+                var[i0:i1] = value
+            else:
+                var[...] = value
+        self.f.variables["slab_done"][i0:i1] = 1
+
+    @staticmethod
+    def _aligned(dset, i0, i1):
+        rc = dset.chunks[0]
+        return i0 % rc == 0 and (i1 % rc == 0 or i1 == dset.shape[0])
+
+    def _compress(self, dset, i0, data):
+        """Yield ``(chunk offset, future of its filtered bytes)`` for a slab's chunks."""
+        chunks, shape = dset.chunks, dset.shape
+        data = np.ascontiguousarray(data, dtype=dset.dtype)
+        starts = [range(0, data.shape[0], chunks[0])] + \
+            [range(0, n, c) for n, c in zip(shape[1:], chunks[1:])]
+        for corner in itertools.product(*starts):
+            block = data[tuple(slice(c, c + n) for c, n in zip(corner, chunks))]
+            offset = (i0 + corner[0], *corner[1:])
+            yield offset, self._pool.submit(_shuffle_deflate, block, chunks)
+
+    def close(self, attrs: dict | None = None):
+        self._pool.shutdown()
+        if attrs:
+            self.f.attrs.update(attrs)
+        self.f.close()
+
+
+def _shuffle_deflate(block, chunks):
+    """HDF5's shuffle then deflate filters on one chunk (padded to the full chunk shape)."""
+    if block.shape != tuple(chunks):
+        full = np.zeros(chunks, dtype=block.dtype)
+        full[tuple(slice(0, n) for n in block.shape)] = block
+        block = full
+    raw = np.ascontiguousarray(block).view(np.uint8)
+    size = block.dtype.itemsize
+    if size > 1:  # byte k of every element together, as H5Z_FILTER_SHUFFLE does
+        raw = raw.reshape(-1, size).T
+    return zlib.compress(np.ascontiguousarray(raw).tobytes(), _COMPRESSION["compression_opts"])
