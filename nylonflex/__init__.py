@@ -14,13 +14,14 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0+unknown"
 
 from .materials import NYLON_PARAMETERS, SILICONE_PARAMETERS, nylon_parameters, silicone_parameters
-from .physics import design_limits
+from .engine import design_limits, evaluate
 
 __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "__version__",
     "design_limits",
+    "evaluate",
     "load_config",
     "nylon_parameters",
     "open_cube",

@@ -18,9 +18,9 @@ from .config import parse_config
 
 #: The benchmark grid of issue 3: 100 x 40 x 10 x 5 x 10 = 2,000,000 designs with curves.
 FULL = {"radius": 100, "wall_thickness": 40, "length": 10, "coil_index": 5, "wrap_angle": 10,
-        "stroke": 51, "pressure": 41, "reference_designs": 6}
+        "stroke": 51, "pressure": 41, "reference_designs": 6, "pointwise_designs": 20000}
 QUICK = {"radius": 12, "wall_thickness": 6, "length": 4, "coil_index": 3, "wrap_angle": 4,
-         "stroke": 11, "pressure": 9, "reference_designs": 2}
+         "stroke": 11, "pressure": 9, "reference_designs": 2, "pointwise_designs": 500}
 
 
 def bench_config(sizes: dict):
@@ -56,6 +56,40 @@ def _reference_design(cfg, a, t, c, psi):
     return s, k_full, k
 
 
+def random_designs(n: int, seed: int = 2026) -> dict:
+    """``n`` designs drawn over the whole accepted range of each axis (log-uniform lengths).
+
+    Radius, wall and length log-uniform over the registry's ranges, coil index uniform over
+    the default table, wrap angle uniform over its range; SI.
+    """
+    from .variables import COORDS
+
+    rng = np.random.default_rng(seed)
+    log_uniform = lambda v: np.exp(rng.uniform(np.log(v.lo), np.log(v.hi), n))  # noqa: E731
+    return {"radius": log_uniform(COORDS["radius"]),
+            "wall_thickness": log_uniform(COORDS["wall_thickness"]),
+            "length": log_uniform(COORDS["length"]),
+            "coil_index": rng.uniform(1.1, 1.7, n),
+            "wrap_angle": rng.uniform(COORDS["wrap_angle"].lo, COORDS["wrap_angle"].hi, n)}
+
+
+def _pointwise_seconds(n: int) -> tuple[float, float, int]:
+    """Per-design time [s] of ``nf.evaluate`` on ``n`` random designs, and of the uncompiled
+    python loop (:func:`nylonflex.physics.design_limits`) on a 50th of them, same run."""
+    from .engine import evaluate
+    from .physics import design_limits as python_loop
+
+    d = random_designs(n)
+    evaluate(**{k: v[:64] for k, v in d.items()})  # compile or load the cache
+    t0 = time.perf_counter()
+    evaluate(**d)
+    t_point = (time.perf_counter() - t0) / n
+    m = max(10, n // 50)
+    t0 = time.perf_counter()
+    python_loop(*(v[:m] for v in d.values()))
+    return t_point, (time.perf_counter() - t0) / m, n
+
+
 def _closed_loop_seconds(duration: float) -> tuple[float, float]:
     """Loop time [s] of the figure-9 closed loop over ``duration`` [s] at 10 ms, and the
     whole run's (tables and output included), once compiled."""
@@ -88,7 +122,8 @@ def run_bench(quick: bool = False, log=None) -> dict:
 
     ``log`` receives each line of the report as it is measured; the figures are returned.
     """
-    from .sweep import compute_slab, plan_slabs, run_sweep
+    from .engine.grid import compute_slab, plan_slabs
+    from .sweep import run_sweep
 
     sizes = QUICK if quick else FULL
     cfg = bench_config(sizes)
@@ -125,6 +160,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
     for d in designs:
         _reference_design(cfg, *d)
     t_ref = (time.perf_counter() - t0) / n_ref
+    t_point, t_loop_py, n_point = _pointwise_seconds(sizes["pointwise_designs"])
 
     sim_duration = 60.0 if quick else 3600.0
     t_loop, t_sim = _closed_loop_seconds(sim_duration)
@@ -141,6 +177,10 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "angle_solves_per_s": solves / t_kernel,
         "reference_s_per_design": t_ref,
         "speedup": t_ref / per_design,
+        "pointwise_s_per_design": t_point,
+        "python_loop_s_per_design": t_loop_py,
+        "pointwise_vs_reference": t_ref / t_point,
+        "pointwise_vs_python_loop": t_loop_py / t_point,
         "closed_loop_s": t_loop,
         "closed_loop_run_s": t_sim,
         "peak_rss_mb": peak_mb,
@@ -153,6 +193,12 @@ def run_bench(quick: bool = False, log=None) -> dict:
     say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
     say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
         "same run)")
+    say(f"  nf.evaluate, scattered      {t_point * 1e6:8.1f} us per design ({n_point:,} random "
+        f"designs over the accepted ranges)")
+    say(f"  python-loop design_limits  {t_loop_py * 1e6:8.1f} us per design "
+        f"(physics.design_limits, the same formulas uncompiled)")
+    say(f"  evaluate speed-up          {result['pointwise_vs_reference']:>12,.0f} x the scipy "
+        f"reference, {result['pointwise_vs_python_loop']:,.0f} x the python loop (same run)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")

@@ -130,10 +130,13 @@ def _suptitle(fig, title, subtitle):
 
 
 def _stroke_max(ds):
-    """s_max(C) read off the cube: the usable stroke of stroke-limited designs [-].
+    """s_max(C) [-], stored in the cube.
 
-    NaN for a coil index with no stroke-limited design in the cube.
+    Cubes written before ``stroke_max`` was stored: the usable stroke of stroke-limited
+    designs (NaN for a coil index with none).
     """
+    if "stroke_max" in ds:
+        return ds["stroke_max"].values
     s = ds["usable_stroke"].where(ds["limit"] == 0)
     dims = [d for d in s.dims if d != "coil_index"]
     return s.max(dims).values

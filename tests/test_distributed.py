@@ -21,9 +21,9 @@ distributed = pytest.importorskip("distributed")
 
 import nylonflex as nf  # noqa: E402
 from nylonflex.cli import main  # noqa: E402
-from nylonflex.distributed import DaskRunner, _normalise_address  # noqa: E402
+from nylonflex.engine.cluster import DaskExecutor, _normalise_address  # noqa: E402
 from nylonflex.storage import VOLATILE_ATTRS, Journal  # noqa: E402
-from nylonflex.sweep import plan_slabs  # noqa: E402
+from nylonflex.engine.grid import plan_slabs  # noqa: E402
 from nylonflex.units import InputError  # noqa: E402
 
 # Eighteen slabs of about 1 MB, some 50 ms of work each: enough tasks for both workers and
@@ -131,7 +131,7 @@ def _free_port():
 
 def test_no_scheduler_is_refused():
     with pytest.raises(InputError, match="no Dask scheduler answers at tcp://127.0.0.1"):
-        DaskRunner(f"tcp://127.0.0.1:{_free_port()}", timeout=0.5)
+        DaskExecutor(f"tcp://127.0.0.1:{_free_port()}", timeout=0.5)
 
 
 def test_malformed_address_is_refused_by_the_cli(config_path, tmp_path, capsys):

@@ -6,7 +6,8 @@ import pytest
 from nylonflex import design_limits
 from nylonflex.config import parse_config
 from nylonflex.physics import bending, chamber, nylon, wrap
-from nylonflex.sweep import compute_slab, run_sweep
+from nylonflex.engine.grid import compute_slab
+from nylonflex.sweep import run_sweep
 
 IRREGULAR = {
     "name": "irregular",

@@ -1,61 +1,138 @@
-"""Imports point down only (STYLE.md): physics <- kernels <- sweep <- storage/charts <- cli."""
+"""The import-layering contract: imports point down, never back, and never in a circle.
+
+physics <- kernels <- engine <- storage, charts, query <- cli (STYLE.md). Each module of the
+package sits in a layer; an import of another nylonflex module must reach a lower layer (or
+its own package). The physics imports neither numba, xarray nor matplotlib.
+"""
 
 import ast
 from pathlib import Path
 
+import pytest
+
 PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 
+#: Layer of each top-level module or subpackage, lowest first. Same-layer imports are
+#: allowed only inside one subpackage.
+LAYERS = {
+    "units": 0, "variables": 0.1, "materials": 0.2, "config": 0.3,
+    "physics": 1, "reference": 1,
+    "kernels": 2,
+    "engine": 3, "simconfig": 3, "simulate": 3,
+    "storage": 4, "charts": 4, "charts_sim": 4, "query": 4,
+    "sweep": 4.5, "bench": 5, "calibration": 5, "design": 5, "explore": 5, "uncertainty": 5,
+    "cli": 6,
+}
 
-def _imports(path: Path) -> set[str]:
+
+def _modules():
+    for path in sorted(PKG.rglob("*.py")):
+        rel = path.relative_to(PKG.parent).with_suffix("")
+        parts = rel.parts if rel.name != "__init__" else rel.parts[:-1]
+        yield path, ".".join(parts)
+
+
+def _imports(path: Path, module: str) -> set[str]:
     names = set()
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
             names.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
-                parts = path.relative_to(PKG.parent).with_suffix("").parts[:-node.level]
-                base = ".".join([*parts, base] if base else parts)
+                anchor = package.split(".")
+                anchor = anchor[:len(anchor) - (node.level - 1)]
+                base = ".".join([*anchor, base] if base else anchor)
             names.add(base)
             names.update(f"{base}.{a.name}" for a in node.names)
-    return names
+    return {n for n in names if n.startswith("nylonflex")}
 
 
-def test_physics_imports_no_numba_xarray_matplotlib_or_upper_layers():
+def _unit(name: str) -> str | None:
+    """The top-level module or subpackage of a dotted nylonflex name (None: the root)."""
+    parts = name.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def _resolve(name: str) -> str:
+    """A dotted import target as a module of the package (``from x import y`` may name y)."""
+    parts = name.split(".")
+    while parts:
+        candidate = PKG.parent.joinpath(*parts)
+        if candidate.with_suffix(".py").is_file() or (candidate / "__init__.py").is_file():
+            return ".".join(parts)
+        parts = parts[:-1]
+    return name
+
+
+def _edges():
+    for path, module in _modules():
+        for target in _imports(path, module):
+            yield path, module, _resolve(target)
+
+
+def test_every_module_has_a_layer():
+    missing = {_unit(m) for _, m in _modules()} - set(LAYERS) - {None, "__main__"}
+    assert not missing, f"add these to LAYERS: {sorted(missing)}"
+
+
+def test_imports_point_down():
+    wrong = []
+    for path, module, target in _edges():
+        src, dst = _unit(module), _unit(target)
+        if src in (None, "__main__") or dst is None or src == dst:
+            continue  # the package root imports lazily; a subpackage imports itself
+        if LAYERS[dst] >= LAYERS[src]:
+            wrong.append(f"{module} -> {target}")
+    assert not wrong, "imports that run back up or sideways: " + "; ".join(wrong)
+
+
+def test_no_import_circles():
+    graph: dict[str, set[str]] = {}
+    for _, module, target in _edges():
+        if target != module and _unit(target) is not None:
+            graph.setdefault(module, set()).add(target)
+    state: dict[str, int] = {}
+
+    def visit(node, stack):
+        state[node] = 1
+        for nxt in graph.get(node, ()):
+            if state.get(nxt) == 1:
+                pytest.fail("import circle: " + " -> ".join(stack[stack.index(nxt):] + [nxt]))
+            if nxt not in state:
+                visit(nxt, stack + [nxt])
+        state[node] = 2
+
+    for node in list(graph):
+        if node not in state:
+            visit(node, [node])
+
+
+def test_physics_imports_no_numba_xarray_matplotlib():
     for path in (PKG / "physics").glob("*.py"):
-        for name in _imports(path):
-            root = name.split(".")[0]
-            assert root not in ("numba", "xarray", "matplotlib", "h5py", "h5netcdf"), (path, name)
-            assert not name.startswith(("nylonflex.kernels", "nylonflex.sweep",
-                                        "nylonflex.storage", "nylonflex.charts",
-                                        "nylonflex.cli", "nylonflex.config")), (path, name)
-
-
-def test_kernels_do_not_import_the_sweep_storage_charts_or_cli():
-    for path in (PKG / "kernels").glob("*.py"):
-        for name in _imports(path):
-            assert not name.startswith(("nylonflex.sweep", "nylonflex.storage",
-                                        "nylonflex.charts", "nylonflex.cli", "xarray",
-                                        "matplotlib")), (path, name)
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level \
+                else []
+            for name in names:
+                assert name.split(".")[0] not in ("numba", "xarray", "matplotlib", "h5py",
+                                                  "h5netcdf"), (path, name)
 
 
 def test_charts_compute_no_physics():
-    for path in PKG.glob("chart*.py"):
-        for name in _imports(path):
-            assert not name.startswith(("nylonflex.physics", "nylonflex.kernels")), (path, name)
+    for path, module, target in _edges():
+        if _unit(module) in ("charts", "charts_sim"):
+            assert _unit(target) not in ("physics", "kernels", "engine"), (module, target)
 
 
-def test_only_the_sweep_and_simulator_call_the_design_kernels():
-    for path in PKG.rglob("*.py"):
-        if path.parent.name == "kernels" or path.name in ("sweep.py", "simulate.py",
-                                                          "distributed.py"):
-            continue
-        for name in _imports(path):
-            assert not name.startswith("nylonflex.kernels.design"), (path, name)
-
-
-def test_cli_holds_no_science():
-    for path in (PKG / "cli").glob("*.py"):
-        for name in _imports(path):
-            assert not name.startswith(("nylonflex.physics", "nylonflex.kernels", "numba")), \
-                (path, name)
+def test_the_contract_fails_when_an_arrow_runs_back(tmp_path, monkeypatch):
+    # a physics module that imports the engine must be caught
+    bad = PKG / "physics" / "_layering_probe.py"
+    bad.write_text("from ..engine import evaluate\n")
+    try:
+        with pytest.raises(AssertionError, match="physics._layering_probe -> nylonflex.engine"):
+            test_imports_point_down()
+    finally:
+        bad.unlink()

@@ -4,7 +4,7 @@ import h5py
 import numpy as np
 import pytest
 
-from nylonflex.storage import _shuffle_deflate
+from nylonflex.storage.cube import _shuffle_deflate
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.int8])

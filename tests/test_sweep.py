@@ -15,7 +15,8 @@ import yaml
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
-from nylonflex.sweep import _bytes_per_radius, plan_slabs, run_sweep
+from nylonflex.engine.grid import _bytes_per_radius, plan_slabs
+from nylonflex.sweep import run_sweep
 from nylonflex.variables import VARIABLES
 
 SMALL = {

@@ -21,6 +21,14 @@ def add_arguments(s):
     s.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _progress(total, quiet):
+    from tqdm import tqdm
+
+    disable = quiet or not sys.stderr.isatty()
+    return tqdm(total=total, unit="design", unit_scale=True, disable=disable,
+                desc="sweep", smoothing=0.1, dynamic_ncols=True)
+
+
 def run(args) -> int:
     from ..config import load_config
     from ..sweep import default_output, run_sweep
@@ -35,8 +43,9 @@ def run(args) -> int:
         if not args.quiet:
             print(msg, file=sys.stderr)
 
-    ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
-                   scheduler=args.scheduler, quiet=args.quiet, log=log)
+    with _progress(cfg.n_designs, args.quiet) as bar:
+        ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
+                       scheduler=args.scheduler, progress=bar.update, log=log)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if cfg.charts and not args.no_charts:
         from ..charts import draw_charts

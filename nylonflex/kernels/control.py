@@ -31,7 +31,7 @@ __all__ = ["angle_table", "closed_loop", "estimate_angle", "plant_angle"]
 
 @jit_kernel
 def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, mu, alpha,
-                x_base, w_base, x_phi, w_phi, rtol, out_angle, out_slope):
+                x_base, w_base, phi_trig, w_phi, rtol, out_angle, out_slope):
     """Bend angle theta(p_k) = kappa(p_k) L and its slope at p_k = k dp [rad], [rad/Pa].
 
     Parameters
@@ -42,7 +42,7 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
         a, t, b, L [m].
     mu, alpha : ndarray
         Ogden constants [Pa], [-].
-    x_base, w_base, x_phi, w_phi : ndarray
+    x_base, w_base, phi_trig, w_phi : ndarray
         Gauss-Legendre nodes and weights (``physics.bending.quadrature_nodes()``).
     rtol : float
         Newton tolerance of the curvature [-].
@@ -58,10 +58,10 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
     for k in range(out_angle.shape[0]):
         # warm start from the previous grid point: a few Newton steps each
         kappa = _curvature(lever * (k * pressure_step), radius, wall_thickness,
-                           base_thickness, mu, alpha, x_base, w_base, x_phi, w_phi, kappa,
+                           base_thickness, mu, alpha, x_base, w_base, phi_trig, w_phi, kappa,
                            rtol)
         _, stiffness = _material_moment(kappa, radius, wall_thickness, base_thickness, mu,
-                                        alpha, x_base, w_base, x_phi, w_phi)
+                                        alpha, x_base, w_base, phi_trig, w_phi)
         out_angle[k] = kappa * length
         out_slope[k] = length * lever / stiffness
 

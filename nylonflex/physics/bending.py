@@ -47,11 +47,29 @@ NEWTON_RTOL = 1e-9
 
 
 def quadrature_nodes(orders=None):
-    """Gauss-Legendre nodes and weights on [-1, 1]: ``(x_base, w_base, x_phi, w_phi)``."""
+    """The material moment's quadrature: ``(x_base, w_base, phi_trig, w_phi)``.
+
+    ``x_base``, ``w_base``: Gauss-Legendre nodes and weights on [-1, 1] of the base layer;
+    ``w_phi``: the weights of each half disc, whose nodes phi_i = pi/4 (x_i + 1) on
+    [0, pi/2] enter only through cos and sin: ``phi_trig`` holds them, shape (2, n), so that
+    no evaluation computes a trigonometric function (computed here once with ``math``, the
+    same functions and so the same bits as the kernels would get).
+    """
     orders = QUADRATURE_ORDERS if orders is None else orders
-    xb, wb = np.polynomial.legendre.leggauss(int(orders["base"]))
-    xp, wp = np.polynomial.legendre.leggauss(int(orders["phi"]))
-    return xb, wb, xp, wp
+    key = (int(orders["base"]), int(orders["phi"]))
+    if key not in _NODES:
+        xb, wb = np.polynomial.legendre.leggauss(key[0])
+        xp, wp = np.polynomial.legendre.leggauss(key[1])
+        half = 0.25 * math.pi
+        trig = np.array([[math.cos(half * (x + 1.0)) for x in xp],
+                         [math.sin(half * (x + 1.0)) for x in xp]])
+        for arr in (xb, wb, trig, wp):
+            arr.flags.writeable = False
+        _NODES[key] = (xb, wb, trig, wp)
+    return _NODES[key]
+
+
+_NODES: dict = {}
 
 
 @formula
@@ -62,16 +80,18 @@ def _pressure_moment(pressure, radius, base_thickness):
 
 
 @formula
-def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, x_phi, w_phi):
-    """int over the half disc of radius R of S(1 + kappa y) y dA, and its kappa-derivative."""
+def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi):
+    """int over the half disc of radius R of S(1 + kappa y) y dA, and its kappa-derivative.
+
+    ``phi_trig`` holds cos and sin of the nodes phi_i on [0, pi/2] (rows 0 and 1).
+    """
     m = 0.0
     dm = 0.0
     half = 0.25 * math.pi  # phi in [0, pi/2]
     r2 = 2.0 * outer * outer
-    for i in range(x_phi.shape[0]):
-        phi = half * (x_phi[i] + 1.0)
-        c = math.cos(phi)
-        y = base_thickness + outer * math.sin(phi)
+    for i in range(w_phi.shape[0]):
+        c = phi_trig[0, i]
+        y = base_thickness + outer * phi_trig[1, i]
         s, ds = _stress_and_slope(1.0 + kappa * y, mu, alpha)
         w = w_phi[i] * half * r2 * c * c * y
         m += w * s
@@ -81,7 +101,7 @@ def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, x_phi, w_phi):
 
 @formula
 def _material_moment(kappa, radius, wall_thickness, base_thickness, mu, alpha,
-                     x_base, w_base, x_phi, w_phi):
+                     x_base, w_base, phi_trig, w_phi):
     """M_S(kappa) [N m] and dM_S/dkappa [N m^2] (MODEL.md section 6)."""
     m = 0.0
     dm = 0.0
@@ -94,14 +114,14 @@ def _material_moment(kappa, radius, wall_thickness, base_thickness, mu, alpha,
         m += w * s
         dm += w * ds * y
     mo, dmo = _half_disc_moment(kappa, radius + wall_thickness, base_thickness, mu, alpha,
-                                x_phi, w_phi)
-    mi, dmi = _half_disc_moment(kappa, radius, base_thickness, mu, alpha, x_phi, w_phi)
+                                phi_trig, w_phi)
+    mi, dmi = _half_disc_moment(kappa, radius, base_thickness, mu, alpha, phi_trig, w_phi)
     return m + mo - mi, dm + dmo - dmi
 
 
 @formula
 def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
-               x_base, w_base, x_phi, w_phi, guess, rtol):
+               x_base, w_base, phi_trig, w_phi, guess, rtol):
     """Solve M_S(kappa) = moment for kappa >= 0 [1/m] by safeguarded Newton.
 
     ``guess`` <= 0 starts from the linear (small-angle) solution. M_S is smooth and strictly
@@ -114,13 +134,13 @@ def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
         k = guess
     else:
         m0, dm0 = _material_moment(0.0, radius, wall_thickness, base_thickness, mu, alpha,
-                                   x_base, w_base, x_phi, w_phi)
+                                   x_base, w_base, phi_trig, w_phi)
         k = moment / dm0
     lo = 0.0
     hi = math.inf
     for _ in range(200):
         m, dm = _material_moment(k, radius, wall_thickness, base_thickness, mu, alpha,
-                                 x_base, w_base, x_phi, w_phi)
+                                 x_base, w_base, phi_trig, w_phi)
         f = m - moment
         if f == 0.0:
             return k

@@ -1,0 +1,114 @@
+"""The design grid: slab plan, one slab through the grid kernel, the arrays without radius.
+
+The design space is cut into slabs of consecutive radii, each of bounded memory
+(``slab_megabytes`` in the config); every other axis is whole in a slab. A slab is what an
+executor computes and a sink stores (:mod:`.slabs`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config import ResolvedConfig
+from ..physics.bending import quadrature_nodes
+from ..physics.chamber import P_ATM, chamber_pressure
+from ..physics.nylon import nylon_force_limit, stroke_max
+from ..physics.wrap import muscle_width
+from ..variables import COORDS, CURVES, DESIGN
+
+__all__ = ["FLOAT_DESIGN", "compute_slab", "coords", "global_arrays", "plan_slabs",
+           "slab_variables"]
+
+#: The float design variables in the registry's order (the kernel's ``out.design`` rows).
+FLOAT_DESIGN = tuple(n for n in DESIGN if n != "limit")
+
+
+def slab_variables() -> dict:
+    """Registry entries of every variable with a radius dimension (what a slab holds)."""
+    return {n: v for n, v in {**DESIGN, **CURVES}.items() if v.dims[0] == "radius"}
+
+
+def coords(cfg: ResolvedConfig) -> dict:
+    """Every coordinate of the cube: the five axes and the two curve axes, SI arrays."""
+    return {**cfg.axes, **cfg.curves}
+
+
+def _bytes_per_radius(cfg: ResolvedConfig) -> int:
+    sizes = {k: len(v) for k, v in coords(cfg).items()}
+    return sum(int(np.prod([sizes[d] for d in v.dims[1:]])) * np.dtype(v.dtype).itemsize
+               for v in slab_variables().values())
+
+
+def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
+    """Slabs ``[(i0, i1), ...]`` of radius indices, and the HDF5 chunk length along radius.
+
+    A slab holds as many radii as fit in ``cfg.slab_megabytes`` (at least one), a multiple
+    of the chunk length so that slabs write whole chunks.
+    """
+    per = _bytes_per_radius(cfg)
+    na = cfg.shape[0]
+    per_slab = min(na, max(1, int(cfg.slab_megabytes * 2**20) // per))
+    # chunks of about 2 MB of one variable, never longer than a slab
+    chunk = max(1, min(per_slab, (2 * 2**20) // max(1, per // 9)))
+    per_slab = (per_slab // chunk) * chunk
+    return [(i, min(na, i + per_slab)) for i in range(0, na, per_slab)], chunk
+
+
+def _coil_table(cfg: ResolvedConfig):
+    from ..kernels.records import CoilTable
+
+    c = cfg.axes["coil_index"]
+    column = lambda x: np.ascontiguousarray(x, dtype=float).reshape(-1)  # noqa: E731
+    return CoilTable(column(stroke_max(c, cfg.nylon)), column(nylon_force_limit(c, cfg.nylon)),
+                     column(muscle_width(c, cfg.nylon)))
+
+
+def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -> dict:
+    """Every radius-dependent variable of the radii [i0, i1), as a dict of arrays.
+
+    ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers.
+    """
+    from ..kernels import design
+    from ..kernels.records import GridAxes, GridOut, Nodes, Ogden
+
+    kernel = design.design_slab_parallel if parallel else design.design_slab_serial
+    grid = GridAxes(radius=np.ascontiguousarray(cfg.axes["radius"][i0:i1]),
+                    wall=cfg.axes["wall_thickness"], length=cfg.axes["length"],
+                    wrap=cfg.axes["wrap_angle"],
+                    base_thickness=-1.0 if cfg.base_thickness is None
+                    else float(cfg.base_thickness),
+                    stroke=cfg.curves["stroke"], pressure=cfg.curves["pressure"], p_atm=P_ATM)
+    sizes = {k: len(v) for k, v in coords(cfg).items()}
+    sizes["radius"] = i1 - i0
+    shape = lambda name: [sizes[d] for d in CURVES[name].dims]  # noqa: E731
+    design_shape = [sizes[d] for d in DESIGN["limit"].dims]
+    out = GridOut(design=np.empty((len(FLOAT_DESIGN), *design_shape)),
+                  limit=np.empty(design_shape, dtype=np.int8),
+                  nylon_force=np.empty(shape("nylon_force")),
+                  bend_angle=np.empty(shape("bend_angle")),
+                  tip_force=np.empty(shape("tip_force")))
+    kernel(grid, _coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
+           out)
+    arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
+    arrays.update(limit=out.limit, nylon_force=out.nylon_force, bend_angle=out.bend_angle,
+                  tip_force=out.tip_force)
+    return arrays
+
+
+def global_arrays(cfg: ResolvedConfig) -> dict:
+    """Variables without a radius dimension: per coil index and per stroke."""
+    c = cfg.axes["coil_index"]
+    column = lambda x: np.asarray(x, float).reshape(-1)  # noqa: E731
+    return {"nylon_force_limit": column(nylon_force_limit(c, cfg.nylon)),
+            "stroke_max": column(stroke_max(c, cfg.nylon)),
+            "chamber_pressure": column(chamber_pressure(cfg.curves["stroke"]))}
+
+
+def _check_registry():
+    # every variable of the registry is either a slab variable or a global one
+    assert set(slab_variables()) | {"nylon_force_limit", "stroke_max", "chamber_pressure"} \
+        == set(DESIGN) | set(CURVES), "variables.py and engine.grid disagree"
+    assert all(n in COORDS for v in {**DESIGN, **CURVES}.values() for n in v.dims)
+
+
+_check_registry()

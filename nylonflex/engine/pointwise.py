@@ -1,0 +1,264 @@
+"""The compiled pointwise evaluator: every design variable of scattered designs.
+
+:func:`evaluate` is what calibration, uncertainty, optimisation and the explorer call: the
+designs' five variables (and the base thickness) broadcast together NumPy-style, and every
+numeric field of the material sets may be an array that broadcasts against them (Ogden
+``mu``/``alpha`` with the terms on the last axis, the coil-index table's columns likewise),
+so 10,000 samples of uncertain materials are one call. The loop is compiled with Numba and
+runs in parallel over the designs; its body is the one the pure-Python reference
+:func:`nylonflex.physics.design_limits` runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
+                         nylon_parameters, silicone_parameters)
+from ..physics._formula import check_input, check_section, check_wrap_angle
+from ..physics.bending import quadrature_nodes
+from ..physics.chamber import P_ATM
+from ..variables import DESIGN
+
+__all__ = ["MODELS", "design_limits", "evaluate"]
+
+#: Model variants :func:`evaluate` knows (docs/model.md).
+MODELS = ("paper",)
+
+#: Designs below which the serial loop is used (threads cost more than they save).
+_PARALLEL_FROM = 64
+
+_FLOAT_DESIGN = [n for n in DESIGN if n != "limit"]
+_SILICONE_FIELDS = ("mu", "alpha")
+_NYLON_TABLES = ("coil_index_table", "stroke_max_table", "tensile_strength_table")
+_NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_per_length",
+                   "heat_capacity_per_length", "heat_loss_per_length")
+
+
+def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
+             silicone="tc5005", nylon="silver_nylon66", model="paper"):
+    """Every design variable of designs that broadcast together (compiled, parallel).
+
+    Parameters
+    ----------
+    radius : float or array
+        Inner chamber radius a [m], 0.5-200 mm.
+    wall_thickness : float or array
+        Wall thickness t [m], 0.1-50 mm.
+    length : float or array
+        Actuator length L [m], 1-2000 mm.
+    coil_index : float or array
+        Coil index C [-], inside the muscle set's coil-index table.
+    wrap_angle : float or array
+        Helix angle psi of the wrap from the hoop direction [rad], 0.1-80 deg.
+    base_thickness : float or array, optional
+        Bottom layer thickness b [m]; b = t when None (docs/model.md s. 1 [choice]).
+    silicone : str, dict or Silicone, default "tc5005"
+        A set name, a :class:`~nylonflex.materials.Silicone`, or ``{"set": name, field:
+        value}`` where ``mu`` [Pa] and ``alpha`` [-] may be arrays of shape (..., terms)
+        whose leading axes broadcast against the designs.
+    nylon : str, dict or Nylon, default "silver_nylon66"
+        A set name, a :class:`~nylonflex.materials.Nylon`, or ``{"set": name, field:
+        value}``; every numeric field may be an array broadcasting against the designs (the
+        tables with their columns on the last axis).
+    model : str, default "paper"
+        Model variant, one of :data:`MODELS`.
+
+    Returns
+    -------
+    dict of str to ndarray
+        The design variables of :data:`nylonflex.variables.DESIGN` (the same names, units
+        and values as :func:`nylonflex.design_limits`), each of the broadcast shape;
+        ``limit`` is int8.
+
+    Raises
+    ------
+    ValueError
+        One line naming the parameter and its accepted range.
+    """
+    if model not in MODELS:
+        raise ValueError(f"model: unknown model {_short(model)}; accepted: {', '.join(MODELS)}")
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
+    L = check_input("length", length)
+    psi = check_wrap_angle(wrap_angle)
+    ogden = _silicone_arrays(silicone)
+    ny = _nylon_arrays(nylon)
+    c = check_input("coil_index", coil_index, -np.inf, np.inf)
+    table = ny["coil_index_table"]
+    bad = ~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])
+    if np.any(bad):
+        lo, hi = np.broadcast_arrays(table[..., 0], table[..., -1], c)[:2]
+        j = np.flatnonzero(np.broadcast_to(bad, np.broadcast(lo, c).shape))[0]
+        raise ValueError(f"coil_index: must be in [{lo.flat[j]:g}, {hi.flat[j]:g}] (the "
+                         f"nylon set's table), got {np.broadcast_to(c, lo.shape).flat[j]:g}")
+    batch = [ogden[0].shape[:-1], ogden[1].shape[:-1], table.shape[:-1],
+             ny["stroke_max_table"].shape[:-1], ny["tensile_strength_table"].shape[:-1],
+             *(np.shape(v) for k, v in ny.items() if k not in _NYLON_TABLES)]
+    try:
+        shape = np.broadcast_shapes(a.shape, t.shape, b.shape, L.shape, c.shape, psi.shape,
+                                    *batch)
+    except ValueError:
+        raise ValueError("evaluate: the designs and material arrays do not broadcast "
+                         f"together (shapes {[x.shape for x in (a, t, L, c, psi)]}, "
+                         f"materials {batch})") from None
+    flat = lambda x: np.ascontiguousarray(np.broadcast_to(x, shape), float).reshape(-1)  # noqa: E731
+    n = int(np.prod(shape))
+    c_flat = flat(c)
+    s_max = _interp(c_flat, _rows(table, shape), _rows(ny["stroke_max_table"], shape))
+    strength = _interp(c_flat, _rows(table, shape), _rows(ny["tensile_strength_table"], shape))
+    d_f = flat(ny["fibre_diameter"])
+    force_limit = strength * (np.pi * d_f**2 / 4.0)
+    width = d_f * (c_flat + 1.0)
+    return _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
+                (s_max, force_limit, width), ogden)
+
+
+def _run(shape, n, design_arrays, coil_arrays, ogden):
+    from ..kernels import design as kernels
+    from ..kernels.records import CoilTable, Nodes, Ogden, PointDesigns, PointOut
+
+    mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
+                 _silicone_rows(ogden, shape))
+    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty(n, dtype=np.int8))
+    kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM else \
+        kernels.design_points_serial
+    kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
+           Nodes(*quadrature_nodes()), P_ATM, out)
+    result = {name: out.design[j].reshape(shape) for j, name in enumerate(_FLOAT_DESIGN)}
+    result["limit"] = out.limit.reshape(shape)
+    return {name: result[name] for name in DESIGN}
+
+
+def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
+                  silicone="tc5005", nylon="silver_nylon66"):
+    """Every design variable of the cube for one design or broadcastable arrays of them.
+
+    The compiled :func:`evaluate` with INTERFACE.md's positional signature: floats (and an
+    int ``limit``) for scalar input, arrays of the broadcast shape otherwise. Arguments,
+    units and errors as :func:`evaluate`; docs/model.md s. 8.
+    """
+    out = evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
+                   base_thickness=base_thickness, silicone=silicone, nylon=nylon)
+    if out["limit"].ndim:
+        return out
+    return {name: int(v) if name == "limit" else float(v) for name, v in out.items()}
+
+
+# --------------------------------------------------------------------------- materials
+
+def _short(value, n=40):
+    text = repr(value)
+    return text if len(text) <= n else text[:n] + "..."
+
+
+def _split(kind, value, table, fields):
+    """(base set object, {field: array override}) of a material argument."""
+    if isinstance(value, (Silicone, Nylon)) or isinstance(value, str):
+        return value, {}
+    if not isinstance(value, Mapping):
+        raise ValueError(f"{kind}: must be a set name, a mapping with 'set' or a material "
+                         f"object, got {_short(value)}")
+    arrays = {k: v for k, v in value.items() if k != "set" and k in fields and np.ndim(v) > 1}
+    scalar = {k: v for k, v in value.items() if k not in arrays}
+    return scalar, arrays
+
+
+def _as_array(kind, key, value):
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{kind}.{key}: must be numbers, got {_short(value)}") from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{kind}.{key}: must be finite, got {arr[~np.isfinite(arr)].flat[0]:g}")
+    return arr
+
+
+def _silicone_arrays(silicone):
+    """``(mu, alpha)`` arrays of shape (..., terms) of a silicone argument, checked."""
+    base, arrays = _split("silicone", silicone, SILICONE_PARAMETERS, _SILICONE_FIELDS)
+    if not arrays:
+        s = silicone_parameters(base)
+        return np.asarray(s.mu, float), np.asarray(s.alpha, float)
+    s = silicone_parameters({k: v for k, v in base.items()})  # the set and scalar fields
+    mu = _as_array("silicone", "mu", arrays.get("mu", s.mu))
+    alpha = _as_array("silicone", "alpha", arrays.get("alpha", s.alpha))
+    if mu.shape[-1] != alpha.shape[-1] or not 1 <= mu.shape[-1] <= 6:
+        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms on the "
+                         f"last axis, got shapes {mu.shape} and {alpha.shape}")
+    if np.any(alpha == 0):
+        raise ValueError("silicone.alpha: must be finite and non-zero")
+    mu0 = 0.5 * np.sum(mu * alpha, axis=-1)
+    if np.any(~(mu0 > 0)):
+        raise ValueError(f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i = "
+                         f"{mu0[~(mu0 > 0)].flat[0]:g} Pa; must be > 0")
+    return mu, alpha
+
+
+def _silicone_rows(ogden, shape):
+    mu, alpha = ogden
+    if mu.ndim == 1 and alpha.ndim == 1:
+        return mu.reshape(1, -1), alpha.reshape(1, -1)
+    k = mu.shape[-1]
+    return (np.broadcast_to(mu, (*shape, k)), np.broadcast_to(alpha, (*shape, k)))
+
+
+def _nylon_arrays(nylon) -> dict:
+    """Every numeric field of a nylon argument as an array (tables: columns last), checked."""
+    base, arrays = _split("nylon", nylon, NYLON_PARAMETERS, _NYLON_TABLES)
+    numeric = {k: v for k, v in (base.items() if isinstance(base, Mapping) else ())
+               if k != "set" and np.ndim(v) > 0 and k not in _NYLON_TABLES}
+    scalar_base = {k: v for k, v in base.items() if k not in numeric} \
+        if isinstance(base, Mapping) else base
+    ny = nylon_parameters(scalar_base)
+    out = {k: np.asarray(v, float) for k, v in ny.to_dict().items() if k != "name"}
+    for key, value in {**numeric, **arrays}.items():
+        out[key] = _as_array("nylon", key, value)
+    if not numeric and not arrays:
+        return out
+    for key in _NYLON_POSITIVE:
+        if np.any(out[key] <= 0):
+            raise ValueError(f"nylon.{key}: must be > 0, got {out[key][out[key] <= 0].flat[0]:g}")
+    if np.any(out["t_max"] <= out["t_amb"]):
+        raise ValueError("nylon.t_max: must be above nylon.t_amb")
+    c, smax, su = (out[k] for k in _NYLON_TABLES)
+    if not (c.shape[-1] == smax.shape[-1] == su.shape[-1] >= 1) or np.any(np.diff(c) <= 0):
+        raise ValueError("nylon.coil_index_table: must increase, one s_max and sigma_u a row")
+    if np.any((smax <= 0) | (smax >= 1)):
+        raise ValueError("nylon.stroke_max_table: each s_max must be in (0, 1)")
+    if np.any(su <= 0):
+        raise ValueError("nylon.tensile_strength_table: each sigma_u must be > 0 Pa")
+    return out
+
+
+def _rows(table, shape):
+    """A table as (m,) when shared by every design, else (n, m) one row a design."""
+    if table.ndim == 1:
+        return table
+    return np.ascontiguousarray(np.broadcast_to(table, (*shape, table.shape[-1]))).reshape(
+        -1, table.shape[-1])
+
+
+def _interp(x, xp, fp):
+    """``np.interp`` of each design's coil index in its own table (rows of ``xp``, ``fp``).
+
+    With 1-D tables this is ``np.interp`` itself; with per-design tables it repeats
+    NumPy's arithmetic (slope times offset plus the left value; a node returns its value)
+    so both give the same bits.
+    """
+    if xp.ndim == 1 and fp.ndim == 1:
+        return np.interp(x, xp, fp)
+    xp, fp = np.broadcast_arrays(np.atleast_2d(xp), np.atleast_2d(fp))
+    xp = np.broadcast_to(xp, (x.size, xp.shape[-1]))
+    fp = np.broadcast_to(fp, (x.size, fp.shape[-1]))
+    m = xp.shape[-1]
+    if m == 1:
+        return fp[:, 0].copy()
+    j = np.clip(np.sum(xp[:, 1:] <= x[:, None], axis=1), 0, m - 2)
+    rows = np.arange(x.size)
+    x0, x1, y0, y1 = xp[rows, j], xp[rows, j + 1], fp[rows, j], fp[rows, j + 1]
+    slope = (y1 - y0) / (x1 - x0)
+    out = slope * (x - x0) + y0
+    out = np.where(x == x0, y0, out)
+    return np.where(x == xp[:, -1], fp[:, -1], out)

@@ -1,0 +1,173 @@
+"""The one slab loop: an executor computes slabs, a sink stores them.
+
+:func:`run_slabs` drives every sweep, in memory or to a cube file, local or on Dask:
+
+- an *executor* yields ``(k, arrays)`` for the slab indices it is given, as they finish:
+  :class:`LocalExecutor` (Numba threads, the next slab computed while the last is stored)
+  or :class:`nylonflex.engine.cluster.DaskExecutor`;
+- a *sink* stores them: ``sink.put(k, i0, i1, arrays)``. :class:`MemorySink` fills an
+  in-memory :class:`xarray.Dataset`; :class:`nylonflex.storage.CubeSink` journals each slab
+  and writes the HDF5 cube.
+
+Ctrl-C or SIGTERM stops the loop after the slab being stored; what was stored stays, so an
+interrupted run loses at most the slabs in flight.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import ResolvedConfig
+from ..units import InputError
+from .grid import compute_slab, coords, global_arrays
+
+__all__ = ["LocalExecutor", "MemorySink", "RunStats", "run_slabs", "set_workers"]
+
+
+@dataclass
+class RunStats:
+    """What a run did: slabs stored, designs computed (not restored) and its wall time."""
+
+    done: set
+    computed: int
+    seconds: float
+    stopped: bool
+
+
+class _Stop(Exception):
+    """Raised by the SIGTERM handler to stop a sweep like Ctrl-C does."""
+
+
+def set_workers(workers=None) -> int:
+    """Set (or read) the number of Numba threads; ``workers`` in [1, cores]."""
+    import numba
+
+    if workers is None:
+        return numba.get_num_threads()
+    if not 1 <= workers <= numba.config.NUMBA_NUM_THREADS:
+        raise InputError(f"--workers: must be in [1, {numba.config.NUMBA_NUM_THREADS}], "
+                         f"got {workers}")
+    numba.set_num_threads(workers)
+    return workers
+
+
+class LocalExecutor:
+    """Slabs on this machine's cores: the Numba-threaded kernel, one slab ahead.
+
+    The kernel releases the GIL, so storing slab k (compression, journal) overlaps the
+    arithmetic of slab k+1; at most two slabs are in memory.
+    """
+
+    def __init__(self, workers=None):
+        self.workers = set_workers(workers)
+
+    def info(self) -> dict:
+        return {"scheduler": "local (numba threads)", "workers": str(self.workers)}
+
+    def map_slabs(self, cfg, slabs, todo):
+        with ThreadPoolExecutor(1, thread_name_prefix="nylonflex-slab") as pool:
+            pending = None
+            for k in todo:
+                future = pool.submit(compute_slab, cfg, *slabs[k])
+                if pending is not None:
+                    yield pending[0], pending[1].result()
+                pending = (k, future)
+            if pending is not None:
+                yield pending[0], pending[1].result()
+
+    def close(self):
+        pass
+
+
+def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -> RunStats:
+    """Compute the slabs ``todo`` with ``executor`` and store each in ``sink``.
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        The design space.
+    slabs : list of (int, int)
+        The slab plan: radius index ranges.
+    todo : iterable of int
+        Indices into ``slabs`` to compute.
+    executor : LocalExecutor or DaskExecutor
+        Yields ``(k, arrays)`` from ``map_slabs(cfg, slabs, todo)``.
+    sink : object with ``put(k, i0, i1, arrays)``
+        Stores a finished slab.
+    progress : callable, optional
+        Called with the number of designs each stored slab adds.
+
+    Returns
+    -------
+    RunStats
+        ``stopped`` is True when Ctrl-C or SIGTERM ended the loop early.
+    """
+    per_radius = cfg.n_designs // cfg.shape[0]
+    stats = RunStats(done=set(), computed=0, seconds=0.0, stopped=False)
+    term = []
+
+    def on_term(signum, frame):
+        term.append(signum)  # a raise that lands in a weakref callback is swallowed;
+        raise _Stop()        # the loop below then stops after the slab it is storing
+
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, on_term) if in_main else None
+    t0 = time.perf_counter()
+    try:
+        for k, arrays in executor.map_slabs(cfg, slabs, todo):
+            i0, i1 = slabs[k]
+            sink.put(k, i0, i1, arrays)
+            stats.done.add(k)
+            stats.computed += (i1 - i0) * per_radius
+            if progress is not None:
+                progress((i1 - i0) * per_radius)
+            if term:
+                raise _Stop()
+    except (KeyboardInterrupt, _Stop):
+        stats.stopped = True
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+        stats.seconds = time.perf_counter() - t0
+    return stats
+
+
+class MemorySink:
+    """Collects a sweep's slabs into arrays; :meth:`dataset` makes the cube."""
+
+    def __init__(self, cfg: ResolvedConfig):
+        from ..variables import CURVES, DESIGN
+
+        self.cfg = cfg
+        self.coords = coords(cfg)
+        sizes = {k: len(v) for k, v in self.coords.items()}
+        self.variables = {**DESIGN, **CURVES}
+        self.data = {name: np.empty([sizes[d] for d in v.dims], dtype=v.dtype)
+                     for name, v in self.variables.items()}
+        self.data.update(global_arrays(cfg))
+        self.done = np.zeros(sizes["radius"], np.int8)
+
+    def put(self, k, i0, i1, arrays):
+        for name, arr in arrays.items():
+            self.data[name][i0:i1] = arr
+        self.done[i0:i1] = 1
+
+    def dataset(self, attrs: dict):
+        """The cube as an :class:`xarray.Dataset` (every variable with its registry attrs)."""
+        import xarray as xr
+
+        from ..variables import COORDS, slab_done_attrs
+
+        ds = xr.Dataset(
+            {name: (v.dims, self.data[name], v.attrs()) for name, v in self.variables.items()},
+            coords={name: (name, values, COORDS[name].attrs())
+                    for name, values in self.coords.items()},
+            attrs=attrs)
+        ds["slab_done"] = ("radius", self.done, slab_done_attrs())
+        return ds

@@ -1,0 +1,42 @@
+"""Named records that the kernels take instead of long positional argument lists.
+
+Plain :func:`collections.namedtuple` types: Numba passes them into jitted code as tuples
+with named fields, so a kernel reads ``silicone.mu`` or ``nodes.phi_trig``. Every array field is
+float64 unless said otherwise; SI units.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+__all__ = ["CoilTable", "GridAxes", "GridOut", "Nodes", "Ogden", "PointDesigns", "PointOut"]
+
+#: Ogden constants of one silicone: ``mu`` [Pa] and ``alpha`` [-], one entry per term.
+#: The pointwise kernel takes 2-D arrays (sample, term) with one row or one row a design.
+Ogden = namedtuple("Ogden", "mu alpha")
+
+#: Gauss-Legendre nodes and weights on [-1, 1] of the material moment: the base layer's
+#: and each half disc's (``physics.bending.quadrature_nodes``).
+Nodes = namedtuple("Nodes", "x_base w_base phi_trig w_phi")
+
+#: The axes of a slab of the design grid: ``radius`` (the slab's radii), ``wall``,
+#: ``length``, ``wrap`` [m, m, m, rad]; ``base_thickness`` [m] (<= 0: b = t); the curve axes
+#: ``stroke`` [-] and ``pressure`` [Pa]; ``p_atm`` the initial chamber pressure [Pa].
+GridAxes = namedtuple("GridAxes", "radius wall length wrap base_thickness stroke pressure p_atm")
+
+#: Per coil index: ``s_max`` [-], ``force_limit`` F_lim [N], ``width`` of the coiled muscle
+#: [m]. The grid kernel takes one entry a coil index of the axis, the pointwise kernel one
+#: a design.
+CoilTable = namedtuple("CoilTable", "s_max force_limit width")
+
+#: Output arrays of the grid kernel: ``design`` (float design variables, the registry's
+#: order less ``limit``, then the slab's design shape), ``limit`` (int8), ``nylon_force``,
+#: ``bend_angle``, ``tip_force`` (the registry's dims).
+GridOut = namedtuple("GridOut", "design limit nylon_force bend_angle tip_force")
+
+#: Scattered designs, one entry each: ``radius``, ``wall``, ``base``, ``length`` [m],
+#: ``wrap`` [rad].
+PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
+
+#: Output of the pointwise kernel: ``design`` (float variables, shape (8, n)) and ``limit``.
+PointOut = namedtuple("PointOut", "design limit")

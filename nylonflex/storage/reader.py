@@ -1,0 +1,113 @@
+"""Reading cubes: open one lazily as an xarray Dataset, its attributes, a summary."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..units import InputError
+from ..variables import AXES, CURVES, DESIGN
+from .journal import Journal
+
+__all__ = ["cube_attrs", "cube_summary", "open_cube"]
+
+
+def cube_attrs(path) -> dict | None:
+    """Global attributes of a nylonflex cube file, or None if it is not one."""
+    import h5py
+
+    path = Path(path)
+    if not path.is_file() or not h5py.is_hdf5(path):
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    except OSError:
+        return None
+    return attrs if attrs.get("nylonflex_cube") else None
+
+
+def _attr(v):
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.ndarray) and v.size == 1:
+        return v.item()
+    return v
+
+
+def open_cube(path, *, quiet: bool = False):
+    """Open a cube written by ``nylonflex sweep`` as an :class:`xarray.Dataset` (lazy).
+
+    An incomplete cube (a sweep stopped early) opens with a warning, its missing radii
+    masked (NaN; ``limit`` then reads as float).
+
+    Raises
+    ------
+    InputError
+        The path is missing, not HDF5, or not a nylonflex cube.
+    """
+    import xarray as xr
+
+    path = Path(path)
+    if not path.exists():
+        parts = Journal(path)
+        extra = (f"; an interrupted run's slabs are in {parts.dir} (finish it with "
+                 "'nylonflex sweep CONFIG --resume')") if parts.exists() else ""
+        raise InputError(f"{path}: no such cube{extra}")
+    attrs = cube_attrs(path)
+    if attrs is None:
+        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
+                         "written by 'nylonflex sweep')")
+    ds = xr.open_dataset(path, engine="h5netcdf")
+    if attrs.get("complete") != "true":
+        done = ds["slab_done"].values.astype(bool)
+        if not quiet:
+            warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
+                          "computed; the rest is masked", stacklevel=2)
+        mask = xr.DataArray(done, dims=("radius",), coords={"radius": ds["radius"]})
+        for name in list(DESIGN) + list(CURVES):
+            if "radius" in ds[name].dims:
+                ds[name] = ds[name].where(mask)
+    return ds
+
+
+def cube_summary(path) -> list[str]:
+    """Lines that describe a cube: dims, ranges, variables, provenance, completeness."""
+    from ..variables import VARIABLES, to_display
+
+    path = Path(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = open_cube(path, quiet=True)
+    a = ds.attrs
+    out = []
+    complete = a.get("complete") == "true"
+    done = int(ds["slab_done"].sum())
+    out.append(f"cube      {path}")
+    out.append(f"name      {a.get('name')}   config sha256 {a.get('config_sha256', '')[:16]}")
+    out.append(f"status    {'complete' if complete else 'INCOMPLETE'} "
+               f"({done}/{ds.sizes['radius']} radii)")
+    n = int(np.prod([ds.sizes[d] for d in AXES]))
+    out.append(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES))
+    out.append("axes")
+    for name in (*AXES, "stroke", "pressure"):
+        v = VARIABLES[name]
+        vals = to_display(name, ds[name].values)
+        unit = "" if v.display == "1" else f" {v.display}"
+        out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})")
+    out.append("variables")
+    for name in ds.data_vars:
+        if name == "slab_done":
+            continue
+        out.append(f"  {name:<18} ({', '.join(ds[name].dims)}) [{ds[name].attrs.get('units')}] "
+                   f"{ds[name].attrs.get('long_name')}")
+    out.append("provenance")
+    for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
+                "quadrature", "created", "run_seconds", "designs_per_second", "workers",
+                "scheduler"):
+        if key in a:
+            out.append(f"  {key:<18} {a[key]}")
+    ds.close()
+    return out

@@ -1,0 +1,129 @@
+"""The engine: the compiled pointwise evaluator against the uncompiled physics loop, and the
+grid engine against a cube written before the rewrite (bit for bit)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import nylonflex as nf
+from nylonflex.bench import random_designs
+from nylonflex.engine.pointwise import _interp
+from nylonflex.physics import design_limits as python_loop
+from nylonflex.variables import DESIGN
+
+DATA = Path(__file__).parent / "data"
+
+
+def _rel(a, b):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-300)))
+
+
+def test_evaluate_matches_the_python_loop_over_the_whole_accepted_range():
+    # 1,500 designs over every axis's accepted range (registry), against the same formulas
+    # run uncompiled one design at a time; the issue asks 1e-12, the code gives 0
+    d = random_designs(1500, seed=7)
+    fast = nf.evaluate(**d)
+    slow = python_loop(*d.values())
+    assert list(fast) == list(DESIGN)
+    for name in DESIGN:
+        assert fast[name].shape == (1500,)
+        assert _rel(fast[name], slow[name]) <= 1e-12, name
+    assert fast["limit"].dtype == np.int8
+    assert 0.2 < fast["limit"].mean() < 0.95  # both branches are exercised
+
+
+def test_per_design_ogden_arrays_are_one_call():
+    d = {k: v[:60] for k, v in random_designs(60, seed=3).items()}
+    rng = np.random.default_rng(1)
+    mu = np.array([56.19e3, 10.49e3]) * rng.uniform(0.7, 1.3, (60, 2))
+    alpha = np.array([0.2975, 2.770]) * rng.uniform(0.9, 1.1, (60, 2))
+    fast = nf.evaluate(**d, silicone={"set": "tc5005", "mu": mu, "alpha": alpha})
+    for i in range(60):
+        one = python_loop(*(v[i] for v in d.values()),
+                          silicone={"set": "tc5005", "mu": list(mu[i]), "alpha": list(alpha[i])})
+        for name in DESIGN:
+            assert _rel(fast[name][i], one[name]) <= 1e-12, (i, name)
+
+
+def test_material_arrays_broadcast_against_the_designs():
+    # one design, 5 silicone samples -> shape (5,); 3 radii x 5 samples -> (3, 5)
+    mu = np.array([56.19e3, 10.49e3]) * np.linspace(0.8, 1.2, 5)[:, None]
+    one = nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.7, 0.1396, silicone={"set": "tc5005", "mu": mu})
+    assert one["tip_force_max"].shape == (5,)
+    grid = nf.evaluate(np.array([6e-3, 7.5e-3, 9e-3])[:, None], 2e-3, 70e-3, 1.7, 0.1396,
+                       silicone={"set": "tc5005", "mu": mu})
+    assert grid["tip_force_max"].shape == (3, 5)
+    np.testing.assert_array_equal(grid["tip_force_max"][1], one["tip_force_max"])
+    # a stiffer silicone resists more: the usable stroke (stroke-limited) stays, the angle drops
+    assert np.all(np.diff(one["bend_angle_max"]) < 0)
+
+
+def test_per_design_coil_index_tables():
+    smax = np.array([0.054, 0.068, 0.083, 0.097]) * np.array([[0.9], [1.0], [1.1]])
+    fast = nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.45, 0.1396,
+                       nylon={"set": "silver_nylon66", "stroke_max_table": smax})
+    for i in range(3):
+        one = python_loop(7.5e-3, 2e-3, 70e-3, 1.45, 0.1396,
+                          nylon={"set": "silver_nylon66", "stroke_max_table": list(smax[i])})
+        for name in DESIGN:
+            assert _rel(fast[name][i], one[name]) <= 1e-12, (i, name)
+
+
+def test_design_limits_is_the_scalar_face_of_evaluate():
+    # paper section 4, example 2: 0.150 N, stroke-limited (docs/model.md s. 8)
+    out = nf.design_limits(7.5e-3, 2e-3, 70e-3, 1.7, np.radians(8.0))
+    assert isinstance(out["tip_force_max"], float) and isinstance(out["limit"], int)
+    assert out["tip_force_max"] == pytest.approx(0.15007, rel=1e-4)
+    assert out["limit"] == 0
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(radius=7.5), r"radius: .*7.5 looks like mm"),
+    (dict(coil_index=2.5), r"coil_index: must be in \[1.1, 1.7\]"),
+    (dict(silicone={"set": "tc5005", "mu": np.full((3, 2), -1.0)}), r"silicone.mu: initial"),
+    (dict(silicone={"set": "tc5005", "mu": np.full((3, 3), 1e3)}), r"silicone.mu/alpha"),
+    (dict(nylon={"set": "silver_nylon66", "stroke_max_table": np.full((2, 4), 1.5)}),
+     r"nylon.stroke_max_table"),
+    (dict(model="magic"), r"model: unknown model 'magic'; accepted: paper"),
+])
+def test_bad_input_is_one_line_naming_the_parameter(kwargs, match):
+    d = dict(radius=7.5e-3, wall_thickness=2e-3, length=70e-3, coil_index=1.7,
+             wrap_angle=0.1396)
+    d.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        nf.evaluate(**d)
+
+
+def test_designs_that_do_not_broadcast_are_refused():
+    with pytest.raises(ValueError, match="do not broadcast"):
+        nf.evaluate(np.full(3, 7e-3), np.full(4, 2e-3), 70e-3, 1.7, 0.14)
+
+
+def test_interp_of_per_design_tables_is_numpys_bit_for_bit():
+    xp = np.array([1.1, 1.3, 1.5, 1.7])
+    fp = np.array([0.054, 0.068, 0.083, 0.097])
+    x = np.concatenate([xp, np.linspace(1.1, 1.7, 97)])
+    rows = np.broadcast_to(xp, (x.size, 4))
+    vals = np.broadcast_to(fp, (x.size, 4))
+    np.testing.assert_array_equal(_interp(x, rows, vals), np.interp(x, xp, fp))
+
+
+def test_the_grid_engine_writes_the_cube_the_code_wrote_before_the_rewrite():
+    # tests/data/reference_cube.h5 was written by nylonflex 0.1.0 (before the engine
+    # rewrite) from reference_cube.yaml; every variable it has must come out identical
+    import xarray as xr
+
+    cfg = nf.load_config(DATA / "reference_cube.yaml")
+    new = nf.run_sweep(cfg)
+    with xr.open_dataset(DATA / "reference_cube.h5", engine="h5netcdf") as old:
+        for name in old.variables:
+            np.testing.assert_array_equal(new[name].values, old[name].values, err_msg=name)
+            assert new[name].attrs.get("units") == old[name].attrs.get("units"), name
+        assert old.attrs["config_sha256"] == new.attrs["config_sha256"]
+    # what the cube stores now beside them: s_max per coil index, for the charts
+    np.testing.assert_array_equal(new["stroke_max"].values,
+                                  np.interp(cfg.axes["coil_index"],
+                                            cfg.nylon.coil_index_table,
+                                            cfg.nylon.stroke_max_table))
