@@ -197,7 +197,7 @@ def range_error(field: str, lo, hi, display_unit: str, got, lo_open: bool = Fals
     elif hi is not None:
         rng = f"{'<' if hi_open else '<='} {show(hi)}"
     else:
-        rng = "finite"
+        return InputError(f"{field}: must be finite, got {show(got)}{unit}")
     return InputError(f"{field}: must be {rng}{unit}, got {show(got)}{unit}")
 
 
