@@ -12,17 +12,19 @@ import copy
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Tag, ValidationError, field_validator, \
+    model_validator
 
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .units import InputError, from_si, parse_quantity, to_si
 from .variables import INPUTS, VARIABLES
 
-__all__ = ["CHARTS", "SweepConfig", "apply_overrides", "load_config", "parse_config"]
+__all__ = ["CHARTS", "SweepConfig", "apply_overrides", "check_range", "load_config",
+           "parse_config", "range_error"]
 
 #: Figures a sweep config may name under ``charts``.
 CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map")
@@ -100,13 +102,12 @@ class SweepConfig(_Strict):
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
     slab_megabytes: float = 16.0
 
-    @model_validator(mode="after")
-    def _name(self):
-        if not valid_name(self.name):
-            raise ValueError("name: letters, digits, '-', '_' and '.' only")
-        if not 1.0 <= self.slab_megabytes <= 4096.0:
-            raise ValueError("slab_megabytes: must be in [1, 4096]")
-        return self
+    @field_validator("name")
+    @classmethod
+    def _name(cls, name):
+        if not valid_name(name):
+            raise ValueError("letters, digits, '-', '_' and '.' only")
+        return name
 
 
 @dataclass(frozen=True)
@@ -158,20 +159,184 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
-def _pydantic_message(err: ValidationError) -> str:
+def range_error(field: str, lo, hi, display_unit: str, got, lo_open: bool = False,
+                hi_open: bool = False) -> InputError:
+    """The one-line refusal of a value outside its range, shown in display units.
+
+    Parameters
+    ----------
+    field : str
+        The dotted field, e.g. ``grid.radius.stop``.
+    lo, hi : float or int or None
+        Accepted range, SI [unit of the quantity]; None: unbounded on that side.
+    display_unit : str
+        Unit to show the range and the value in (``"1"``: none shown).
+    got : float or int
+        The refused value, SI [unit of the quantity].
+    lo_open, hi_open : bool
+        Whether the bound itself is refused.
+
+    Returns
+    -------
+    InputError
+        ``grid.radius.stop: must be in [0.5, 200] mm, got 900 mm``.
+    """
+    def show(x):
+        if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
+            return str(int(x))  # counts and seeds: every digit
+        return f"{from_si(x, display_unit):g}"
+
+    unit = "" if display_unit in ("1", "", None) else f" {display_unit}"
+    if lo is not None and hi is not None:
+        rng = f"in {'(' if lo_open else '['}{show(lo)}, {show(hi)}{')' if hi_open else ']'}"
+    elif lo is not None:
+        rng = f"{'>' if lo_open else '>='} {show(lo)}"
+    elif hi is not None:
+        rng = f"{'<' if hi_open else '<='} {show(hi)}"
+    else:
+        return InputError(f"{field}: must be finite, got {show(got)}{unit}")
+    return InputError(f"{field}: must be {rng}{unit}, got {show(got)}{unit}")
+
+
+def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
+                display_unit: str | None = None, *, lo_open: bool = False,
+                hi_open: bool = False, slack: float = 0.0) -> float:
+    """Parse a quantity (``"7.5 mm"`` or a bare number in ``unit``) to SI and check its range.
+
+    Parameters
+    ----------
+    raw : str or float
+        The value as the user typed it [``unit`` when bare].
+    field : str
+        The dotted field, for messages.
+    kind : str
+        The quantity's kind (``"length"``, ``"angle"``, ...).
+    unit : str
+        Unit of a bare number.
+    lo, hi : float or None
+        Accepted range, SI [unit of the quantity]; None: unbounded on that side.
+    display_unit : str or None
+        Unit of the message; ``unit`` when None.
+    lo_open, hi_open : bool
+        Whether the bound itself is refused.
+    slack : float
+        Tolerance on a closed bound, SI; a value within it is clamped onto the bound.
+
+    Returns
+    -------
+    float
+        The value in SI, within [lo, hi].
+
+    Raises
+    ------
+    InputError
+        Not a number, a unit of another kind, or out of range: one line naming ``field``.
+    """
+    value = float(parse_quantity(raw, field, kind, unit))
+    ok = math.isfinite(value)
+    if lo is not None:
+        ok = ok and (value > lo if lo_open else value >= lo - slack)
+    if hi is not None:
+        ok = ok and (value < hi if hi_open else value <= hi + slack)
+    if not ok:
+        raise range_error(field, lo, hi, display_unit or unit, value, lo_open, hi_open)
+    if lo is not None and not lo_open:
+        value = max(value, lo)
+    if hi is not None and not hi_open:
+        value = min(value, hi)
+    return value
+
+
+def _strip(tp):
+    """A type without its Annotated metadata and without None in a union."""
+    while get_origin(tp) is Annotated:
+        tp = get_args(tp)[0]
+    if get_origin(tp) in (Union, type(int | None)):
+        args = [a for a in get_args(tp) if a is not type(None)]
+        if len(args) == 1:
+            return _strip(args[0])
+    return tp
+
+
+def _union_member(tp, tag):
+    """The member of a union that pydantic's location ``tag`` names, or None."""
+    for member in get_args(tp):
+        meta = get_args(member)[1:] if get_origin(member) is Annotated else ()
+        base = _strip(member)
+        tags = {m.tag for m in meta if isinstance(m, Tag)}
+        if isinstance(base, type) and issubclass(base, BaseModel):
+            tags.add(base.__name__)
+            kind = base.model_fields.get("kind")
+            if kind is not None and get_origin(kind.annotation) is Literal:
+                tags.update(get_args(kind.annotation))
+        if tag in tags:
+            return base
+    return None
+
+
+def _walk(model, loc):
+    """The dotted path (``actuators[0].design.radius``) of a pydantic location, and the
+    type it ends at (None when unknown); union members' tags are not part of the path."""
+    path, tp = "", model
+    for part in loc:
+        tp = _strip(tp)
+        if get_origin(tp) in (Union, type(int | None)):
+            tp = _union_member(tp, part)  # a union's tag: not a key the user typed
+            continue
+        if isinstance(part, int):
+            path += f"[{part}]"
+            args = get_args(tp)
+            tp = args[0] if get_origin(tp) in (list, tuple) and args else None
+            continue
+        path += f".{part}" if path else str(part)
+        if isinstance(tp, type) and issubclass(tp, BaseModel) and part in tp.model_fields:
+            tp = tp.model_fields[part].annotation
+        elif get_origin(tp) is dict:
+            tp = get_args(tp)[1]
+        else:
+            tp = None
+    return path, _strip(tp) if tp is not None else None
+
+
+_TYPE_MESSAGES = {
+    "model_type": "must be a mapping of keys",
+    "model_attributes_type": "must be a mapping of keys",
+    "dict_type": "must be a mapping of keys",
+    "list_type": "must be a list",
+    "int_type": "must be an integer",
+    "int_from_float": "must be an integer",
+    "string_type": "must be a string",
+}
+
+
+def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
+    """One line for the first error of a validation against ``model``: the dotted field and
+    what it accepts."""
     e = err.errors()[0]
-    loc = ".".join(str(x) for x in e["loc"] if not str(x).startswith(("function-after",
-                                                                       "literal[", "str")))
+    path, tp = _walk(model, e["loc"])
     msg = e["msg"].removeprefix("Value error, ")
-    if e["type"] == "extra_forbidden":
-        msg = "unknown key"
-    elif e["type"] == "missing":
-        msg = "missing key"
-    elif e["type"] == "literal_error":
-        msg = msg.replace("Input should be", "must be one of")
     got = e.get("input")
-    tail = "" if e["type"] == "missing" or isinstance(got, dict) else f", got {got!r}"
-    return f"{loc or 'config'}: {msg}{tail}"
+    tail = "" if isinstance(got, dict) else f", got {got!r}"
+    kind = e["type"]
+    if kind == "extra_forbidden":
+        parent = _walk(model, e["loc"][:-1])[1]
+        keys = sorted(parent.model_fields) if isinstance(parent, type) and \
+            issubclass(parent, BaseModel) else []
+        msg, tail = "unknown key" + (f"; accepted: {', '.join(keys)}" if keys else ""), ""
+    elif kind == "missing":
+        msg, tail = "missing key", ""
+    elif kind == "literal_error":
+        msg = msg.replace("Input should be", "must be one of")
+    elif kind in ("union_tag_invalid", "union_tag_not_found"):
+        key = e["ctx"]["discriminator"].strip("'")
+        path = f"{path}.{key}" if path else key
+        tags = [t for m in get_args(tp) for t in get_args(_strip(m).model_fields[key].annotation)]
+        msg = f"must be one of {', '.join(tags)}"
+        tail = f", got {e['ctx']['tag']!r}" if kind == "union_tag_invalid" else ""
+        msg = msg if tail else f"missing key; accepted: {', '.join(tags)}"
+    else:
+        msg = _TYPE_MESSAGES.get(kind, msg)
+    return f"{path or 'config'}: {msg}{tail}"
 
 
 def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
@@ -182,13 +347,7 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
         lo, hi = nylon.coil_index_range
 
     def value(text, field):
-        v = parse_quantity(text, field, kind, units)
-        if not (np.isfinite(v) and lo - 1e-12 <= v <= hi + 1e-12):
-            rng = f"[{from_si(lo, shown):g}, {from_si(hi, shown):g}]"
-            unit_txt = "" if shown == "1" else f" {shown}"
-            raise InputError(f"{field}: must be in {rng}{unit_txt}, got "
-                             f"{from_si(v, shown):g}{unit_txt}")
-        return min(max(v, lo), hi)
+        return check_range(text, field, kind, units, lo, hi, shown, slack=1e-12)
 
     if axis.values is not None:
         if len(axis.values) == 0:
@@ -196,7 +355,7 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
         vals = np.array([value(v, f"{path}.values[{i}]") for i, v in enumerate(axis.values)])
     else:
         if not 1 <= axis.num <= _MAX_POINTS:
-            raise InputError(f"{path}.num: must be in [1, {_MAX_POINTS}], got {axis.num}")
+            raise range_error(f"{path}.num", 1, _MAX_POINTS, "1", axis.num)
         start, stop = value(axis.start, f"{path}.start"), value(axis.stop, f"{path}.stop")
         vals = np.linspace(start, stop, axis.num) if axis.num > 1 else np.array([start])
     if len(vals) > 1 and np.any(np.diff(vals) <= 0):
@@ -217,7 +376,9 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     try:
         cfg = SweepConfig.model_validate(raw)
     except ValidationError as err:
-        raise InputError(_pydantic_message(err)) from None
+        raise InputError(_pydantic_message(err, SweepConfig)) from None
+    if not 1.0 <= cfg.slab_megabytes <= 4096.0:
+        raise range_error("slab_megabytes", 1.0, 4096.0, "1", cfg.slab_megabytes)
     try:
         silicone = silicone_parameters(cfg.silicone)
         nylon = nylon_parameters(cfg.nylon)
@@ -232,12 +393,9 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     if cfg.base_thickness == "wall":
         base = None
     else:
-        units = cfg.base_thickness.units or "mm"
-        _, _, lo, hi, _ = DESIGN_RANGES["base_thickness"]
-        base = parse_quantity(cfg.base_thickness.value, "base_thickness.value", "length", units)
-        if not lo <= base <= hi:
-            raise InputError(f"base_thickness.value: must be in [{lo * 1e3:g}, {hi * 1e3:g}] "
-                             f"mm, got {base * 1e3:g} mm")
+        kind, _, lo, hi, shown = DESIGN_RANGES["base_thickness"]
+        base = check_range(cfg.base_thickness.value, "base_thickness.value", kind,
+                           cfg.base_thickness.units or "mm", lo, hi, shown)
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, raw=copy.deepcopy(raw))

@@ -8,10 +8,11 @@ small table built once per design, and a bang-bang controller switches the suppl
 gripper of figure 10: the switched-on muscles are in parallel on it, and its terminal
 voltage sags over its internal resistance.
 
-A config (YAML) is validated here before any kernel runs; every refusal is one
-:class:`~nylonflex.units.InputError` line naming the field. :func:`run_simulation` returns
-an :class:`xarray.Dataset` in SI with ``units`` and ``long_name`` on every variable;
-:func:`simulate_command` is the ``nylonflex simulate`` entry point.
+A config (YAML) is validated by :mod:`nylonflex.simconfig` before any kernel runs (its
+names are re-exported here); every refusal is one :class:`~nylonflex.units.InputError` line
+naming the field. :func:`run_simulation` returns an :class:`xarray.Dataset` in SI with
+``units`` and ``long_name`` on every variable; :func:`summary` gives the lines the
+``nylonflex simulate`` command prints.
 
 Overheating [choice]: the temperature is not clamped. Above T_max the stroke keeps
 following the same eq. (2) shape (a little past s_max(C)); the run records the highest
@@ -21,25 +22,28 @@ breaking force, and the summary warns.
 
 from __future__ import annotations
 
-import copy
 import math
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import yaml
 
 from . import __version__
-from .config import DESIGN_RANGES, read_yaml, valid_name
-from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.bending import NEWTON_RTOL, quadrature_nodes
 from .physics.chamber import P_ATM, chamber_pressure
 from .physics.nylon import _stroke_scale, nylon_force_limit, stroke
-from .physics.thermal import muscle_resistance, steady_temperature
-from .physics.wrap import muscle_length, nylon_force
-from .units import InputError, from_si, parse_quantity
+from .physics.wrap import nylon_force
+from .simconfig import (  # noqa: F401 - the config layer's names, importable from here too
+    DEFAULTS,
+    ActuatorSpec,
+    Reference,
+    SimConfig,
+    actuator_muscle_length,
+    load_sim_config,
+    parse_sim_config,
+    top_temperature,
+)
 
 __all__ = [
     "PLANT_TABLE_POINTS",
@@ -59,9 +63,6 @@ __all__ = [
 #: Points of the plant's angle-pressure table (cubic Hermite on exact values and slopes):
 #: below 1e-11 relative to the curvature solve for the default design (tests).
 PLANT_TABLE_POINTS = 513
-
-#: Largest number of samples times actuators of one run (8 float64 series each).
-_MAX_SAMPLES = 20_000_000
 
 #: Output variables: name -> (units, long_name). Every time series has dims
 #: (actuator, time), squeezed to (time,) for a single actuator.
@@ -94,418 +95,8 @@ SIM_METRICS: dict[str, tuple[str, str]] = {
 }
 
 # ---------------------------------------------------------------------------------------
-# config
-# ---------------------------------------------------------------------------------------
-
-#: MODEL.md section 10: the default design, supply and timing.
-DEFAULTS: dict[str, Any] = {
-    "silicone": "tc5005",
-    "nylon": "silver_nylon66",
-    "design": {"radius": "7.5 mm", "wall_thickness": "2 mm", "length": "70 mm",
-               "coil_index": 1.7, "wrap_angle": "8 deg", "base_thickness": "wall"},
-    "supply": {"voltage": "12 V", "internal_resistance": "0 ohm"},
-    "time": {"duration": "120 s", "step": "10 ms"},
-    "sensor": {"noise": "0 kPa", "seed": 0},
-    "estimator": {"table_points": 65, "filter_time_constant": "0 s"},
-    "controller": {"hysteresis": "0 deg"},
-}
-
-_TOP_KEYS = {"name", "silicone", "nylon", "design", "supply", "time", "initial_temperature",
-             "sensor", "estimator", "controller", "reference", "metrics", "actuators",
-             "description"}
-_ACTUATOR_KEYS = {"name", "silicone", "nylon", "design", "initial_temperature", "sensor",
-                  "estimator", "controller", "reference", "metrics"}
-_SECTION_KEYS = {
-    "design": {"radius", "wall_thickness", "length", "coil_index", "wrap_angle",
-               "base_thickness"},
-    "supply": {"voltage", "internal_resistance"},
-    "time": {"duration", "step"},
-    "sensor": {"noise", "seed"},
-    "estimator": {"table_points", "filter_time_constant"},
-    "controller": {"hysteresis"},
-    "metrics": {"rms_from"},
-}
-_REFERENCE_KEYS = {
-    "sine": {"kind", "mean", "amplitude", "frequency", "phase"},
-    "step": {"kind", "initial", "final", "at"},
-    "schedule": {"kind", "times", "angles", "interpolation"},
-}
-
-@dataclass(frozen=True)
-class Reference:
-    """A reference angle schedule, SI.
-
-    Attributes
-    ----------
-    kind : str
-        ``"sine"``, ``"step"`` or ``"schedule"``.
-    params : dict
-        sine: ``mean``, ``amplitude`` [rad], ``frequency`` [Hz], ``phase`` [rad];
-        step: ``initial``, ``final`` [rad], ``at`` [s];
-        schedule: ``times`` [s], ``angles`` [rad], ``interpolation`` (hold or linear).
-    """
-
-    kind: str
-    params: dict
-
-    @property
-    def span(self) -> float:
-        """The reference's size [rad]: sine amplitude, step height or schedule range."""
-        p = self.params
-        if self.kind == "sine":
-            return p["amplitude"]
-        if self.kind == "step":
-            return abs(p["final"] - p["initial"])
-        return float(np.ptp(p["angles"]))
-
-
-@dataclass(frozen=True)
-class ActuatorSpec:
-    """One actuator of a simulation, SI: design, materials, loop settings and reference."""
-
-    name: str
-    radius: float
-    wall_thickness: float
-    length: float
-    coil_index: float
-    wrap_angle: float
-    base_thickness: float
-    silicone: Silicone
-    nylon: Nylon
-    initial_temperature: float
-    noise: float
-    seed: int
-    table_points: int
-    filter_time_constant: float
-    hysteresis: float
-    reference: Reference
-    rms_from: float
-
-
-@dataclass(frozen=True)
-class SimConfig:
-    """A validated simulation config: the supply, the time grid and the actuators (SI).
-
-    ``text`` is the resolved config as YAML (SI), written into the output file.
-    """
-
-    name: str
-    supply_voltage: float
-    internal_resistance: float
-    duration: float
-    step: float
-    actuators: tuple[ActuatorSpec, ...]
-    gripper: bool
-    raw: dict = field(compare=False, repr=False)
-
-    @property
-    def n_steps(self) -> int:
-        """Number of samples, t = 0, dt, ..., up to the duration [-]."""
-        return int(math.floor(self.duration / self.step + 1e-9)) + 1
-
-    @property
-    def text(self) -> str:
-        return yaml.safe_dump(_resolved_doc(self), sort_keys=False, width=100)
-
-
-def _resolved_doc(cfg: SimConfig) -> dict:
-    acts = []
-    for a in cfg.actuators:
-        acts.append({
-            "name": a.name,
-            "design": {k: getattr(a, k) for k in ("radius", "wall_thickness", "length",
-                                                  "coil_index", "wrap_angle",
-                                                  "base_thickness")},
-            "silicone": a.silicone.to_dict(),
-            "nylon": a.nylon.to_dict(),
-            "initial_temperature": a.initial_temperature,
-            "sensor": {"noise": a.noise, "seed": a.seed},
-            "estimator": {"table_points": a.table_points,
-                          "filter_time_constant": a.filter_time_constant},
-            "controller": {"hysteresis": a.hysteresis},
-            "reference": {"kind": a.reference.kind,
-                          **{k: (list(map(float, v)) if isinstance(v, (list, tuple,
-                                                                      np.ndarray)) else v)
-                             for k, v in a.reference.params.items()}},
-            "metrics": {"rms_from": a.rms_from},
-        })
-    return {"name": cfg.name,
-            "supply": {"voltage": cfg.supply_voltage,
-                       "internal_resistance": cfg.internal_resistance},
-            "time": {"duration": cfg.duration, "step": cfg.step},
-            "actuators": acts,
-            "units": "SI (m, rad, s, K, Pa, V, ohm)"}
-
-
-def _mapping(value, path) -> dict:
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise InputError(f"{path}: must be a mapping of keys, got {value!r}")
-    return value
-
-
-def _known(d: dict, allowed, path):
-    for key in d:
-        if key not in allowed:
-            raise InputError(f"{path}.{key}: unknown key; accepted: "
-                             f"{', '.join(sorted(allowed))}" if path else
-                             f"{key}: unknown key; accepted: {', '.join(sorted(allowed))}")
-
-
-def _quantity(raw, path, kind, unit, lo=None, hi=None, *, lo_open=False, show=None) -> float:
-    """Parse ``"7.5 mm"``, a bare number (in ``unit``) or ``{value, units}`` to SI, in range."""
-    if isinstance(raw, dict):
-        _known(raw, {"value", "units"}, path)
-        if "value" not in raw:
-            raise InputError(f"{path}.value: missing key")
-        raw = f"{raw['value']} {raw.get('units', unit)}"
-    if isinstance(raw, bool) or raw is None or isinstance(raw, (list, dict)):
-        raise InputError(f"{path}: expected a number with an optional unit ({unit}), "
-                         f"got {raw!r}")
-    value = float(parse_quantity(raw, path, kind, unit))
-    show = show or unit
-    bad = not math.isfinite(value)
-    if lo is not None:
-        bad |= value <= lo if lo_open else value < lo
-    if hi is not None:
-        bad |= value > hi
-    if bad:
-        lo_s = "" if lo is None else f"{from_si(lo, show):g}"
-        hi_s = "" if hi is None else f"{from_si(hi, show):g}"
-        if lo is not None and hi is not None:
-            rng = f"in {'(' if lo_open else '['}{lo_s}, {hi_s}] {show}"
-        elif lo is not None:
-            rng = f"{'>' if lo_open else '>='} {lo_s} {show}"
-        else:
-            rng = f"<= {hi_s} {show}"
-        raise InputError(f"{path}: must be {rng}, got {raw!r}")
-    return value
-
-
-def _integer(raw, path, lo, hi) -> int:
-    if isinstance(raw, bool) or not isinstance(raw, int) or not lo <= raw <= hi:
-        raise InputError(f"{path}: must be an integer in [{lo}, {hi}], got {raw!r}")
-    return raw
-
-
-def _angle_list(raw, path, kind, unit):
-    if not isinstance(raw, list) or len(raw) == 0:
-        raise InputError(f"{path}: must be a non-empty list, got {raw!r}")
-    return [_quantity(v, f"{path}[{i}]", kind, unit) for i, v in enumerate(raw)]
-
-
-def _reference(raw, path, duration) -> Reference:
-    raw = _mapping(raw, path)
-    if not raw:
-        raise InputError(f"{path}: missing; give kind: sine, step or schedule")
-    kind = raw.get("kind")
-    if kind not in _REFERENCE_KEYS:
-        raise InputError(f"{path}.kind: must be one of sine, step, schedule, got {kind!r}")
-    _known(raw, _REFERENCE_KEYS[kind], path)
-    big = math.radians(360.0)
-    if kind == "sine":
-        for key in ("mean", "amplitude", "frequency"):
-            if key not in raw:
-                raise InputError(f"{path}.{key}: missing key")
-        p = {"mean": _quantity(raw["mean"], f"{path}.mean", "angle", "deg", 0.0, big),
-             "amplitude": _quantity(raw["amplitude"], f"{path}.amplitude", "angle", "deg",
-                                    0.0, big),
-             "frequency": _quantity(raw["frequency"], f"{path}.frequency", "frequency",
-                                    "Hz", 0.0, 100.0, lo_open=True),
-             "phase": _quantity(raw.get("phase", 0.0), f"{path}.phase", "angle", "deg",
-                                -big, big)}
-        if p["amplitude"] > p["mean"]:
-            raise InputError(f"{path}.amplitude: must be <= mean so the angle stays >= 0 deg, "
-                             f"got {raw['amplitude']!r}")
-        return Reference("sine", p)
-    if kind == "step":
-        if "final" not in raw:
-            raise InputError(f"{path}.final: missing key")
-        p = {"initial": _quantity(raw.get("initial", 0.0), f"{path}.initial", "angle", "deg",
-                                  0.0, big),
-             "final": _quantity(raw["final"], f"{path}.final", "angle", "deg", 0.0, big),
-             "at": _quantity(raw.get("at", 0.0), f"{path}.at", "time", "s", 0.0, duration)}
-        if p["final"] == p["initial"]:
-            raise InputError(f"{path}.final: must differ from initial, got {raw['final']!r}")
-        return Reference("step", p)
-    for key in ("times", "angles"):
-        if key not in raw:
-            raise InputError(f"{path}.{key}: missing key")
-    times = _angle_list(raw["times"], f"{path}.times", "time", "s")
-    angles = _angle_list(raw["angles"], f"{path}.angles", "angle", "deg")
-    if len(times) != len(angles):
-        raise InputError(f"{path}.angles: needs one angle per time ({len(times)}), "
-                         f"got {len(angles)}")
-    if any(b <= a for a, b in zip(times, times[1:])) or times[0] < 0.0:
-        raise InputError(f"{path}.times: must be >= 0 s and strictly increasing, "
-                         f"got {raw['times']!r}")
-    for i, a in enumerate(angles):
-        if not 0.0 <= a <= big:
-            raise InputError(f"{path}.angles[{i}]: must be in [0, 360] deg, "
-                             f"got {raw['angles'][i]!r}")
-    interp = raw.get("interpolation", "hold")
-    if interp not in ("hold", "linear"):
-        raise InputError(f"{path}.interpolation: must be one of hold, linear, got {interp!r}")
-    return Reference("schedule", {"times": times, "angles": angles, "interpolation": interp})
-
-
-def _section(top: dict, own: dict, key: str, path: str) -> dict:
-    """Defaults, then the top-level section, then the actuator's own: key by key."""
-    merged = dict(DEFAULTS.get(key, {}))
-    for src, where in ((top, key), (own, path)):
-        sec = _mapping(src.get(key), where)
-        _known(sec, _SECTION_KEYS[key], where)
-        merged.update(sec)
-    return merged
-
-
-def _actuator(top: dict, own: dict, path: str, duration: float, dt: float, index: int,
-              name: str) -> ActuatorSpec:
-    pre = f"{path}." if path else ""
-    try:
-        sil = silicone_parameters(own.get("silicone", top.get("silicone",
-                                                               DEFAULTS["silicone"])))
-        ny = nylon_parameters(own.get("nylon", top.get("nylon", DEFAULTS["nylon"])))
-    except ValueError as exc:  # the material sets name their own field
-        raise InputError(f"{pre}{exc}") from None
-    d = _section(top, own, "design", f"{pre}design")
-    vals = {}
-    for key in ("radius", "wall_thickness", "length", "wrap_angle"):
-        kind, unit, lo, hi, _ = DESIGN_RANGES[key]
-        vals[key] = _quantity(d[key], f"{pre}design.{key}", kind, unit, lo, hi)
-    lo, hi = ny.coil_index_range
-    vals["coil_index"] = _quantity(d["coil_index"], f"{pre}design.coil_index",
-                                   "dimensionless", "1", lo, hi)
-    b = d["base_thickness"]
-    if b == "wall":
-        vals["base_thickness"] = vals["wall_thickness"]
-    else:
-        kind, unit, lo, hi, _ = DESIGN_RANGES["base_thickness"]
-        vals["base_thickness"] = _quantity(b, f"{pre}design.base_thickness", kind, unit, lo,
-                                           hi)
-    t0_raw = own.get("initial_temperature", top.get("initial_temperature"))
-    t0 = ny.t_amb if t0_raw is None else _quantity(
-        t0_raw, f"{pre}initial_temperature", "temperature", "degC", ny.t_amb, ny.t_max,
-        show="degC")
-    sensor = _section(top, own, "sensor", f"{pre}sensor")
-    est = _section(top, own, "estimator", f"{pre}estimator")
-    ctl = _section(top, own, "controller", f"{pre}controller")
-    met = _section(top, own, "metrics", f"{pre}metrics")
-    ref = _reference(own.get("reference", top.get("reference")), f"{pre}reference",
-                     duration)
-    if "rms_from" in met:
-        rms_from = _quantity(met["rms_from"], f"{pre}metrics.rms_from", "time", "s", 0.0,
-                             duration)
-    else:  # the sine's first period is the warm-up from ambient (MODEL.md section 10)
-        rms_from = min(1.0 / ref.params["frequency"], duration) if ref.kind == "sine" else 0.0
-    return ActuatorSpec(
-        name=name, silicone=sil, nylon=ny, initial_temperature=t0, reference=ref,
-        noise=_quantity(sensor["noise"], f"{pre}sensor.noise", "pressure", "kPa", 0.0, 100e3),
-        seed=_integer(sensor["seed"], f"{pre}sensor.seed", 0, 2**32 - 1) + index,
-        table_points=_integer(est["table_points"], f"{pre}estimator.table_points", 2,
-                              100_000),
-        filter_time_constant=_quantity(est["filter_time_constant"],
-                                       f"{pre}estimator.filter_time_constant", "time", "s",
-                                       0.0, 3600.0),
-        hysteresis=_quantity(ctl["hysteresis"], f"{pre}controller.hysteresis", "angle", "deg",
-                             0.0, math.radians(90.0)),
-        rms_from=rms_from, **vals)
-
-
-def parse_sim_config(raw, source: str = "config") -> SimConfig:
-    """Validate a simulation config (a mapping from YAML) into a :class:`SimConfig` (SI).
-
-    Parameters
-    ----------
-    raw : dict
-        The config as read from YAML (see ``configs/control.yaml``).
-    source : str
-        What to call the config in messages.
-
-    Raises
-    ------
-    InputError
-        One line: the field as a dotted path, what it accepts and what it got.
-    """
-    if not isinstance(raw, dict):
-        raise InputError(f"{source}: must be a YAML mapping of keys (name, design, reference, "
-                         f"...)")
-    _known(raw, _TOP_KEYS, "")
-    name = raw.get("name")
-    if not valid_name(name):
-        raise InputError(f"name: letters, digits, '-', '_' and '.' only, got {name!r}")
-    supply = _section(raw, {}, "supply", "supply")
-    voltage = _quantity(supply["voltage"], "supply.voltage", "voltage", "V", 0.0, 1000.0,
-                        lo_open=True)
-    r_int = _quantity(supply["internal_resistance"], "supply.internal_resistance", "resistance",
-                      "ohm", 0.0, 1e4)
-    tm = _section(raw, {}, "time", "time")
-    duration = _quantity(tm["duration"], "time.duration", "time", "s", 0.0, 10 * 86400.0,
-                         lo_open=True)
-    dt = _quantity(tm["step"], "time.step", "time", "s", 0.0, duration, lo_open=True,
-                   show="ms")
-    acts_raw = raw.get("actuators")
-    if acts_raw is None:
-        specs = (_actuator(raw, {}, "", duration, dt, 0, "actuator"),)
-        gripper = False
-    else:
-        if not isinstance(acts_raw, list) or not 1 <= len(acts_raw) <= 64:
-            raise InputError(f"actuators: must be a list of 1 to 64 actuators, got {acts_raw!r}")
-        specs, names = [], set()
-        for i, item in enumerate(acts_raw):
-            path = f"actuators[{i}]"
-            item = _mapping(item, path)
-            _known(item, _ACTUATOR_KEYS, path)
-            nm = item.get("name", f"actuator_{i}")
-            if not isinstance(nm, str) or not nm.isidentifier() or nm in names:
-                raise InputError(f"{path}.name: a unique name of letters, digits and '_', "
-                                 f"got {nm!r}")
-            names.add(nm)
-            specs.append(_actuator(raw, item, path, duration, dt, i, nm))
-        specs = tuple(specs)
-        gripper = True
-    cfg = SimConfig(name=name, supply_voltage=voltage, internal_resistance=r_int,
-                    duration=duration, step=dt, actuators=specs, gripper=gripper,
-                    raw=copy.deepcopy(raw))
-    if cfg.n_steps * len(specs) > _MAX_SAMPLES:
-        raise InputError(f"time.step: {cfg.n_steps} samples x {len(specs)} actuators is more "
-                         f"than {_MAX_SAMPLES}; use a longer step or a shorter duration")
-    for a in specs:
-        top = _top_temperature(cfg, a)
-        s_top = float(stroke(top, a.coil_index, a.nylon))
-        if s_top >= 0.5:  # Boyle and the wrap model mean nothing this far
-            raise InputError(f"supply.voltage: must keep every muscle's stroke below 0.5, "
-                             f"but heats {a.name} to {top - 273.15:.0f} degC (stroke "
-                             f"{s_top:.2f}), got {voltage:g} V")
-    return cfg
-
-
-def load_sim_config(path) -> SimConfig:
-    """Read and validate a simulation config file (YAML)."""
-    return parse_sim_config(read_yaml(path), str(path))
-
-
-# ---------------------------------------------------------------------------------------
 # running
 # ---------------------------------------------------------------------------------------
-
-def _muscle_length(a: ActuatorSpec) -> float:
-    return float(muscle_length(a.radius, a.wall_thickness, a.length, a.wrap_angle,
-                               a.coil_index, a.base_thickness, a.nylon))
-
-
-def _top_temperature(cfg: SimConfig, a: ActuatorSpec) -> float:
-    """Highest temperature the muscle can reach: its start or full supply alone [K].
-
-    The exact step is a convex combination of T and T_ss, so T never leaves
-    [T_amb, max(T(0), T_ss(E))] (with others on, the supply only sags).
-    """
-    lm = _muscle_length(a)
-    r = float(muscle_resistance(lm, a.nylon))
-    v = cfg.supply_voltage * r / (r + cfg.internal_resistance)
-    return max(a.initial_temperature, float(steady_temperature(v, lm, a.nylon)))
-
 
 def reference_signal(ref: Reference, t):
     """The reference angle at times ``t`` [rad].
@@ -627,8 +218,8 @@ def run_simulation(cfg: SimConfig):
     plants, slopes, ests, refs, noises, reach = [], [], [], [], [], []
     for a in cfg.actuators:
         ny = a.nylon
-        lm = _muscle_length(a)
-        top = _top_temperature(cfg, a)
+        lm = actuator_muscle_length(a)
+        top = top_temperature(cfg, a)
         scale = float(_stroke_scale(a.coil_index, np.asarray(ny.coil_index_table),
                                     np.asarray(ny.stroke_max_table), ny.t_amb, ny.t_max,
                                     ny.gamma, ny.beta, ny.t_g, ny.sigma_g))

@@ -210,7 +210,7 @@ def _mutate(raw, path, value):
     (("silicone",), "jelly", r"silicone: unknown set 'jelly'"),
     (("nylon",), {"set": "silver_nylon66", "colour": 1}, r"nylon.colour: unknown field"),
     (("name",), "../x", r"name: letters, digits"),
-    (("charts",), ["fig99"], r"charts.0: must be one of"),
+    (("charts",), ["fig99"], r"charts\[0\]: must be one of"),
 ])
 def test_bad_config_exits_2_with_one_line_and_no_file(tmp_path, capsys, path, value, match):
     import re
