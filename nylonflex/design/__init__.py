@@ -12,6 +12,7 @@ and dropped if it violates a constraint.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -71,18 +72,24 @@ class DesignResult:
 
 def _materials(ds, spec):
     """The model with the materials the cube was computed with (from its attributes)."""
+    silicone, nylon, base, memo = _cube_materials(ds.attrs["config_yaml"])
+    return Model(silicone, nylon, base, spec.model, memo)
+
+
+@functools.lru_cache(maxsize=8)
+def _cube_materials(config_yaml):
     import yaml
 
     from ..materials import Nylon, Silicone
 
-    cfg = yaml.safe_load(ds.attrs["config_yaml"])
+    cfg = yaml.safe_load(config_yaml)
 
     def build(cls, d):
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
 
     base = cfg.get("base_thickness", "wall")
-    return Model(build(Silicone, cfg["silicone"]), build(Nylon, cfg["nylon"]),
-                 None if base == "wall" else float(base), spec.model)
+    return (build(Silicone, cfg["silicone"]), build(Nylon, cfg["nylon"]),
+            None if base == "wall" else float(base), {})
 
 
 def _open(spec, cube):

@@ -24,6 +24,8 @@ __all__ = ["Model", "evaluate_rows", "meets", "refine"]
 
 # finite-difference step in the unit-scaled variables
 _FD_STEP = 1e-6
+# designs remembered per material set
+_MEMO_MAX = 200_000
 # bisection steps of the fall-back segment search
 _BISECT = 30
 
@@ -41,19 +43,30 @@ class Model:
         Model variant.
     """
 
-    def __init__(self, silicone, nylon, base_thickness=None, model="paper"):
+    def __init__(self, silicone, nylon, base_thickness=None, model="paper", memo=None):
         self.silicone, self.nylon = silicone, nylon
         self.base_thickness, self.model = base_thickness, model
         self.evaluations = 0
+        # designs already evaluated with these materials (shared between runs on one cube)
+        self.memo = {} if memo is None else memo
 
     def __call__(self, X) -> dict:
         """Every axis and design variable at designs ``X`` (n, 5) [SI], as (n,) arrays."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
-        self.evaluations += len(X)
-        design = dict(zip(AXES, X.T))
-        values = _exact(**design, base_thickness=self.base_thickness, silicone=self.silicone,
-                        nylon=self.nylon, model=self.model)
-        out = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in values.items()}
+        keys = [x.tobytes() for x in X]
+        todo = [i for i, k in enumerate(keys) if k not in self.memo]
+        if todo:
+            self.evaluations += len(todo)
+            design = dict(zip(AXES, X[todo].T))
+            values = _exact(**design, base_thickness=self.base_thickness,
+                            silicone=self.silicone, nylon=self.nylon, model=self.model)
+            values = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in values.items()}
+            if len(self.memo) > _MEMO_MAX:
+                self.memo.clear()
+            for j, i in enumerate(todo):
+                self.memo[keys[i]] = {k: v[j] for k, v in values.items()}
+        names = list(self.memo[keys[0]])
+        out = {k: np.array([self.memo[key][k] for key in keys]) for k in names}
         out.update({k: X[:, i].copy() for i, k in enumerate(AXES)})
         return out
 

@@ -222,23 +222,25 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
     if multi and len(best["radius"]):
         best = _take(best, np.lexsort(_minimised(spec.objectives, best).T[::-1]))
     if feasible == 0:
-        reasons = _reasons(conds, met_alone, near_alone, near_others, total)
+        reasons = _reasons(conds, met_alone, near_alone, near_others, total, fixed)
     return GridScan(total, feasible, best, cloud, fixed, ranges, reasons)
 
 
-def _reasons(conds, met_alone, near_alone, near_others, total):
+def _reasons(conds, met_alone, near_alone, near_others, total, fixed):
     if total == 0:
         return ["the cube has no computed designs"]
+    where = "in the cube" if not fixed else \
+        "with " + ", ".join(f"{n} {_shown(n, v)}" for n, v in fixed.items())
     out = []
     for j, c in enumerate(conds):
-        if not met_alone[j]:
-            out.append(f"{c.text}: no design in the cube meets it; the nearest has "
-                       f"{c.name} = {_shown(c.name, near_alone[j][1])}")
-    if out:
-        return out
-    for j, c in enumerate(conds):
         d, value = near_others[j]
-        if np.isfinite(d) and d > 0:
+        others = (f"the nearest of those that meet the other constraints has {c.name} = "
+                  f"{_shown(c.name, value)}") if np.isfinite(d) and len(conds) > 1 else ""
+        if not met_alone[j]:
+            alone = f"{c.name} = {_shown(c.name, near_alone[j][1])}"
+            out.append(f"{c.text}: no design {where} meets it; the nearest has {alone}"
+                       + (f"; {others}" if others else ""))
+        elif others and d > 0:
             out.append(f"{c.text}: no design that meets the other constraints meets it; "
-                       f"the nearest has {c.name} = {_shown(c.name, value)}")
+                       + others.replace(" of those that meet the other constraints", ""))
     return out or ["no design meets every constraint together"]
