@@ -25,11 +25,13 @@ __all__ = [
     "load_config",
     "nylon_parameters",
     "open_cube",
+    "run_design",
     "run_sweep",
     "silicone_parameters",
 ]
 
-_LAZY = {"load_config": "config", "run_sweep": "sweep", "open_cube": "storage"}
+_LAZY = {"load_config": "config", "run_sweep": "sweep", "open_cube": "storage",
+         "run_design": "design"}
 
 
 def __getattr__(name):

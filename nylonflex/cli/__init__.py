@@ -23,6 +23,7 @@ COMMANDS = {
     "sweep": "sweep",
     "chart": "chart",
     "query": "query",
+    "design": "design",
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",

@@ -1,0 +1,210 @@
+"""Design from a specification: the best design or the Pareto set, refined off the grid.
+
+>>> import nylonflex as nf
+>>> res = nf.run_design("configs/design_force.yaml")       # doctest: +SKIP
+>>> res.designs[0]["tip_force_max"], res.designs[0]["source"]  # doctest: +SKIP
+
+Stages: (1) the grid: the cube's feasible designs and the best of them (one objective) or
+their non-dominated set (several); (2) with ``refine``, continuous optimisation over the
+axes with the exact model (:mod:`.refine`); (3) every reported design re-evaluated exactly
+and dropped if it violates a constraint.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..query import COLUMNS
+from .refine import Model, evaluate_rows, meets, refine
+from .search import GridScan, nondominated, scan_grid
+from .spec import DesignSpec, Objective, load_spec, parse_spec
+
+__all__ = ["DesignResult", "DesignSpec", "Objective", "load_spec", "nondominated",
+           "parse_spec", "run_design"]
+
+
+@dataclass
+class DesignResult:
+    """The answer to a spec.
+
+    Attributes
+    ----------
+    spec : DesignSpec
+    designs : list of dict
+        The reported designs, each with every axis and design variable [SI] (exactly
+        re-evaluated) and ``source`` (``"grid"`` or ``"refined"``). One objective: the best
+        design (refined, when refinement beat the grid) and the best grid point. Several:
+        the front (refined when ``refine``, else the grid's), ordered by the first objective.
+    grid_front : dict of str to numpy.ndarray
+        The grid's best rows (one objective) or non-dominated set (several), exact values.
+    refined_front : dict of str to numpy.ndarray
+        Several objectives with ``refine``: the non-dominated set of the grid front and the
+        refined designs; else empty.
+    scan : GridScan
+        Totals, the feasible cloud and, when infeasible, the reasons.
+    evaluations : int
+        Exact model evaluations.
+    dropped : int
+        Reported candidates dropped because exact re-evaluation broke a constraint.
+    """
+
+    spec: DesignSpec
+    designs: list
+    grid_front: dict
+    refined_front: dict
+    scan: GridScan
+    evaluations: int
+    dropped: int = 0
+    improvement: dict = field(default_factory=dict)
+
+    @property
+    def feasible(self) -> bool:
+        return bool(self.designs)
+
+    @property
+    def reasons(self) -> list:
+        return self.scan.reasons
+
+
+def _materials(ds, spec):
+    """The model with the materials the cube was computed with (from its attributes)."""
+    silicone, nylon, base, memo = _cube_materials(ds.attrs["config_yaml"])
+    return Model(silicone, nylon, base, spec.model, memo)
+
+
+@functools.lru_cache(maxsize=8)
+def _cube_materials(config_yaml):
+    import yaml
+
+    from ..materials import Nylon, Silicone
+
+    cfg = yaml.safe_load(config_yaml)
+
+    def build(cls, d):
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
+
+    base = cfg.get("base_thickness", "wall")
+    return (build(Silicone, cfg["silicone"]), build(Nylon, cfg["nylon"]),
+            None if base == "wall" else float(base), {})
+
+
+def _open(spec, cube):
+    from ..config import parse_config
+    from ..storage import open_cube
+    from ..sweep import run_sweep
+
+    if cube is not None or spec.cube is not None:
+        return open_cube(Path(cube if cube is not None else spec.cube), quiet=True)
+    return run_sweep(parse_config(spec.sweep, "grid"))
+
+
+def _rows(records) -> dict:
+    keys = records[0].keys() if records else COLUMNS
+    return {k: np.array([r[k] for r in records], dtype=float) for k in keys}
+
+
+def _records(rows, source) -> list:
+    n = len(rows["radius"])
+    return [{**{k: float(v[i]) for k, v in rows.items()}, "source": source}
+            for i in range(n)]
+
+
+def run_design(spec, cube=None) -> DesignResult:
+    """Answer a design spec.
+
+    Parameters
+    ----------
+    spec : DesignSpec, dict or path
+        The spec, its mapping or its YAML file.
+    cube : path or xarray.Dataset, optional
+        Overrides the spec's start (a cube file or an opened cube).
+
+    Returns
+    -------
+    DesignResult
+
+    Raises
+    ------
+    InputError
+        A malformed spec or a missing cube.
+    """
+    if isinstance(spec, (str, Path)):
+        spec = load_spec(spec)
+    elif isinstance(spec, dict):
+        spec = parse_spec(spec)
+    own = not hasattr(cube, "data_vars")
+    ds = _open(spec, cube) if own else cube
+    try:
+        model = _materials(ds, spec)
+        multi = len(spec.objectives) > 1
+        scan = scan_grid(ds, spec, keep=1 if multi else max(1, spec.starts))
+    finally:
+        if own:
+            ds.close()
+    refined = refine(model, spec, scan) if spec.refine and scan.feasible else []
+
+    # every reported design, exactly, once more; drop any that breaks a constraint
+    grid = evaluate_rows(model, scan.best)
+    grid = {k: v[meets(spec, grid, scan.fixed)] for k, v in grid.items()}
+    new = evaluate_rows(model, _rows(refined)) if refined else {k: np.empty(0) for k in grid}
+    ok = meets(spec, new, scan.fixed)
+    dropped = int((~ok).sum())
+    new = {k: v[ok] for k, v in new.items()}
+
+    signs = np.array([o.sign for o in spec.objectives])
+
+    def F(rows):
+        return np.column_stack([rows[o.name] for o in spec.objectives]) * signs
+
+    improvement = {}
+    refined_front = {k: np.empty(0) for k in grid}
+    if not multi:
+        grid = {k: v[:1] for k, v in grid.items()}
+        designs = _records(grid, "grid")
+        if len(new["radius"]) and len(grid["radius"]):
+            k = int(np.argmin(F(new)[:, 0]))
+            if F(new)[k, 0] < F(grid)[0, 0]:
+                designs = _records({n: v[k:k + 1] for n, v in new.items()}, "refined") + designs
+        if spec.refine and designs:
+            name = spec.objectives[0].name
+            g, b = designs[-1][name], designs[0][name]
+            improvement = {name: (g, b, (b - g) / abs(g) if g else np.nan)}
+    else:
+        order = np.lexsort(F(grid).T[::-1]) if len(grid["radius"]) else []
+        grid = {k: v[order] for k, v in grid.items()}
+        designs = _records(grid, "grid")
+        if spec.refine:
+            both = {k: np.concatenate([new[k], grid[k]]) for k in grid}
+            source = ["refined"] * len(new["radius"]) + ["grid"] * len(grid["radius"])
+            keep = nondominated(F(both)) if len(source) else np.zeros(0, bool)
+            idx = np.flatnonzero(keep)
+            idx = idx[np.lexsort(F(both)[idx].T[::-1])] if len(idx) else idx
+            refined_front = {k: v[idx] for k, v in both.items()}
+            designs = [{**{k: float(both[k][i]) for k in both}, "source": source[i]}
+                       for i in idx]
+            improvement = _front_gain(F(grid), F(refined_front), spec)
+    return DesignResult(spec, designs, grid, refined_front, scan, model.evaluations,
+                        dropped, improvement)
+
+
+def _front_gain(g, r, spec):
+    """Two objectives: the area each front dominates (hypervolume) from the grid's nadir."""
+    if len(spec.objectives) != 2 or len(g) == 0:
+        return {}
+    ref = g.max(axis=0)
+
+    def area(F):
+        F = F[np.lexsort(F.T[::-1])]
+        total, best_y = 0.0, ref[1]
+        for x, y in F:
+            if y < best_y:
+                total += (ref[0] - x) * (best_y - y)
+                best_y = y
+        return total
+
+    a_g, a_r = area(g), area(r)
+    return {"hypervolume": (a_g, a_r, (a_r - a_g) / a_g if a_g else np.nan)}

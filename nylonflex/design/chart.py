@@ -1,0 +1,86 @@
+"""The Pareto-front chart of a design result (matplotlib, Agg, imported lazily).
+
+Two or more objectives: the first two, the cube's feasible designs as a grey cloud, the
+grid front and the refined front. One objective: the objective against the first free axis,
+the cloud, the best grid point and the refined design. Axes in display units with the
+registry's labels; the chart computes nothing (the result carries every value).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..variables import AXES, display_label, to_display
+
+__all__ = ["draw_front"]
+
+
+def _sorted_step(ax, x, y, **kw):
+    order = np.argsort(x, kind="stable")
+    ax.plot(np.asarray(x)[order], np.asarray(y)[order], **kw)
+
+
+def draw_front(res, out_dir) -> Path:
+    """Draw ``res`` into ``out_dir/<name>.png``; return the path.
+
+    Parameters
+    ----------
+    res : DesignResult
+    out_dir : path
+        Created when missing; an existing chart of the same name is replaced.
+    """
+    from ..charts import _RC, _figure, _plt
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = out_dir / f"{res.spec.name}.png"
+    objs = res.spec.objectives
+    if len(objs) >= 2:
+        xname, yname = objs[1].name, objs[0].name
+    else:
+        free = [a for a in AXES if a not in res.scan.fixed and
+                res.scan.ranges[a][1] > res.scan.ranges[a][0]]
+        xname, yname = (free[0] if free else "radius"), objs[0].name
+    plt = _plt()
+    with plt.rc_context(_RC):
+        fig, axes = _figure(size=(6.4, 4.6))
+        ax = axes[0, 0]
+        cloud = res.scan.cloud
+        if len(cloud["radius"]):
+            ax.scatter(to_display(xname, cloud[xname]), to_display(yname, cloud[yname]),
+                       s=6, c="0.75", lw=0, label=f"feasible grid designs ({res.scan.feasible})",
+                       rasterized=True)
+        grid = res.grid_front
+        refined = res.refined_front
+        if len(objs) >= 2:
+            if len(grid["radius"]):
+                _sorted_step(ax, to_display(xname, grid[xname]), to_display(yname, grid[yname]),
+                             color="C0", marker="o", ms=4, lw=1.0,
+                             label=f"grid front ({len(grid['radius'])})")
+            if len(refined["radius"]):
+                _sorted_step(ax, to_display(xname, refined[xname]),
+                             to_display(yname, refined[yname]), color="C3", marker=".",
+                             ms=7, lw=1.2, ls="--",
+                             label=f"refined front ({len(refined['radius'])})")
+        else:
+            for d in res.designs:
+                style = dict(color="C3", marker="*", ms=14) if d["source"] == "refined" \
+                    else dict(color="C0", marker="o", ms=8, mfc="none", mew=1.8)
+                ax.plot(to_display(xname, d[xname]), to_display(yname, d[yname]), ls="none",
+                        label=f"{'refined design' if d['source'] == 'refined' else 'best grid point'}",
+                        **style)
+        ax.set_xlabel(display_label(xname) + f"  ({'min' if objs[-1].sense == 'min' else 'max'})"
+                      if len(objs) >= 2 else display_label(xname))
+        ax.set_ylabel(display_label(yname) + f"  ({objs[0].sense})")
+        title = "Pareto front" if len(objs) >= 2 else "best design"
+        ax.set_title(f"{title}: {res.spec.name}")
+        if res.spec.constraints:
+            text = "\n".join(c.text for c in res.spec.constraints)
+            ax.text(0.99, 0.02, text, transform=ax.transAxes, ha="right", va="bottom",
+                    fontsize=7.5, color="0.3")
+        ax.legend(loc="upper left")
+        fig.savefig(path)
+        plt.close(fig)
+    return path

@@ -1,0 +1,293 @@
+"""Off the grid: continuous optimisation over the axes with the exact model.
+
+One objective: SLSQP (scipy.optimize) from the best feasible grid points, the constraints as
+inequality functions. Several objectives: the epsilon-constraint method with the same
+SLSQP: from each grid-front seed, optimise the first objective with every other objective
+held at least as good as the seed's. Each refined design therefore weakly dominates its
+seed, so the refined front dominates or equals the grid front by construction; it is
+deterministic and needs no new dependency (an evolutionary method such as pymoo's NSGA-II
+would need thousands of evaluations and could lose grid-front points to crowding).
+
+The model is only piecewise smooth (the strength limit switches ``limit``), so the
+optimiser's answer is never trusted: it is re-evaluated exactly, and when it violates a
+constraint or is worse than its seed, the segment from the (feasible) seed to it is
+searched for the best point that meets every constraint.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..variables import AXES
+
+__all__ = ["Model", "evaluate_rows", "meets", "refine"]
+
+# finite-difference step in the unit-scaled variables
+_FD_STEP = 1e-6
+# designs remembered per material set
+_MEMO_MAX = 200_000
+# bisection steps of the fall-back segment search
+_BISECT = 30
+
+
+class Model:
+    """The exact model with a cube's materials; counts its evaluations.
+
+    Parameters
+    ----------
+    silicone, nylon : Silicone, Nylon
+        Material sets.
+    base_thickness : float or None
+        b [m]; None for b = t.
+    model : str
+        Model variant.
+    """
+
+    def __init__(self, silicone, nylon, base_thickness=None, model="paper", memo=None):
+        self.silicone, self.nylon = silicone, nylon
+        self.base_thickness, self.model = base_thickness, model
+        self.evaluations = 0
+        # designs already evaluated with these materials (shared between runs on one cube)
+        self.memo = {} if memo is None else memo
+
+    def __call__(self, X) -> dict:
+        """Every axis and design variable at designs ``X`` (n, 5) [SI], as (n,) arrays."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        keys = [x.tobytes() for x in X]
+        todo = [i for i, k in enumerate(keys) if k not in self.memo]
+        if todo:
+            self.evaluations += len(todo)
+            design = dict(zip(AXES, X[todo].T))
+            values = _exact(**design, base_thickness=self.base_thickness,
+                            silicone=self.silicone, nylon=self.nylon, model=self.model)
+            values = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in values.items()}
+            if len(self.memo) > _MEMO_MAX:
+                self.memo.clear()
+            for j, i in enumerate(todo):
+                self.memo[keys[i]] = {k: v[j] for k, v in values.items()}
+        names = list(self.memo[keys[0]])
+        out = {k: np.array([self.memo[key][k] for key in keys]) for k in names}
+        out.update({k: X[:, i].copy() for i, k in enumerate(AXES)})
+        return out
+
+
+def _exact(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness,
+           silicone, nylon, model):
+    """The one call into the exact pointwise model (every design variable, SI).
+
+    ``nylonflex.evaluate`` (compiled, same names and values) replaces ``design_limits`` here
+    when it lands; ``model`` is then passed on.
+    """
+    from ..physics import design_limits
+
+    return design_limits(radius, wall_thickness, length, coil_index, wrap_angle,
+                         base_thickness, silicone, nylon)
+
+
+def evaluate_rows(model, rows) -> dict:
+    """Re-evaluate the designs of ``rows`` (columns by name) exactly."""
+    X = np.column_stack([np.asarray(rows[a], float) for a in AXES])
+    return model(X) if len(X) else {k: np.empty(0) for k in rows}
+
+
+def meets(spec, rows, fixed) -> np.ndarray:
+    """True where a design meets every constraint (fixed axes hold by construction)."""
+    n = len(rows["radius"])
+    ok = np.ones(n, dtype=bool)
+    for c in spec.constraints:
+        if c.op == "==" and c.name in fixed:
+            ok &= np.asarray(rows[c.name], float) == fixed[c.name]
+        else:
+            ok &= c.mask(np.asarray(rows[c.name], float))
+    return ok
+
+
+def _bounds(spec, ranges, fixed):
+    """Per axis ``(lo, hi)`` [SI]: the grid range narrowed by axis constraints."""
+    out = {}
+    for a in AXES:
+        if a in fixed:
+            out[a] = (fixed[a], fixed[a])
+            continue
+        lo, hi = ranges[a]
+        span = max(hi - lo, abs(hi), 1e-300)
+        for c in spec.constraints:
+            if c.name != a:
+                continue
+            inset = 1e-9 * span if c.op in ("<", ">") else 0.0
+            if c.op in ("<=", "<"):
+                hi = min(hi, c.value - inset)
+            elif c.op in (">=", ">"):
+                lo = max(lo, c.value + inset)
+        out[a] = (lo, hi)
+    return out
+
+
+class _Problem:
+    """SLSQP's view: unit-scaled free axes, one primary objective, inequality functions."""
+
+    def __init__(self, model, spec, bounds, seed_row, primary, eps):
+        self.model, self.spec = model, spec
+        self.free = [a for a in AXES if bounds[a][1] > bounds[a][0]]
+        self.lo = np.array([bounds[a][0] for a in self.free])
+        self.span = np.array([bounds[a][1] - bounds[a][0] for a in self.free])
+        self.base = np.array([float(seed_row[a]) for a in AXES])
+        self.primary = primary
+        self.eps = eps  # [(objective, seed value)]: sign * value <= sign * seed value
+        self.conds = [c for c in spec.constraints
+                      if c.name not in AXES and c.op in ("<=", "<", ">=", ">", "==")]
+        scale = lambda v: max(abs(float(v)), 1e-12)  # noqa: E731
+        self.f_scale = scale(seed_row[primary.name])
+        self.c_scale = [scale(c.value) if c.value != 0 else 1.0 for c in self.conds]
+        self.e_scale = [scale(v) for _, v in eps]
+        self._cache = (None, None)
+
+    def design(self, U) -> np.ndarray:
+        U = np.clip(np.atleast_2d(U), 0.0, 1.0)
+        X = np.repeat(self.base[None, :], len(U), axis=0)
+        for k, a in enumerate(self.free):
+            X[:, AXES.index(a)] = self.lo[k] + U[:, k] * self.span[k]
+        return X
+
+    def u0(self) -> np.ndarray:
+        x = np.array([self.base[AXES.index(a)] for a in self.free])
+        return np.clip((x - self.lo) / self.span, 0.0, 1.0)
+
+    def _quantities(self, rows):
+        """Rows of [objective, inequality..., equality...] values, all scaled."""
+        q = [self.primary.sign * rows[self.primary.name] / self.f_scale]
+        for c, s in zip(self.conds, self.c_scale):
+            x = rows[c.name]
+            q.append((x - c.value) / s if c.op in (">=", ">", "==") else (c.value - x) / s)
+        for (o, v), s in zip(self.eps, self.e_scale):
+            q.append(o.sign * (v - rows[o.name]) / s)
+        return np.array(q)
+
+    def _at(self, u):
+        key = np.asarray(u, float).tobytes()
+        if self._cache[0] != key:
+            u = np.clip(np.asarray(u, float), 0.0, 1.0)
+            steps = np.where(u + _FD_STEP <= 1.0, _FD_STEP, -_FD_STEP)
+            U = np.vstack([u, u + np.diag(steps)])
+            q = self._quantities(self.model(self.design(U)))
+            jac = (q[:, 1:] - q[:, :1]) / steps[None, :]
+            self._cache = (key, (q[:, 0], jac))
+        return self._cache[1]
+
+    def objective(self, u):
+        q, jac = self._at(u)
+        return q[0], jac[0]
+
+    def constraints(self):
+        n_ineq = 1 + len(self.conds)
+        out = []
+        for i in range(1, n_ineq + len(self.eps)):
+            kind = "eq" if i < n_ineq and self.conds[i - 1].op == "==" else "ineq"
+            out.append({"type": kind, "fun": lambda u, i=i: self._at(u)[0][i],
+                        "jac": lambda u, i=i: self._at(u)[1][i]})
+        return out
+
+
+def _acceptable(spec, fixed, prob, rows, seed_value):
+    """Mask: meets every constraint, keeps the seed's other objectives, no worse."""
+    ok = meets(spec, rows, fixed)
+    for o, v in prob.eps:
+        ok &= o.sign * rows[o.name] <= o.sign * v
+    f = prob.primary.sign * rows[prob.primary.name]
+    return ok & (f <= prob.primary.sign * seed_value), f
+
+
+def _improve(model, spec, bounds, fixed, seed_row, primary, eps, maxiter):
+    """The best design found from ``seed_row``: a row dict, or None when none beats it."""
+    from scipy.optimize import minimize
+
+    prob = _Problem(model, spec, bounds, seed_row, primary, eps)
+    if not prob.free:
+        return None
+    u0 = prob.u0()
+    try:
+        res = minimize(prob.objective, u0, jac=True, method="SLSQP",
+                       bounds=[(0.0, 1.0)] * len(u0), constraints=prob.constraints(),
+                       options={"maxiter": maxiter, "ftol": 1e-10})
+        u1 = np.clip(res.x, 0.0, 1.0)
+    except (ValueError, ArithmeticError):
+        return None
+    if not np.all(np.isfinite(u1)) or np.allclose(u1, u0, rtol=0, atol=1e-12):
+        return None
+    seed_value = float(seed_row[primary.name])
+    # the answer, then points along the segment from the seed toward it
+    t = np.concatenate([[1.0], np.linspace(0.0, 1.0, 17)[1:-1]])
+    rows = model(prob.design(u0[None, :] + t[:, None] * (u1 - u0)[None, :]))
+    ok, f = _acceptable(spec, fixed, prob, rows, seed_value)
+    if ok[0]:
+        k = 0
+    else:
+        if not ok.any():
+            ok_t, bad_t = 0.0, float(t[1:].min()) if len(t) > 1 else 1.0
+        else:
+            k = int(np.argmin(np.where(ok, f, np.inf)))
+            ok_t = float(t[k])
+            above = t[t > ok_t]
+            bad_t = float(above.min()) if len(above) else 1.0
+        best = None if not ok.any() else _take1(rows, int(np.argmin(np.where(ok, f, np.inf))))
+        for _ in range(_BISECT):  # the last acceptable point before the first bad one
+            mid = 0.5 * (ok_t + bad_t)
+            r = model(prob.design(u0 + mid * (u1 - u0)))
+            good, fm = _acceptable(spec, fixed, prob, r, seed_value)
+            if good[0]:
+                ok_t = mid
+                if best is None or fm[0] < primary.sign * best[primary.name]:
+                    best = _take1(r, 0)
+            else:
+                bad_t = mid
+        if best is None:
+            return None
+        rows, k = {key: np.array([v]) for key, v in best.items()}, 0
+    row = _take1(rows, k)
+    if not primary.sign * row[primary.name] < primary.sign * seed_value:
+        return None  # no strict improvement: the seed stays
+    return row
+
+
+def _take1(rows, k) -> dict:
+    return {key: float(np.asarray(v)[k]) for key, v in rows.items()}
+
+
+def refine(model, spec, scan) -> list:
+    """Refined designs (row dicts) from the grid stage's best rows or front.
+
+    Parameters
+    ----------
+    model : Model
+        The exact model.
+    spec : DesignSpec
+    scan : GridScan
+
+    Returns
+    -------
+    list of dict
+        One objective: at most one design, better than the best grid point. Several: one
+        design per seed that it improved, each weakly dominating its seed.
+    """
+    bounds = _bounds(spec, scan.ranges, scan.fixed)
+    seeds = evaluate_rows(model, scan.best)
+    n = len(seeds["radius"])
+    if n == 0:
+        return []
+    primary, others = spec.objectives[0], spec.objectives[1:]
+    if others:
+        pick = np.unique(np.linspace(0, n - 1, min(spec.starts, n)).round().astype(int))
+    else:
+        pick = np.arange(min(spec.starts, n))
+    out = []
+    for i in pick:
+        seed = _take1(seeds, int(i))
+        if not meets(spec, {k: np.array([v]) for k, v in seed.items()}, scan.fixed)[0]:
+            continue
+        eps = [(o, seed[o.name]) for o in others]
+        row = _improve(model, spec, bounds, scan.fixed, seed, primary, eps, spec.maxiter)
+        if row is not None:
+            out.append(row)
+    if not others and out:
+        out = [min(out, key=lambda r: primary.sign * r[primary.name])]
+    return out

@@ -1,0 +1,110 @@
+"""A design result as text: a table in display units, JSON or CSV in SI."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+
+from ..query import COLUMNS, _cell
+from ..variables import VARIABLES, to_display
+
+__all__ = ["format_csv", "format_json", "format_table"]
+
+
+def _columns(res):
+    extra = [k for d in res.designs[:1] for k in d if k not in COLUMNS and k != "source"]
+    return [*COLUMNS, *extra]
+
+
+def _shown(name, x) -> str:
+    unit = VARIABLES[name].display if name in VARIABLES else "1"
+    return f"{float(to_display(name, x)) if name in VARIABLES else x:.4g}" + \
+        ("" if unit == "1" else f" {unit}")
+
+
+def summary(res) -> list:
+    """Lines that say what was asked, what the grid gave and what refinement added."""
+    spec, scan = res.spec, res.scan
+    lines = [f"design '{spec.name}': " + ", ".join(str(o) for o in spec.objectives)
+             + (" subject to " + "; ".join(c.text for c in spec.constraints)
+                if spec.constraints else "")]
+    if not res.designs:
+        lines.append(f"infeasible: none of the {scan.total} designs scanned meets every "
+                     "constraint")
+        lines += [f"  {r}" for r in scan.reasons]
+        return lines
+    lines.append(f"grid: {scan.feasible} of {scan.total} designs feasible")
+    for name, (g, b, rel) in res.improvement.items():
+        if name == "hypervolume":
+            lines.append(f"refined front: {len(res.designs)} designs "
+                         f"({sum(d['source'] == 'refined' for d in res.designs)} refined); "
+                         f"it dominates or equals the grid front of "
+                         f"{len(res.grid_front['radius'])}; dominated area +{100 * rel:.2f} %")
+        else:
+            how = (f"refined {_shown(name, b)}, {100 * rel:+.2f} %" if b != g else
+                   "refinement found nothing better (the optimum sits on the grid, at "
+                   "the bounds the constraints allow)")
+            lines.append(f"best grid point: {name} {_shown(name, g)}; {how}")
+    if not res.improvement and len(spec.objectives) == 1:
+        name = spec.objectives[0].name
+        lines.append(f"best grid point: {name} {_shown(name, res.designs[0][name])} "
+                     "(refine is off)")
+    elif not res.improvement:
+        lines.append(f"grid front: {len(res.designs)} designs (refine is off)")
+    if res.dropped:
+        lines.append(f"{res.dropped} refined design(s) dropped: exact re-evaluation broke "
+                     "a constraint")
+    lines.append(f"{res.evaluations} exact evaluations")
+    return lines
+
+
+def format_table(res) -> str:
+    """The summary, then the designs in display units."""
+    out = io.StringIO()
+    for line in summary(res):
+        print(line, file=out)
+    if not res.designs:
+        return out.getvalue()
+    heads = ["source", *_columns(res)]
+    units = [""] + [f"[{VARIABLES[h].display}]" if h in VARIABLES and
+                    VARIABLES[h].display != "1" else "" for h in heads[1:]]
+    cells = [[d["source"]] + [_cell(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
+                              for h in heads[1:]] for d in res.designs]
+    widths = [max(len(h), len(u), *(len(r[j]) for r in cells))
+              for j, (h, u) in enumerate(zip(heads, units))]
+    print("  ".join(h.rjust(w) for h, w in zip(heads, widths)), file=out)
+    print("  ".join(u.rjust(w) for u, w in zip(units, widths)), file=out)
+    for r in cells:
+        print("  ".join(c.rjust(w) for c, w in zip(r, widths)), file=out)
+    return out.getvalue()
+
+
+def _value(name, x):
+    if name == "limit":
+        return int(x) if math.isfinite(x) else None
+    return float(x) if math.isfinite(x) else None
+
+
+def format_json(res) -> str:
+    """``{"designs": [{...SI..., "source": ...}], "units": {...}}`` (INTERFACE.md)."""
+    cols = _columns(res)
+    designs = [{**{k: _value(k, d[k]) for k in cols}, "source": d["source"]}
+               for d in res.designs]
+    units = {k: VARIABLES[k].units if k in VARIABLES else "1" for k in cols}
+    return json.dumps({"designs": designs, "units": units}, indent=1) + "\n"
+
+
+def format_csv(res) -> str:
+    """CSV in SI, one row per design; the header names the units (``radius [m]``)."""
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    cols = _columns(res)
+    w.writerow(["source"] + [f"{k} [{VARIABLES[k].units if k in VARIABLES else '1'}]"
+                             for k in cols])
+    for d in res.designs:
+        w.writerow([d["source"]] + ["" if _value(k, d[k]) is None else
+                                    (_value(k, d[k]) if k == "limit" else repr(float(d[k])))
+                                    for k in cols])
+    return out.getvalue()

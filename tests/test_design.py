@@ -1,0 +1,276 @@
+"""``nylonflex design``: specs, the grid's best design and Pareto set, refinement, refusals.
+
+Expected numbers: the paper's first worked example (section 4; MODEL.md section 8: 20 mm,
+6 mm, 90 mm, C 1.1, psi 8 deg gives 1.20 N with a full range of motion); the Pareto set
+against a brute-force O(n^2) check; every design against the constraints it was asked for.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from conftest import write_cube
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import nylonflex as nf
+from nylonflex.cli import main
+from nylonflex.config import parse_config
+from nylonflex.design import nondominated, parse_spec, run_design
+from nylonflex.query import Condition
+from nylonflex.sweep import run_sweep
+from nylonflex.units import InputError
+from nylonflex.variables import AXES, DESIGN, VARIABLES, to_display
+
+SMALL = {
+    "name": "small",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 9, "units": "mm"},  # 2.5 mm steps
+        "wall_thickness": {"values": [2, 4, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"values": [5, 8, 20], "units": "deg"},
+    },
+    "curves": {"stroke": {"values": [0.05]}, "pressure": {"values": [0]}},
+}
+PAPER_Q1 = ["range_fraction >= 1", "radius <= 20 mm", "wall_thickness <= 6 mm",
+            "length == 90 mm", "coil_index == 1.1", "wrap_angle == 8 deg"]
+FRONT = [{"max": "tip_force_max"}, {"min": "radius"}]
+
+
+@pytest.fixture(scope="module")
+def ds():
+    return run_sweep(parse_config(SMALL))
+
+
+@pytest.fixture(scope="module")
+def cube(tmp_path_factory):
+    return write_cube(tmp_path_factory.mktemp("design"), SMALL)
+
+
+def spec(objectives, constraints=(), refine=False, **kw):
+    return parse_spec({"cube": "unused.h5", "objectives": objectives,
+                       "constraints": list(constraints), "refine": refine, **kw})
+
+
+def brute_front(F):
+    """Row i is non-dominated when no row is <= everywhere and < somewhere (O(n^2))."""
+    F = np.asarray(F, float)
+    le = np.all(F[:, None, :] <= F[None, :, :], axis=2)  # le[j, i]: j <= i everywhere
+    lt = np.any(F[:, None, :] < F[None, :, :], axis=2)
+    return ~np.any(le & lt, axis=0)
+
+
+def cube_rows(ds):
+    flat = ds[list(DESIGN)].to_dataframe().reset_index()
+    return {k: flat[k].to_numpy(float) for k in [*AXES, *DESIGN]}
+
+
+# ---------------------------------------------------------------------------- the paper
+def test_paper_first_question_meets_every_constraint_and_gives_1p2_newton(ds):
+    res = run_design(spec([{"max": "tip_force_max"}], PAPER_Q1, refine=True), cube=ds)
+    best = res.designs[0]
+    for c in PAPER_Q1:
+        assert Condition(c).mask(np.array([best[Condition(c).name]]))[0], c
+    # section 4: 1.2 N; the grid's best is (20 mm, 6 mm), a corner of the constraints
+    assert best["tip_force_max"] >= 1.2
+    grid_best = [d for d in res.designs if d["source"] == "grid"][0]
+    assert best["tip_force_max"] >= grid_best["tip_force_max"]
+    assert grid_best["radius"] == pytest.approx(20e-3) and grid_best["wall_thickness"] == 6e-3
+    name = "tip_force_max"
+    g, b, rel = res.improvement[name]
+    assert rel >= 0 and b == best[name]
+
+
+def test_refinement_beats_the_grid_between_grid_values(ds):
+    # radius <= 21 mm: the grid stops at 20 mm, the continuum reaches 21 mm
+    cons = ["range_fraction >= 1", "radius <= 21 mm", "length == 90 mm", "coil_index == 1.1",
+            "wrap_angle == 8 deg"]
+    res = run_design(spec([{"max": "tip_force_max"}], cons, refine=True), cube=ds)
+    refined, grid = res.designs
+    assert (refined["source"], grid["source"]) == ("refined", "grid")
+    assert refined["tip_force_max"] > grid["tip_force_max"]
+    assert 20e-3 < refined["radius"] <= 21e-3
+    exact = nf.design_limits(*(refined[a] for a in AXES))  # re-evaluated exactly
+    assert refined["tip_force_max"] == pytest.approx(exact["tip_force_max"], rel=1e-12)
+
+
+# ---------------------------------------------------------------------------- Pareto set
+def test_nondominated_matches_brute_force_with_ties():
+    rng = np.random.default_rng(1)
+    for k in (2, 3):
+        F = rng.integers(0, 6, size=(200, k)).astype(float)  # many ties
+        assert np.array_equal(nondominated(F), brute_front(F))
+
+
+def test_two_objectives_return_exactly_the_cubes_non_dominated_feasible_set(ds):
+    res = run_design(spec(FRONT, ["range_fraction >= 1"]), cube=ds)
+    rows = cube_rows(ds)
+    ok = rows["range_fraction"] >= 1
+    F = np.column_stack([-rows["tip_force_max"][ok], rows["radius"][ok]])
+    want = {tuple(np.round([rows[a][ok][i] for a in AXES], 12))
+            for i in np.flatnonzero(brute_front(F))}
+    got = {tuple(np.round([d[a] for a in AXES], 12)) for d in res.designs}
+    assert got == want and all(d["source"] == "grid" for d in res.designs)
+
+
+def test_refined_front_dominates_or_equals_the_grid_front(ds):
+    res = run_design(spec(FRONT, ["range_fraction >= 1"], refine={"starts": 6, "maxiter": 30}),
+                     cube=ds)
+    G = np.column_stack([-res.grid_front["tip_force_max"], res.grid_front["radius"]])
+    R = np.column_stack([-res.refined_front["tip_force_max"], res.refined_front["radius"]])
+    for g in G:
+        assert np.any(np.all(R <= g + 1e-15, axis=1)), g
+    assert any(d["source"] == "refined" for d in res.designs)
+    assert all(d["range_fraction"] >= 1 for d in res.designs)
+
+
+# ---------------------------------------------------------------------------- property
+_NAMES = [n for n in [*AXES, *DESIGN] if n != "limit"]
+
+
+@st.composite
+def random_spec(draw, rows):
+    n_obj = draw(st.integers(1, 2))
+    names = draw(st.lists(st.sampled_from(_NAMES), min_size=n_obj, max_size=n_obj,
+                          unique=True))
+    objectives = [{draw(st.sampled_from(["max", "min"])): n} for n in names]
+    constraints = []
+    for _ in range(draw(st.integers(0, 3))):
+        name = draw(st.sampled_from(_NAMES))
+        values = np.unique(rows[name])
+        if name in AXES and draw(st.booleans()):
+            op, value = "==", float(draw(st.sampled_from(list(values))))
+        else:
+            op = draw(st.sampled_from(["<=", ">=", "<", ">"]))
+            value = draw(st.floats(float(values.min()), float(values.max())))
+        unit = VARIABLES[name].display
+        shown = float(to_display(name, value))
+        constraints.append(f"{name} {op} {shown!r}" + ("" if unit == "1" else f" {unit}"))
+    refine = {"starts": 1, "maxiter": 5} if draw(st.integers(0, 19)) == 0 else False
+    return objectives, constraints, refine
+
+
+@pytest.fixture(scope="module")
+def tiny():
+    """48 designs: small fronts keep 1,000 exactly re-evaluated specs to seconds."""
+    grid = {"radius": {"values": [5, 12.5, 20], "units": "mm"},
+            "wall_thickness": {"values": [2, 6], "units": "mm"},
+            "length": {"values": [70, 90], "units": "mm"},
+            "coil_index": {"values": [1.1, 1.7]},
+            "wrap_angle": {"values": [5, 20], "units": "deg"}}
+    return run_sweep(parse_config({**SMALL, "grid": grid}))
+
+
+def test_no_returned_design_violates_a_constraint(tiny):
+    ds, rows = tiny, cube_rows(tiny)
+    @settings(max_examples=1000, deadline=None,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(random_spec(rows))
+    def check(case):
+        objectives, constraints, refine = case
+        res = run_design(spec(objectives, constraints, refine), cube=ds)
+        for d in res.designs:
+            for c in constraints:
+                cond = Condition(c)
+                assert cond.mask(np.array([d[cond.name]]))[0], (c, d)
+        if not res.designs:
+            assert res.reasons
+
+    check()
+
+
+# ---------------------------------------------------------------------------- command
+def run(capsys, *argv):
+    rc = main(["design", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def write_spec(tmp_path, cube, **kw):
+    import yaml
+
+    doc = {"name": "t", "cube": str(cube), "objectives": [{"max": "tip_force_max"}],
+           "constraints": PAPER_Q1, "refine": False, **kw}
+    path = tmp_path / "spec.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def test_json_has_designs_and_units_in_si(cube, tmp_path, capsys):
+    rc, out, _ = run(capsys, write_spec(tmp_path, cube), "--format", "json")
+    doc = json.loads(out)
+    assert rc == 0 and set(doc) == {"designs", "units"}
+    d = doc["designs"][0]
+    assert d["source"] == "grid" and d["radius"] == pytest.approx(0.02)
+    assert d["tip_force_max"] == pytest.approx(1.2034, abs=1e-4)  # MODEL.md s. 8: 1.20 N
+    assert doc["units"]["radius"] == "m" and doc["units"]["wrap_angle"] == "rad"
+
+
+def test_table_and_csv(cube, tmp_path, capsys):
+    path = write_spec(tmp_path, cube)
+    rc, out, _ = run(capsys, path)
+    assert rc == 0 and "best grid point: tip_force_max 1.203 N" in out
+    rc, out, _ = run(capsys, path, "--format", "csv")
+    assert rc == 0 and out.splitlines()[0].startswith("source,radius [m]")
+
+
+def test_infeasible_spec_exits_0_and_says_which_constraint(cube, tmp_path, capsys):
+    path = write_spec(tmp_path, cube, constraints=[*PAPER_Q1, "tip_force_max >= 5 N"])
+    rc, out, _ = run(capsys, path)
+    assert rc == 0 and "infeasible" in out
+    # alone, within the fixed slice, radius 25 mm comes nearest; with the others, (20, 6) mm
+    assert "tip_force_max >= 5 N: no design with length 90 mm, coil_index 1.1, wrap_angle " \
+           "8 deg meets it; the nearest has tip_force_max = 2.156 N; the nearest of those " \
+           "that meet the other constraints has tip_force_max = 1.203 N" in out
+    rc, out, err = run(capsys, path, "--format", "json")
+    assert rc == 0 and json.loads(out)["designs"] == [] and "tip_force_max >= 5 N" in err
+
+
+def test_infeasible_alone_and_off_grid(cube, tmp_path, capsys):
+    rc, out, _ = run(capsys, write_spec(tmp_path, cube, constraints=["radius <= 2 mm"]))
+    assert rc == 0 and "radius <= 2 mm: no design in the cube meets it; the nearest has " \
+                       "radius = 5 mm" in out
+    rc, out, _ = run(capsys, write_spec(tmp_path, cube, constraints=["length == 150 mm"]))
+    assert rc == 0 and "the cube's length spans 70 mm .. 90 mm" in out
+
+
+@pytest.mark.parametrize("doc, match", [
+    ({"objectives": [{"max": "tip_force"}]}, r"objectives\[0\]: unknown name 'tip_force'"),
+    ({"objectives": [{"up": "radius"}]}, r"objectives\[0\]: sense must be 'max' or 'min'"),
+    ({"objectives": []}, r"objectives: expected a list"),
+    ({"constraints": ["radius <= 20 kPa"]}, r"constraints\[0\] radius: unit 'kPa'"),
+    ({"constraints": ["force >= 1 N"]}, r"constraints\[0\]: unknown name 'force'"),
+    ({"refine": {"starts": 0}}, r"refine.starts: must be an integer in \[1, 1000\]"),
+    ({"colour": "red"}, r"colour: unknown key"),
+    ({"grid": {}}, r"exactly one of 'cube'"),
+    ({"silicone": "tc5005"}, r"silicone: a cube carries its own materials"),
+])
+def test_malformed_specs_are_refused_with_one_line(doc, match):
+    raw = {"cube": "c.h5", "objectives": [{"max": "tip_force_max"}], **doc}
+    with pytest.raises(InputError, match=match):
+        parse_spec(raw)
+
+
+def test_malformed_spec_exits_2(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text("cube: c.h5\nobjectives: [{max: nope}]\n")
+    rc, out, err = run(capsys, path)
+    assert rc == 2 and out == "" and err.count("\n") == 1 and "objectives[0]" in err
+    rc, _, err = run(capsys, tmp_path / "missing.yaml")
+    assert rc == 2 and "no such spec file" in err
+
+
+def test_grid_start_computes_the_cube_in_memory():
+    raw = {"grid": {**SMALL["grid"], "radius": {"values": [15, 20], "units": "mm"}},
+           "silicone": "tc5005", "objectives": [{"max": "tip_force_max"}],
+           "constraints": PAPER_Q1, "refine": False}
+    res = run_design(raw)
+    assert res.designs[0]["tip_force_max"] == pytest.approx(1.2034, abs=1e-4)
+
+
+def test_chart_is_written(cube, tmp_path, capsys):
+    path = write_spec(tmp_path, cube, objectives=FRONT, constraints=["range_fraction >= 1"],
+                      refine={"starts": 3, "maxiter": 10})
+    rc, _, err = run(capsys, path, "--chart", tmp_path / "charts")
+    assert rc == 0 and (tmp_path / "charts" / "t.png").stat().st_size > 10_000
