@@ -1,0 +1,15 @@
+"""Calibration: fit material and muscle sets to bench data, and check a design against it.
+
+Domain functions only (they return values and never print): :func:`read_table` reads the
+data, :func:`fit_silicone`, :func:`fit_stroke`, :func:`fit_thermal` and :func:`fit_muscle`
+return a :class:`FitResult`, :func:`write_material_file` writes the YAML file that configs
+use as ``silicone: {file: ...}`` or ``nylon: {file: ...}``, and :func:`validate_design`
+compares one design's model with its measurements. docs/calibration.md has the formats.
+"""
+
+from .data import Table, read_table
+from .hyperelastic import MODELS, TESTS, fit_silicone, nominal_stress
+from .result import FitResult
+
+__all__ = ["MODELS", "TESTS", "FitResult", "Table", "fit_silicone", "nominal_stress",
+           "read_table"]
