@@ -293,4 +293,7 @@ def read_yaml(path) -> dict:
 
 def load_config(path, overrides=()) -> ResolvedConfig:
     """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
-    return parse_config(apply_overrides(read_yaml(path), overrides), str(path))
+    from .calibration.files import anchor_material_files
+
+    raw = anchor_material_files(read_yaml(path), Path(path).parent)
+    return parse_config(apply_overrides(raw, overrides), str(path))

@@ -240,6 +240,13 @@ def _resolve(kind, table, value, overrides):
         return value
     if isinstance(value, Mapping):
         value = dict(value)
+        if "file" in value:  # a fitted material file (nylonflex.calibration), as a set
+            from .calibration.files import read_material_set
+
+            if "set" in value:
+                raise ValueError(f"{kind}: give 'file' or 'set', not both")
+            value["set"], params = read_material_set(kind, value.pop("file"), table)
+            table = {**table, value["set"]: params}
         overrides = {**{k: v for k, v in value.items() if k != "set"}, **(overrides or {})}
         value = value.get("set")
         if value is None:

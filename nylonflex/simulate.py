@@ -483,7 +483,10 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
 
 def load_sim_config(path) -> SimConfig:
     """Read and validate a simulation config file (YAML)."""
-    return parse_sim_config(read_yaml(path), str(path))
+    from .calibration.files import anchor_material_files
+
+    raw = anchor_material_files(read_yaml(path), Path(path).parent)
+    return parse_sim_config(raw, str(path))
 
 
 # ---------------------------------------------------------------------------------------

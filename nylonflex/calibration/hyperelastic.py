@@ -275,4 +275,4 @@ def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
         rmse=rmse, r2=r2, fitted_range={"stretch": [float(lam[0]), float(lam[-1])]},
         data={"path": table.path, "sha256": table.sha256}, x_name="stretch",
         y_name="nominal_stress", x=lam, y=stress, y_fit=y_fit, uncertainty=sol.method,
-        units={**units, "initial_shear_modulus": "Pa"}, notes=notes)
+        units={**units, "initial_shear_modulus": "Pa", "rmse": "Pa"}, notes=notes)
