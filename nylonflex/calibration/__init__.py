@@ -8,8 +8,12 @@ compares one design's model with its measurements. docs/calibration.md has the f
 """
 
 from .data import Table, read_table
+from .files import read_material_set, write_material_file
 from .hyperelastic import MODELS, TESTS, fit_silicone, nominal_stress
+from .muscle import fit_muscle, fit_stroke, fit_thermal
 from .result import FitResult
+from .validate import validate_design
 
-__all__ = ["MODELS", "TESTS", "FitResult", "Table", "fit_silicone", "nominal_stress",
-           "read_table"]
+__all__ = ["MODELS", "TESTS", "FitResult", "Table", "fit_muscle", "fit_silicone",
+           "fit_stroke", "fit_thermal", "nominal_stress", "read_material_set", "read_table",
+           "validate_design", "write_material_file"]

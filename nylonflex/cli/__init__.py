@@ -26,6 +26,8 @@ COMMANDS = {
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",
+    "fit": "fit",
+    "validate": "validate",
 }
 
 
