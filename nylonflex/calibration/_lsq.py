@@ -53,7 +53,8 @@ def _cov(jac, residuals, dof):
     return s2 * np.linalg.inv(jtj)
 
 
-def solve(residual, jacobian, starts, lower, upper, *, bootstrap=100, seed=0):
+def solve(residual, jacobian, starts, lower, upper, *, bootstrap=100, seed=0,
+          max_nfev=2000):
     """Minimise ``sum residual(x)^2`` from several starts, with bounds.
 
     Parameters
@@ -68,6 +69,8 @@ def solve(residual, jacobian, starts, lower, upper, *, bootstrap=100, seed=0):
         Bounds of each parameter.
     bootstrap : int
         Residual-bootstrap draws when the Jacobian covariance does not hold.
+    max_nfev : int
+        Evaluations allowed a start.
     seed : int
         Seed of the bootstrap.
 
@@ -82,7 +85,7 @@ def solve(residual, jacobian, starts, lower, upper, *, bootstrap=100, seed=0):
         x0 = np.clip(np.asarray(x0, float), lower, upper)
         try:
             r = optimize.least_squares(residual, x0, jac=jacobian, bounds=(lower, upper),
-                                       method="trf", x_scale="jac", max_nfev=2000)
+                                       method="trf", x_scale="jac", max_nfev=max_nfev)
         except (ValueError, FloatingPointError, np.linalg.LinAlgError):
             continue
         if not (np.all(np.isfinite(r.x)) and np.isfinite(r.cost)):
@@ -113,7 +116,7 @@ def solve(residual, jacobian, starts, lower, upper, *, bootstrap=100, seed=0):
             return residual(x) + shift
         try:
             rb = optimize.least_squares(r2, best.x, jac=jacobian, bounds=(lower, upper),
-                                        method="trf", x_scale="jac", max_nfev=200)
+                                        method="trf", x_scale="jac", max_nfev=100)
         except (ValueError, FloatingPointError):
             continue
         if np.all(np.isfinite(rb.x)):

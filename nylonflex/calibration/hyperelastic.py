@@ -35,6 +35,8 @@ MODELS = {"ogden1": 1, "ogden2": 2, "ogden3": 3, "neo_hookean": 1, "yeoh2": None
 TESTS = ("uniaxial", "planar")
 _K = {"uniaxial": -0.5, "planar": -1.0}  # l3 = l^k
 _ALPHA_MIN, _ALPHA_MAX = 0.05, 40.0
+#: A fit that explains less than this of the variance is refused as not converged.
+MIN_R2 = 0.5
 
 
 def _check_model(model, test):
@@ -184,6 +186,13 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="
     y = stress / scale
     rng = np.random.default_rng(seed)
 
+    def _res(x):
+        return _ogden(lam, x[:n_terms], x[n_terms:], test)[0] - y
+
+    def _jac(x):
+        _, dmu, dal = _ogden(lam, x[:n_terms], x[n_terms:], test)
+        return np.hstack([dmu, dal])
+
     if model == "yeoh2":
         def res(x):
             return _yeoh(lam, x, test)[0] - y
@@ -200,27 +209,22 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="
             return _ogden(lam, x, np.array([2.0]), test)[1]
         sol = solve(res, jac, [np.array([0.1]), np.array([1.0])], [0.0], [np.inf], seed=seed)
     else:
-        best = None
+        screened = []  # a short run from every start, then the best few run to the end
         for x0, signs in _ogden_starts(n_terms, lam, y, test, rng, max(starts, 2)):
             lo = np.concatenate([np.where(signs > 0, 0.0, -np.inf),
                                  np.where(signs > 0, _ALPHA_MIN, -_ALPHA_MAX)])
             hi = np.concatenate([np.where(signs > 0, np.inf, 0.0),
                                  np.where(signs > 0, _ALPHA_MAX, -_ALPHA_MIN)])
-
-            def res(x):
-                return _ogden(lam, x[:n_terms], x[n_terms:], test)[0] - y
-
-            def jac(x):
-                _, dmu, dal = _ogden(lam, x[:n_terms], x[n_terms:], test)
-                return np.hstack([dmu, dal])
-            cand = solve(res, jac, [x0], lo, hi, bootstrap=0)
-            if cand is not None and (best is None or cand.residuals @ cand.residuals <
-                                     best[0].residuals @ best[0].residuals):
-                best = (cand, lo, hi, res, jac)
+            cand = solve(_res, _jac, [x0], lo, hi, bootstrap=0, max_nfev=400)
+            if cand is not None:
+                screened.append((float(cand.residuals @ cand.residuals), cand.x, lo, hi))
+        screened.sort(key=lambda c: c[0])
         sol = None
-        if best is not None:  # redo the best for its uncertainty (bootstrap if on a bound)
-            cand, lo, hi, res, jac = best
-            sol = solve(res, jac, [cand.x], lo, hi, seed=seed)
+        for _, x0, lo, hi in screened[:4]:
+            cand = solve(_res, _jac, [x0], lo, hi, seed=seed)
+            if cand is not None and (sol is None or cand.residuals @ cand.residuals <
+                                     sol.residuals @ sol.residuals):
+                sol = cand
     if sol is None or not sol.converged or not np.all(np.isfinite(sol.x)):
         raise InputError(f"{path}: the {model} fit did not converge; try another --model "
                          "or --max-stretch")
@@ -264,6 +268,9 @@ def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
         ci95 = {"mu": [list(c) for c in ci[:n_terms]], "alpha": [list(c) for c in ci[n_terms:]]}
     y_fit = nominal_stress(lam, model, params, test)
     rmse, r2 = statistics(stress, y_fit)
+    if not r2 >= MIN_R2:
+        raise InputError(f"{table.path}: the {model} fit did not converge to a usable "
+                         f"solution (R^2 = {r2:.3g} < {MIN_R2}); is this a loading curve?")
     notes = []
     if sol.method == "bootstrap":
         notes.append("a parameter sits on its bound (a vanishing or extreme Ogden term): "

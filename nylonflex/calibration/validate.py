@@ -135,7 +135,7 @@ def validate_design(config, data) -> list[Comparison]:
             if q == "bend_angle":
                 m = bend_angle(p, a, t, L, b, silicone=design["silicone"])
             else:
-                m = tip_force(p, a, L, b)
+                m = tip_force(p, a, L, t if b is None else b)  # b = t: 'wall'
             found.append((q, p, y, np.asarray(m, float)))
     if not found:
         raise InputError(f"{table.path}: needs columns stroke and pressure, pressure and "
