@@ -6,7 +6,7 @@
   paper's eq. 2); s_max = s(T_max).
 - :func:`fit_thermal`: a step response at a known voltage to eq. (3),
   ``T(t) = T_inf + (T_0 - T_inf) exp(-(t - t_0)/tau)``; lambda' = V^2 / (R l_m (T_inf - T_amb))
-  and c' = tau lambda' (MODEL.md section 2: R = r' l_m, Lambda = lambda' l_m, C = c' l_m).
+  and c' = tau lambda' (R = r' l_m, Lambda = lambda' l_m, C = c' l_m).
 - :func:`fit_muscle`: force against displacement and temperature (and velocity) to eq. (1),
   ``F = k x + c (T - T_amb) [+ b dx/dt]``; the blocked force c (T_max - T_amb).
 """
