@@ -9,6 +9,7 @@ dotted path) and what it accepts.
 from __future__ import annotations
 
 import copy
+import math
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -448,4 +449,7 @@ def read_yaml(path) -> dict:
 
 def load_config(path, overrides=()) -> ResolvedConfig:
     """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
-    return parse_config(apply_overrides(read_yaml(path), overrides), str(path))
+    from .material_files import anchor_material_files
+
+    raw = anchor_material_files(read_yaml(path), Path(path).parent)
+    return parse_config(apply_overrides(raw, overrides), str(path))

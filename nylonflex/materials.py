@@ -240,6 +240,14 @@ def _resolve(kind, table, value, overrides):
         return value
     if isinstance(value, Mapping):
         value = dict(value)
+        if "file" in value:  # a fitted material file (nylonflex.calibration), as a set
+            from .material_files import read_material_set
+
+            if "set" in value:
+                raise ValueError(f"{kind}: give 'file' or 'set', not both")
+            known = {f.name for f in fields(Nylon)} - {"name", "description", "sources"}
+            value["set"], params = read_material_set(kind, value.pop("file"), table, known)
+            table = {**table, value["set"]: params}
         overrides = {**{k: v for k, v in value.items() if k != "set"}, **(overrides or {})}
         value = value.get("set")
         if value is None:

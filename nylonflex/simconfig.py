@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
@@ -521,5 +522,9 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
 
 
 def load_sim_config(path) -> SimConfig:
-    """Read and validate a simulation config file (YAML)."""
-    return parse_sim_config(read_yaml(path), str(path))
+    """Read and validate a simulation config file (YAML); material files are read relative
+    to its folder."""
+    from .material_files import anchor_material_files
+
+    raw = anchor_material_files(read_yaml(path), Path(path).parent)
+    return parse_sim_config(raw, str(path))

@@ -27,6 +27,8 @@ COMMANDS = {
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",
+    "fit": "fit",
+    "validate": "validate",
 }
 
 

@@ -73,15 +73,13 @@ class Model:
 
 def _exact(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness,
            silicone, nylon, model):
-    """The one call into the exact pointwise model (every design variable, SI).
+    """The one call into the exact pointwise model, :func:`nylonflex.evaluate` (compiled;
+    every design variable, SI)."""
+    from ..engine import evaluate
 
-    ``nylonflex.evaluate`` (compiled, same names and values) replaces ``design_limits`` here
-    when it lands; ``model`` is then passed on.
-    """
-    from ..physics import design_limits
-
-    return design_limits(radius, wall_thickness, length, coil_index, wrap_angle,
-                         base_thickness, silicone, nylon)
+    return evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
+                    base_thickness=base_thickness, silicone=silicone, nylon=nylon,
+                    model=model)
 
 
 def evaluate_rows(model, rows) -> dict:

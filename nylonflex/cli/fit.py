@@ -1,0 +1,131 @@
+"""``nylonflex fit silicone|stroke|thermal|muscle DATA``: fit a set, write its material file."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+HELP = "fit a silicone or nylon muscle set to bench data"
+DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
+as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md.
+
+  nylonflex fit silicone tests/data/ecoflex_0050.csv --model ogden2 --max-stretch 4 \\
+      --out fits/ecoflex50.yaml --chart fits/
+  nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
+  nylonflex fit thermal step.csv --voltage 5V --muscle-length 300mm
+  nylonflex fit muscle force.csv"""
+
+KINDS = ("silicone", "stroke", "thermal", "muscle")
+
+
+def add_arguments(p):
+    p.add_argument("kind", choices=KINDS, help="what to fit")
+    p.add_argument("data", help="data file (CSV with units in the header, or a Soft Robotics "
+                   "Materials Database file)")
+    p.add_argument("--model", default="ogden2",
+                   help="silicone: ogden1|ogden2|ogden3|neo_hookean|yeoh2 (default ogden2)")
+    p.add_argument("--test", default="uniaxial", choices=["uniaxial", "planar"],
+                   help="silicone: the test (default uniaxial)")
+    p.add_argument("--max-stretch", type=float, help="silicone: fit stretch <= X only")
+    p.add_argument("--coil-index", type=float, help="stroke: coil index C of the muscle")
+    p.add_argument("--voltage", help="thermal: step voltage, e.g. 5V")
+    p.add_argument("--muscle-length", help="thermal: muscle length, e.g. 300mm (for lambda', c')")
+    p.add_argument("--resistance", help="thermal: muscle resistance, e.g. 45ohm (default r' l_m)")
+    p.add_argument("--nylon", default="silver_nylon66",
+                   help="stroke/thermal/muscle: base nylon set (T_amb, T_max, coil table)")
+    p.add_argument("--t-amb", help="ambient temperature, e.g. 25degC (default: the set's)")
+    p.add_argument("--t-max", help="highest temperature, e.g. 150degC (default: the set's)")
+    p.add_argument("--name", default="", help="name of the fitted set")
+    p.add_argument("--out", metavar="FILE.yaml", help="write the material file here")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    p.add_argument("--chart", metavar="DIR", help="draw data, fit and residuals into DIR")
+    p.add_argument("--format", choices=["table", "json"], default="table")
+
+
+def _q(text, field, kind, unit):
+    from ..units import parse_quantity
+
+    return None if text is None else parse_quantity(text, field, kind, unit)
+
+
+def fit(args):
+    """The FitResult the arguments ask for."""
+    from ..calibration import fit_muscle, fit_silicone, fit_stroke, fit_thermal
+    from ..units import InputError
+
+    t_amb = _q(args.t_amb, "--t-amb", "temperature", "degC")
+    t_max = _q(args.t_max, "--t-max", "temperature", "degC")
+    if args.kind == "silicone":
+        return fit_silicone(args.data, args.model, args.test, args.max_stretch, args.name)
+    nylon = {"file": args.nylon} if args.nylon.endswith((".yaml", ".yml")) else args.nylon
+    if args.kind == "stroke":
+        if args.coil_index is None:
+            raise InputError("--coil-index: required for 'fit stroke'")
+        return fit_stroke(args.data, args.coil_index, nylon, t_amb, t_max, args.name)
+    if args.kind == "thermal":
+        if args.voltage is None:
+            raise InputError("--voltage: required for 'fit thermal', e.g. --voltage 5V")
+        return fit_thermal(args.data, _q(args.voltage, "--voltage", "voltage", "V"),
+                           _q(args.muscle_length, "--muscle-length", "length", "mm"),
+                           _q(args.resistance, "--resistance", "resistance", "ohm"),
+                           nylon, t_amb, args.name)
+    return fit_muscle(args.data, nylon, t_amb, t_max, args.name)
+
+
+def format_table(res) -> str:
+    """The fit as aligned text lines."""
+    def one(v):
+        return f"{v:.6g}"
+    lines = [f"{res.kind} fit: {res.model}" + (f" ({res.test})" if res.test else "")
+             + f", {res.n_points} points of {res.data['path']}",
+             f"  data sha256 {res.data['sha256']}",
+             f"  {'parameter':<28}{'value':>14}{'std error':>14}   95 % interval"]
+    for key, val in res.parameters.items():
+        unit = res.units.get(key, "")
+        vals = val if isinstance(val, list) else [val]
+        ses = res.stderr[key] if isinstance(val, list) else [res.stderr[key]]
+        cis = res.ci95[key] if isinstance(val, list) else [res.ci95[key]]
+        for i, (v, s, c) in enumerate(zip(vals, ses, cis)):
+            name = f"{key}_{i + 1}" if isinstance(val, list) else key
+            lines.append(f"  {name + ' [' + unit + ']':<28}{one(v):>14}{one(s):>14}   "
+                         f"[{one(c[0])}, {one(c[1])}]")
+    for key, d in res.derived.items():
+        unit = res.units.get(key, "")
+        lines.append(f"  {key + ' [' + unit + ']':<28}{one(d['value']):>14}"
+                     f"{one(d['stderr']):>14}   [{one(d['ci95'][0])}, {one(d['ci95'][1])}]")
+    rng = ", ".join(f"{k} {one(v[0])}-{one(v[1])}" for k, v in res.fitted_range.items())
+    lines.append(f"  RMSE {one(res.rmse)} {res.units.get('rmse', '')}, R^2 {res.r2:.6f}; "
+                 f"fitted range (SI): {rng}; intervals: {res.uncertainty}")
+    lines += [f"  note: {n}" for n in res.notes]
+    return "\n".join(lines) + "\n"
+
+
+def run(args) -> int:
+    from ..calibration import write_material_file
+    from ..units import InputError
+    from . import warn
+
+    if args.out and not args.overwrite:
+        from pathlib import Path
+
+        if Path(args.out).exists():  # refuse before the work, and never overwrite silently
+            raise InputError(f"--out {args.out}: exists; give --overwrite to replace it")
+    res = fit(args)
+    if args.out:
+        write_material_file(res, args.out, name=args.name or None, overwrite=args.overwrite)
+    if args.chart:
+        from pathlib import Path
+
+        from ..charts_fit import fit_chart
+
+        stem = Path(args.data).stem
+        fit_chart(res, Path(args.chart) / f"fit_{args.kind}_{stem}_{res.model}.png")
+    if args.format == "json":
+        sys.stdout.write(json.dumps(res.to_json(), indent=2) + "\n")
+    else:
+        sys.stdout.write(format_table(res))
+        if args.out:
+            print(f"wrote {args.out}")
+    for n in res.notes if args.format == "json" else ():
+        warn("fit", n)
+    return 0
