@@ -40,7 +40,7 @@ _RC = {"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.font
 
 # The paper's worked examples (section 4), SI: (radius, wall, length, coil index).
 _EXAMPLES = ((20e-3, 6e-3, 90e-3, 1.1), (7.5e-3, 2e-3, 70e-3, 1.7))
-_WRAP_DEFAULT = math.radians(8.0)  # MODEL.md s. 8 checks the examples at psi = 8 deg
+_WRAP_DEFAULT = math.radians(8.0)  # docs/model.md s. 8 checks the examples at psi = 8 deg
 _LENGTH_DEFAULT = 90e-3
 
 
@@ -174,7 +174,7 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
     a_r = _nearest(ds, "radius", 15e-3 if radius is None else radius)
     t_r = _nearest(ds, "wall_thickness", 4e-3 if wall_thickness is None else wall_thickness)
 
-    # F_n does not depend on the coil index (MODEL.md s. 4): read it at the first one
+    # F_n does not depend on the coil index (docs/model.md s. 4): read it at the first one
     force = ds["nylon_force"].isel(coil_index=0)
     stroke = to_display("stroke", ds["stroke"].values)
     f_lim = to_display("nylon_force_limit", ds["nylon_force_limit"].values)

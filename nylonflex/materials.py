@@ -1,7 +1,7 @@
-"""Named, cited material parameter sets (MODEL.md section 9).
+"""Named, cited material parameter sets (docs/model.md section 9).
 
 Each set is a plain dict of SI values beside a ``sources`` dict that says where every
-value comes from, tagged as MODEL.md does:
+value comes from, tagged as docs/model.md does:
 
 - ``S`` read in a source,
 - ``D`` derived,
@@ -122,7 +122,8 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
             "linear in coil index between 1.1 and 1.7",
             "tensile_strength_table": "P: about 100 MPa at C = 1.1 (1 kg on a 0.34 mm thread, "
             "Cho et al. via Sun et al. 2021), falling as 1/C",
-            "coil_index_table": "MODEL.md section 9",
+            "coil_index_table": "P: the coil indices the paper discusses (1.1-1.7), docs/model.md "
+            "section 9",
         },
     },
 }
@@ -164,7 +165,7 @@ class Silicone:
 
 @dataclass(frozen=True)
 class Nylon:
-    """Coiled nylon muscle parameters (MODEL.md section 9), SI except the eq. (2) shape.
+    """Coiled nylon muscle parameters (docs/model.md section 9), SI except the eq. (2) shape.
 
     Attributes
     ----------

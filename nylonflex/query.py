@@ -200,7 +200,7 @@ def _slab_rows(ds, at_loc, r0, r1):
         a, b = sub.isel({name: 0}), sub.isel({name: 1})
         mixed = (a["limit"] != b["limit"]) | a["limit"].isnull() | b["limit"].isnull()
         if name == "length":
-            # F* = M*/L and theta* = kappa(p*) L (MODEL.md s. 8): interpolate the
+            # F* = M*/L and theta* = kappa(p*) L (docs/model.md s. 8): interpolate the
             # length-free M* and kappa*, exact along this axis, then scale back
             la, lb = (float(ds["length"].values[k]) for k in at_loc["length"][:2])
             length = la * (1.0 - w) + lb * w

@@ -1,8 +1,8 @@
 """Slow, obviously right references for the fast solvers (like stumpy's ``tests/naive.py``).
 
-Adaptive scipy quadrature of MODEL.md section 6's double integral exactly as written (no
+Adaptive scipy quadrature of docs/model.md section 6's double integral exactly as written (no
 change of variables), bracketing root finders, and nothing shared with nylonflex's solvers
-but the material constants and the closed-form stress of MODEL.md section 5.
+but the material constants and the closed-form stress of docs/model.md section 5.
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def curvature(p, a, t, b, mu, alpha, near=None):
 
 
 def nylon_force(s, a, t, b, psi, c, mu, alpha, fibre_diameter):
-    """F_n(s) of MODEL.md section 4, written out [N]."""
+    """F_n(s) of docs/model.md section 4, written out [N]."""
     p = P_ATM * ((1 - s) ** -2 - 1)
     s_theta = stress(1 - s, mu, alpha)
     p_out = math.pi * (a + t) + 2 * (a + t) + 2 * b

@@ -59,7 +59,7 @@ _MAX_SAMPLES = 20_000_000
 #: Most actuators on one supply.
 _MAX_ACTUATORS = 64
 
-#: MODEL.md section 10: the default design, supply and timing.
+#: docs/model.md section 10: the default design, supply and timing.
 DEFAULTS: dict[str, Any] = {
     "silicone": "tc5005",
     "nylon": "silver_nylon66",
@@ -441,7 +441,7 @@ def _actuator(top: SimConfigModel, own: _Loop, path: str, duration: float, index
     if "rms_from" in met:
         rms_from = check_range(met["rms_from"], f"{pre}metrics.rms_from", "time", "s", 0.0,
                                duration)
-    else:  # the sine's first period is the warm-up from ambient (MODEL.md section 10)
+    else:  # the sine's first period is the warm-up from ambient (docs/model.md section 10)
         rms_from = min(1.0 / ref.params["frequency"], duration) if ref.kind == "sine" else 0.0
     return ActuatorSpec(
         name=name, silicone=sil, nylon=ny, initial_temperature=t0, reference=ref,

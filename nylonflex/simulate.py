@@ -1,4 +1,4 @@
-"""Closed-loop simulation in time: the paper's figures 9 and 10 (MODEL.md section 10).
+"""Closed-loop simulation in time: the paper's figures 9 and 10 (docs/model.md section 10).
 
 The plant is the thermal ODE of eq. (3) driving the muscle temperature T; the stroke s(T),
 the chamber pressure p(s) and the bend angle theta(p) follow quasi-statically. A pressure
@@ -298,7 +298,7 @@ def run_simulation(cfg: SimConfig):
              "supply_voltage": cfg.supply_voltage,
              "internal_resistance": cfg.internal_resistance, "time_step": cfg.step,
              "loop_time": loop_time,
-             "model": "MODEL.md section 10: exact step of eq. (3), quasi-static s, p, theta; "
+             "model": "docs/model.md section 10: exact step of eq. (3), quasi-static s, p, theta; "
                       "bang-bang on the pressure-based angle estimate"}
     if cfg.gripper:
         coords["actuator"] = ("actuator", [a.name for a in cfg.actuators],

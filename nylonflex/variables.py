@@ -39,7 +39,7 @@ class Variable:
     long_name : str
         Human label (``attrs["long_name"]``).
     description : str
-        What it is, with the MODEL.md section.
+        What it is, with the docs/model.md section.
     display : str
         Unit shown on charts and accepted bare on the command line.
     kind : str
@@ -92,69 +92,69 @@ _DEG = np.pi / 180.0
 
 COORDS = {v.name: v for v in [
     _v("radius", ["radius"], "m", "chamber radius", "inner radius a of the half-cylindrical "
-       "chamber (MODEL.md s. 1)", "mm", "length", lo=0.5e-3, hi=0.2),
+       "chamber (docs/model.md s. 1)", "mm", "length", lo=0.5e-3, hi=0.2),
     _v("wall_thickness", ["wall_thickness"], "m", "wall thickness",
-       "thickness t of the half-cylindrical silicone wall (MODEL.md s. 1)", "mm", "length",
+       "thickness t of the half-cylindrical silicone wall (docs/model.md s. 1)", "mm", "length",
        lo=0.1e-3, hi=0.05),
-    _v("length", ["length"], "m", "actuator length", "actuator length L (MODEL.md s. 1)",
+    _v("length", ["length"], "m", "actuator length", "actuator length L (docs/model.md s. 1)",
        "mm", "length", lo=1e-3, hi=2.0),
     _v("coil_index", ["coil_index"], "1", "coil index",
-       "spring index C = D/d of the coiled muscle (MODEL.md s. 2)", "1", "dimensionless"),
+       "spring index C = D/d of the coiled muscle (docs/model.md s. 2)", "1", "dimensionless"),
     _v("wrap_angle", ["wrap_angle"], "rad", "wrap angle",
-       "helix angle psi of the wrap from the hoop direction (MODEL.md s. 4)", "deg", "angle",
+       "helix angle psi of the wrap from the hoop direction (docs/model.md s. 4)", "deg", "angle",
        lo=0.1 * _DEG, hi=80.0 * _DEG),
     _v("stroke", ["stroke"], "1", "muscle stroke",
-       "muscle contraction s, a fraction of its ambient length (MODEL.md s. 2)", "1",
+       "muscle contraction s, a fraction of its ambient length (docs/model.md s. 2)", "1",
        "dimensionless", lo=0.0, hi=0.5),
     _v("pressure", ["pressure"], "Pa", "chamber pressure", "gauge pressure p of the chamber "
-       "(MODEL.md s. 3)", "kPa", "pressure", lo=0.0, hi=100e3),
+       "(docs/model.md s. 3)", "kPa", "pressure", lo=0.0, hi=100e3),
 ]}
 
 #: Inputs that are neither axes nor stored variables.
 INPUTS = {v.name: v for v in [
     _v("base_thickness", [], "m", "base thickness", "thickness b of the bottom layer below "
-       "the chamber floor; b = t unless given (MODEL.md s. 1)", "mm", "length",
+       "the chamber floor; b = t unless given (docs/model.md s. 1)", "mm", "length",
        lo=0.1e-3, hi=0.05),
 ]}
 
 DESIGN = {v.name: v for v in [
     _v("usable_stroke", AXES, "1", "usable stroke",
-       "s* = min(s_max(C), s_lim), the stroke the muscle can use (MODEL.md s. 8)", "1",
+       "s* = min(s_max(C), s_lim), the stroke the muscle can use (docs/model.md s. 8)", "1",
        "dimensionless"),
     _v("limit", AXES, "1", "limiting factor",
-       "0 stroke-limited (full range of motion), 1 strength-limited (MODEL.md s. 8)", "1",
+       "0 stroke-limited (full range of motion), 1 strength-limited (docs/model.md s. 8)", "1",
        "dimensionless", "int8"),
-    _v("pressure_max", AXES, "Pa", "maximum pressure", "p* = p(s*) (MODEL.md s. 8)", "kPa",
+    _v("pressure_max", AXES, "Pa", "maximum pressure", "p* = p(s*) (docs/model.md s. 8)", "kPa",
        "pressure"),
-    _v("torque_max", AXES, "N m", "maximum torque", "M* = M_P(p*) (MODEL.md s. 8)", "N mm",
+    _v("torque_max", AXES, "N m", "maximum torque", "M* = M_P(p*) (docs/model.md s. 8)", "N mm",
        "torque"),
-    _v("tip_force_max", AXES, "N", "maximum tip force", "F* = M*/L, blocked (MODEL.md s. 7-8)",
+    _v("tip_force_max", AXES, "N", "maximum tip force", "F* = M*/L, blocked (docs/model.md s. 7-8)",
        "N", "force"),
     _v("bend_angle_max", AXES, "rad", "maximum bend angle",
-       "theta* = kappa(p*) L, free bending (MODEL.md s. 6, 8)", "deg", "angle"),
+       "theta* = kappa(p*) L, free bending (docs/model.md s. 6, 8)", "deg", "angle"),
     _v("range_fraction", AXES, "1", "range of motion fraction",
-       "theta*/theta(s_max); 1 means a full range of motion (MODEL.md s. 8)", "1",
+       "theta*/theta(s_max); 1 means a full range of motion (docs/model.md s. 8)", "1",
        "dimensionless"),
-    _v("nylon_force_max", AXES, "N", "nylon force at usable stroke", "F_n(s*) (MODEL.md s. 4)",
+    _v("nylon_force_max", AXES, "N", "nylon force at usable stroke", "F_n(s*) (docs/model.md s. 4)",
        "N", "force"),
-    _v("nylon_use", AXES, "1", "nylon strength use", "F_n(s*)/F_lim(C) (MODEL.md s. 4, 8)",
+    _v("nylon_use", AXES, "1", "nylon strength use", "F_n(s*)/F_lim(C) (docs/model.md s. 4, 8)",
        "1", "dimensionless"),
 ]}
 
 CURVES = {v.name: v for v in [
     _v("nylon_force", ["radius", "wall_thickness", "coil_index", "wrap_angle", "stroke"], "N",
-       "nylon force", "tension F_n(s) in the wrap (MODEL.md s. 4)", "N", "force"),
+       "nylon force", "tension F_n(s) in the wrap (docs/model.md s. 4)", "N", "force"),
     _v("nylon_force_limit", ["coil_index"], "N", "nylon force limit",
-       "breaking force F_lim(C) = sigma_u(C) A_f (MODEL.md s. 2)", "N", "force"),
+       "breaking force F_lim(C) = sigma_u(C) A_f (docs/model.md s. 2)", "N", "force"),
     _v("stroke_max", ["coil_index"], "1", "maximum stroke",
-       "free stroke s_max(C) of the muscle at its highest safe temperature (MODEL.md s. 2)",
+       "free stroke s_max(C) of the muscle at its highest safe temperature (docs/model.md s. 2)",
        "1", "dimensionless"),
     _v("chamber_pressure", ["stroke"], "Pa", "chamber pressure",
-       "gauge pressure p(s), Boyle (MODEL.md s. 3)", "kPa", "pressure"),
+       "gauge pressure p(s), Boyle (docs/model.md s. 3)", "kPa", "pressure"),
     _v("bend_angle", ["radius", "wall_thickness", "length", "pressure"], "rad", "bend angle",
-       "free bending angle theta(p) = kappa(p) L (MODEL.md s. 6)", "deg", "angle"),
+       "free bending angle theta(p) = kappa(p) L (docs/model.md s. 6)", "deg", "angle"),
     _v("tip_force", ["radius", "wall_thickness", "length", "pressure"], "N", "tip force",
-       "blocked tip force M_P(p)/L (MODEL.md s. 7)", "N", "force"),
+       "blocked tip force M_P(p)/L (docs/model.md s. 7)", "N", "force"),
 ]}
 
 #: The mask of the radii a sweep has stored (1) or not yet (0).

@@ -26,7 +26,8 @@ def test_pressure_moment_is_first_moment_of_the_half_disc():
 @pytest.mark.parametrize("a,t,kappa", [(5e-3, 1e-3, 3.0), (25e-3, 6e-3, 40.0),
                                        (12e-3, 2e-3, 150.0)])
 def test_material_moment_matches_adaptive_quadrature(name, a, t, kappa):
-    # MODEL.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12 (nylonflex.reference)
+    # docs/model.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12
+    # (nylonflex.reference)
     mu, alpha = silicone_parameters(name).arrays()
     expected = ref.material_moment(kappa, a, t, t, mu, alpha)
     assert bending.material_moment(kappa, a, t, None, name) == pytest.approx(expected,
@@ -96,19 +97,19 @@ def test_angle_monotone_in_pressure(name, a, t, pressures):
 
 @given(st.floats(1e-3, 0.3), st.floats(0.0, 40e3))
 def test_angle_proportional_to_length(length, p):
-    # MODEL.md section 6: theta depends on L only through the factor L
+    # docs/model.md section 6: theta depends on L only through the factor L
     theta = bending.bend_angle(p, 8e-3, 2e-3, length)
     assert theta == pytest.approx(bending.curvature(p, 8e-3, 2e-3) * length, rel=1e-15)
 
 
 def test_base_thickness_choice_defaults_to_wall():
-    # MODEL.md section 1 [choice]: b = t unless given
+    # docs/model.md section 1 [choice]: b = t unless given
     assert bending.curvature(20e3, 9e-3, 3e-3) == bending.curvature(20e3, 9e-3, 3e-3, 3e-3)
     assert bending.curvature(20e3, 9e-3, 3e-3) != bending.curvature(20e3, 9e-3, 3e-3, 1e-3)
 
 
 def test_nominal_stress_on_undeformed_section_choice():
-    # MODEL.md section 6 [choice]: M_S integrates the nominal S = sigma/l, not sigma, over
+    # docs/model.md section 6 [choice]: M_S integrates the nominal S = sigma/l, not sigma, over
     # the undeformed section; the two differ by the factor l at each fibre.
     a, t, kappa = 10e-3, 2e-3, 30.0
     mu, alpha = silicone_parameters("tc5005").arrays()
@@ -127,7 +128,7 @@ def test_nominal_stress_on_undeformed_section_choice():
 
 
 def test_tip_force_is_pressure_moment_over_length():
-    # eq. (16), MODEL.md section 7
+    # eq. (16), docs/model.md section 7
     assert bending.tip_force(10e3, 7.5e-3, 0.07, 2e-3) == pytest.approx(
         bending.pressure_moment(10e3, 7.5e-3, 2e-3) / 0.07, rel=1e-15)
 

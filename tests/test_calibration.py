@@ -77,11 +77,13 @@ def test_other_forms_recover_known_parameters(tmp_path, model, params):
     for k, v in params.items():
         assert np.allclose(r.parameters[k], v, rtol=1e-6)
 
+@pytest.mark.slow
 
 def test_ogden_fits_keep_the_stability_condition():
     r = fit_silicone(ECOFLEX, "ogden3", max_stretch=2.0, starts=2)
     assert all(m * a >= 0 for m, a in zip(r.parameters["mu"], r.parameters["alpha"]))
 
+@pytest.mark.slow
 
 def test_initial_shear_modulus_interval_covers_the_truth(tmp_path):
     """Issue 11: 20 sets with 2 % noise, the 95 % interval covers mu_0 >= 16 times."""
@@ -109,6 +111,7 @@ def _database_authors_fit(lam, stress_mpa):
     return float(np.sqrt(np.mean(r.fun**2))) * 1e6  # [Pa]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("max_stretch", [None, 4.0])
 def test_ecoflex_fit_no_worse_than_the_database_script(max_stretch):
     t = read_table(ECOFLEX)
@@ -157,6 +160,7 @@ def test_config_file_path_is_relative_to_the_config(tmp_path):
     assert c.silicone.name == "file:ecoflex_0050"  # the data file's stem
 
 
+@pytest.mark.slow
 # --- nylon -------------------------------------------------------------------------------
 
 def test_stroke_interval_covers_s_max(tmp_path):
@@ -183,6 +187,7 @@ def test_stroke_fit_adds_a_row_to_the_coil_table(tmp_path):
     assert float(np.interp(1.6, ny.coil_index_table, ny.stroke_max_table)) == \
         pytest.approx(0.9 * 0.083, rel=1e-6)
 
+@pytest.mark.slow
 
 def test_thermal_interval_covers_tau(tmp_path):
     rng = np.random.default_rng(3)
@@ -261,6 +266,7 @@ def test_bad_data_is_refused(tmp_path, capsys, name):
     assert rc == 2 and not out.exists()
     assert len(err.splitlines()) == 1 and name in err
 
+@pytest.mark.slow
 
 def test_cli_json_and_no_silent_overwrite(tmp_path, capsys):
     import json

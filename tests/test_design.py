@@ -1,6 +1,6 @@
 """``nylonflex design``: specs, the grid's best design and Pareto set, refinement, refusals.
 
-Expected numbers: the paper's first worked example (section 4; MODEL.md section 8: 20 mm,
+Expected numbers: the paper's first worked example (section 4; docs/model.md section 8: 20 mm,
 6 mm, 90 mm, C 1.1, psi 8 deg gives 1.20 N with a full range of motion); the Pareto set
 against a brute-force O(n^2) check; every design against the constraints it was asked for.
 """
@@ -161,6 +161,7 @@ def tiny():
             "wrap_angle": {"values": [5, 20], "units": "deg"}}
     return run_sweep(parse_config({**SMALL, "grid": grid}))
 
+@pytest.mark.slow
 
 def test_no_returned_design_violates_a_constraint(tiny):
     ds, rows = tiny, cube_rows(tiny)
@@ -203,7 +204,7 @@ def test_json_has_designs_and_units_in_si(cube, tmp_path, capsys):
     assert rc == 0 and set(doc) == {"designs", "units"}
     d = doc["designs"][0]
     assert d["source"] == "grid" and d["radius"] == pytest.approx(0.02)
-    assert d["tip_force_max"] == pytest.approx(1.2034, abs=1e-4)  # MODEL.md s. 8: 1.20 N
+    assert d["tip_force_max"] == pytest.approx(1.2034, abs=1e-4)  # docs/model.md s. 8: 1.20 N
     assert doc["units"]["radius"] == "m" and doc["units"]["wrap_angle"] == "rad"
 
 

@@ -1,4 +1,4 @@
-"""The compiled kernels against the physics functions (rtol 1e-9, MODEL.md section 11)."""
+"""The compiled kernels against the physics functions (rtol 1e-9, docs/model.md section 11)."""
 
 import numpy as np
 import pytest

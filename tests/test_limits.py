@@ -22,7 +22,7 @@ def test_returns_every_design_variable_of_the_cube_table():
 
 
 def test_paper_example_1_large_actuator():
-    # paper section 4 / MODEL.md section 8: (20, 6, 90 mm, C 1.1) ~ 1.2 N, full range
+    # paper section 4 / docs/model.md section 8: (20, 6, 90 mm, C 1.1) ~ 1.2 N, full range
     d = design_limits(**EXAMPLE_1)
     assert d["tip_force_max"] == pytest.approx(1.20, rel=0.01)
     assert d["limit"] == 0
@@ -31,7 +31,7 @@ def test_paper_example_1_large_actuator():
 
 
 def test_paper_example_2_small_actuator():
-    # paper section 4 / MODEL.md section 8: (7.5, 2, 70 mm, C 1.7) ~ 0.15 N
+    # paper section 4 / docs/model.md section 8: (7.5, 2, 70 mm, C 1.7) ~ 0.15 N
     d = design_limits(**EXAMPLE_2)
     assert d["tip_force_max"] == pytest.approx(0.150, rel=0.01)
     assert d["limit"] == 0
@@ -49,7 +49,7 @@ def test_stroke_limited_values_follow_the_closed_forms():
                                                 rel=1e-12)
 
 
-# a large actuator with a steep wrap: strength-limited (MODEL.md section 8)
+# a large actuator with a steep wrap: strength-limited (docs/model.md section 8)
 STRONG = dict(radius=25e-3, wall_thickness=6e-3, length=90e-3, coil_index=1.7,
               wrap_angle=25 * DEG)
 
@@ -85,7 +85,7 @@ def test_nylon_force_formula_against_reference():
 
 
 def test_wrap_pitch_choice_helix_or_touching_turns():
-    # MODEL.md section 4 [choice]: pitch = max(P_out tan psi, w / cos psi), w = d_f (C + 1)
+    # docs/model.md section 4 [choice]: pitch = max(P_out tan psi, w / cos psi), w = d_f (C + 1)
     p_out = math.pi * 9.5e-3 + 2 * 9.5e-3 + 2 * 2e-3
     assert wrap.outer_perimeter(7.5e-3, 2e-3) == pytest.approx(p_out)
     assert wrap.wrap_pitch(7.5e-3, 2e-3, 8 * DEG, 1.7) == pytest.approx(p_out * math.tan(8 * DEG))
@@ -100,7 +100,7 @@ def test_wrap_pitch_choice_helix_or_touching_turns():
 @given(st.floats(5e-3, 25e-3), st.floats(1e-3, 6e-3), st.floats(1.1, 1.7),
        st.floats(2 * DEG, 30 * DEG), st.floats(0.03, 0.2), st.floats(0.03, 0.2))
 def test_nylon_force_and_limits_independent_of_length(a, t, c, psi, l1, l2):
-    # MODEL.md section 4: F_n independent of L; section 6: theta proportional to L
+    # docs/model.md section 4: F_n independent of L; section 6: theta proportional to L
     d1, d2 = design_limits(a, t, l1, c, psi), design_limits(a, t, l2, c, psi)
     for k in ("usable_stroke", "limit", "pressure_max", "torque_max", "nylon_force_max",
               "nylon_use", "range_fraction"):

@@ -9,7 +9,7 @@ from nylonflex.materials import (
 
 
 @pytest.mark.parametrize("name,mu0", [
-    # MODEL.md section 9, column mu_0 (printed to 3 digits from rounded mu, alpha)
+    # docs/model.md section 9, column mu_0 (printed to 3 digits from rounded mu, alpha)
     ("tc5005", 22.9e3), ("ecoflex_00_30", 17.3e3), ("dragon_skin_10", 50.1e3),
     ("elastosil_m4601", 220e3)])
 def test_initial_shear_modulus_matches_model_table(name, mu0):
@@ -22,8 +22,8 @@ def test_every_value_has_a_source():
     for name, p in NYLON_PARAMETERS.items():
         numeric = {k for k, v in p.items() if k not in ("description", "sources")}
         assert numeric <= set(p["sources"]), (name, numeric - set(p["sources"]))
-        # each source carries its tag S/D/P/K (MODEL.md section 9)
-        assert all(s.split(":")[0].strip("/ ")[0] in "SDPKM" for s in p["sources"].values())
+        # each source carries its tag S/D/P/K (docs/model.md section 9)
+        assert all(s.split(":")[0].strip("/ ")[0] in "SDPK" for s in p["sources"].values())
 
 
 def test_override_field_by_field():

@@ -6,13 +6,13 @@ import pytest
 from nylonflex.physics import nylon, thermal, wrap
 from nylonflex.physics.nylon import free_strain, stroke, stroke_max, tensile_strength
 
-T_AMB, T_MAX = 298.15, 423.15  # MODEL.md section 9: 25 degC, 150 degC
+T_AMB, T_MAX = 298.15, 423.15  # docs/model.md section 9: 25 degC, 150 degC
 
 
 @pytest.mark.parametrize("c,smax,su", [(1.1, 0.054, 100e6), (1.3, 0.068, 85e6),
                                        (1.5, 0.083, 73e6), (1.7, 0.097, 65e6)])
 def test_coil_index_table_rows(c, smax, su):
-    # MODEL.md section 9, coil-index table
+    # docs/model.md section 9, coil-index table
     assert stroke_max(c) == pytest.approx(smax, rel=1e-12)
     assert tensile_strength(c) == pytest.approx(su, rel=1e-12)
 
@@ -23,7 +23,7 @@ def test_table_interpolates_linearly():
 
 
 def test_force_limit_is_strength_times_fibre_area():
-    # F_lim = sigma_u pi d_f^2 / 4, d_f = 0.34 mm (MODEL.md sections 2, 9)
+    # F_lim = sigma_u pi d_f^2 / 4, d_f = 0.34 mm (docs/model.md sections 2, 9)
     assert nylon.nylon_force_limit(1.1) == pytest.approx(100e6 * math.pi * 0.34e-3**2 / 4)
 
 
@@ -36,7 +36,7 @@ def test_larger_coil_index_more_stroke_less_strength():
 
 @pytest.mark.parametrize("c", [1.1, 1.37, 1.7])
 def test_stroke_choice_zero_at_ambient_and_s_max_at_t_max(c):
-    # MODEL.md section 2 [choice]: s(T) = eps(T_amb) - eps(T), scaled to reach s_max(C)
+    # docs/model.md section 2 [choice]: s(T) = eps(T_amb) - eps(T), scaled to reach s_max(C)
     assert stroke(T_AMB, c) == 0.0
     assert stroke(T_MAX, c) == pytest.approx(stroke_max(c), rel=1e-13)
 
@@ -48,7 +48,7 @@ def test_stroke_is_one_shape_scaled_per_coil_index():
 
 
 def test_stroke_follows_eq2_erf_form():
-    # eq. (2) written out with the reference constants of MODEL.md section 9 (degC)
+    # eq. (2) written out with the reference constants of docs/model.md section 9 (degC)
     a, g, b, tg, sg = -0.04341, 1.951e-4, 0.04944, 118.6, 41.3
     eps = lambda tc: a - g * tc - b * math.erf((tc - tg) / (sg * math.sqrt(2)))  # noqa: E731
     k = 0.097 / (eps(25.0) - eps(150.0))
@@ -68,19 +68,19 @@ def test_temperature_for_stroke_inverts_stroke():
 
 
 def test_thermomechanical_force_eq1():
-    # F = k (x - x0) + b_d v + c (T - T0), MODEL.md section 9 constants
+    # F = k (x - x0) + b_d v + c (T - T0), docs/model.md section 9 constants
     f = nylon.thermomechanical_force(0.002, 0.01, T_AMB + 50, rest_displacement=0.001)
     assert f == pytest.approx(16 * 0.001 + 0.1 * 0.01 + 2e-3 * 50)
 
 
 def test_default_design_muscle_length_and_heating():
-    # MODEL.md section 10: l_m ~ 503 mm, R ~ 75 ohm, 1.91 W at 12 V, tau = c'/lambda' = 15 s
+    # docs/model.md section 10: l_m ~ 503 mm, R ~ 75 ohm, 1.91 W at 12 V, tau = c'/lambda' = 15 s
     lm = wrap.muscle_length(7.5e-3, 2e-3, 70e-3, 8 * math.pi / 180, 1.7)
     assert lm == pytest.approx(0.503, abs=1e-3)
     assert thermal.muscle_resistance(lm) == pytest.approx(75.5, abs=0.2)
     assert 12**2 / thermal.muscle_resistance(lm) == pytest.approx(1.91, abs=0.01)
     assert thermal.thermal_time_constant() == pytest.approx(15.0)
-    # MODEL.md section 9: with 12 V on ~0.5 m the muscle settles near T_max
+    # docs/model.md section 9: with 12 V on ~0.5 m the muscle settles near T_max
     assert thermal.steady_temperature(12.0, lm) == pytest.approx(T_MAX, abs=3.0)
 
 

@@ -1,6 +1,6 @@
 """``nylonflex query``: grid points, interpolation, filters, formats and refusals.
 
-Expected numbers come from MODEL.md section 8 (the paper's worked examples, 1.20 N and
+Expected numbers come from docs/model.md section 8 (the paper's worked examples, 1.20 N and
 0.150 N) and from :func:`nylonflex.design_limits` (the exact value at any design).
 """
 
@@ -57,7 +57,7 @@ def run(capsys, *argv):
 
 # ---------------------------------------------------------------------------- --at
 def test_paper_example_2_prints_0150_newton(cube, capsys):
-    # MODEL.md s. 8: (7.5 mm, 2 mm, 70 mm, C 1.7, psi 8 deg) gives 0.150 N, stroke-limited
+    # docs/model.md s. 8: (7.5 mm, 2 mm, 70 mm, C 1.7, psi 8 deg) gives 0.150 N, stroke-limited
     rc, out, _ = run(capsys, cube, "--at", AT_2)
     assert rc == 0
     assert "grid point" in out
@@ -66,7 +66,7 @@ def test_paper_example_2_prints_0150_newton(cube, capsys):
 
 
 def test_paper_example_1_bare_numbers_mean_mm_and_deg(cube, capsys):
-    # MODEL.md s. 8: (20 mm, 6 mm, 90 mm, C 1.1) gives 1.20 N with a full range of motion
+    # docs/model.md s. 8: (20 mm, 6 mm, 90 mm, C 1.1) gives 1.20 N with a full range of motion
     rc, out, _ = run(capsys, cube, "--at",
                      "radius=20,wall_thickness=6,length=90,coil_index=1.1,wrap_angle=8")
     assert rc == 0
@@ -99,7 +99,7 @@ def test_interpolated_radius_within_1_percent_of_design_limits(tmp_path):
 
 
 def test_length_interpolation_is_exact(ds):
-    # F* = M*/L and theta* = kappa L (MODEL.md s. 8): exact along L, whatever the spacing
+    # F* = M*/L and theta* = kappa L (docs/model.md s. 8): exact along L, whatever the spacing
     at = dict(EXAMPLE_1, length=77e-3)
     res = query.query_cube(ds, at=at)
     exact = nf.design_limits(**at)

@@ -12,7 +12,7 @@ SETS = list(SILICONE_PARAMETERS)
 
 @pytest.mark.parametrize("s,p", [
     (0.0, 0.0),
-    (0.1, 101325 * (1 / 0.81 - 1)),   # MODEL.md section 3 closed form
+    (0.1, 101325 * (1 / 0.81 - 1)),   # docs/model.md section 3 closed form
     (0.054, 101325 * (1 / 0.946**2 - 1)),
 ])
 def test_boyle_pressure(s, p):
@@ -20,7 +20,7 @@ def test_boyle_pressure(s, p):
 
 
 def test_volume_ratio_choice_uniform_shrink_at_fixed_length():
-    # MODEL.md section 3: V1/V2 = 1/(1 - s)^2 (eq. 8), isothermal P1 V1 = P2 V2
+    # docs/model.md section 3: V1/V2 = 1/(1 - s)^2 (eq. 8), isothermal P1 V1 = P2 V2
     s = np.linspace(0, 0.3, 7)
     p2 = chamber.P_ATM * chamber.volume_ratio(s)
     assert np.allclose(p2 - chamber.P_ATM, chamber.chamber_pressure(s), rtol=1e-13)
@@ -48,7 +48,7 @@ def test_bending_stress_is_tensile_and_increasing(name, lam):
 
 def test_neo_hookean_limit():
     # Ogden N=1, alpha=2 is neo-Hookean with shear modulus mu: plane strain nominal stress
-    # S = mu (l - l^-3) (MODEL.md section 5 with l2 = 1, l3 = 1/l)
+    # S = mu (l - l^-3) (docs/model.md section 5 with l2 = 1, l3 = 1/l)
     lam = np.linspace(0.6, 3.0, 9)
     assert np.allclose(silicone.bending_stress(lam, "elastosil_m4601"),
                        220e3 * (lam - lam**-3), rtol=1e-13)
@@ -73,7 +73,7 @@ def test_cauchy_stress_is_derivative_of_strain_energy():
 
 
 def test_hoop_stress_choice_holds_the_length():
-    # MODEL.md section 4 [choice]: l_theta = 1 - s, l_l = 1 (not the paper's eq. 10 1 - s),
+    # docs/model.md section 4 [choice]: l_theta = 1 - s, l_l = 1 (not the paper's eq. 10 1 - s),
     # sigma_r = 0, so S_theta(s) = S(1 - s) of the plane-strain formula
     s = 0.08
     assert silicone.hoop_stress(s) == pytest.approx(silicone.bending_stress(1 - s), rel=1e-15)

@@ -2,7 +2,7 @@
 simulate configs (issue 9). Parsing only; the simulation itself is tested in
 test_simulate.py.
 
-Expected values come from the configs' own text (``configs/*.yaml``), MODEL.md section 10's
+Expected values come from the configs' own text (``configs/*.yaml``), docs/model.md section 10's
 defaults as written in :data:`nylonflex.simconfig.DEFAULTS`, and the ranges of
 ``config.DESIGN_RANGES``.
 """
@@ -154,7 +154,7 @@ def test_value_units_form_and_bare_numbers_resolve_like_strings():
 
 
 def test_defaults_fill_an_almost_empty_config():
-    # DEFAULTS: MODEL.md section 10's design at 12 V, 120 s at 10 ms
+    # DEFAULTS: docs/model.md section 10's design at 12 V, 120 s at 10 ms
     cfg = parse_sim_config({"name": "d", "reference": {"kind": "step", "final": 90}})
     a = cfg.actuators[0]
     assert (cfg.supply_voltage, cfg.internal_resistance) == (12.0, 0.0)

@@ -1,8 +1,8 @@
-"""The closed-loop simulation (MODEL.md section 10; paper figures 9 and 10).
+"""The closed-loop simulation (docs/model.md section 10; paper figures 9 and 10).
 
 Each expected number says where it comes from: the closed-form solution of eq. (3), the
 physics layer's curvature solve (itself checked against adaptive quadrature elsewhere),
-MODEL.md section 10's independent check, or the issue's done criteria.
+docs/model.md section 10's independent check, or the issue's done criteria.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 DEG = math.pi / 180.0
 T0C = 273.15
 
-# MODEL.md section 10: the default design
+# docs/model.md section 10: the default design
 A, T, L, C, PSI = 7.5e-3, 2e-3, 70e-3, 1.7, 8 * DEG
 
 
@@ -44,7 +44,7 @@ def _yaml(name):
 
 
 def _base(**over):
-    """A short single-actuator config of the default design (MODEL.md section 10)."""
+    """A short single-actuator config of the default design (docs/model.md section 10)."""
     raw = {"name": "t", "time": {"duration": "20 s", "step": "10 ms"},
            "reference": {"kind": "step", "initial": 0, "final": 120, "at": "1 s"}}
     raw.update(over)
@@ -60,7 +60,7 @@ def _run(raw):
 def _exact_temperature(t, t_start, voltage, lm):
     """T(t) = T_ss + (T0 - T_ss) exp(-t/tau), tau = c'/lambda', T_ss = T_amb + V^2/(R Lambda).
 
-    Closed form of eq. (3) at constant voltage, with MODEL.md section 9's c' = 0.45 J/(K m),
+    Closed form of eq. (3) at constant voltage, with docs/model.md section 9's c' = 0.45 J/(K m),
     lambda' = 0.03 W/(K m), r' = 0.15 ohm/mm, T_amb = 25 degC.
     """
     r, loss = 150.0 * lm, 0.03 * lm
@@ -104,7 +104,7 @@ def _tables(points, p_top=24e3):
 def test_angle_table_is_the_curvature_solve():
     dp, angle, slope = _tables(33)
     p = dp * np.arange(33)
-    # physics.bend_angle: Newton on the Gauss-Legendre moment (MODEL.md section 6)
+    # physics.bend_angle: Newton on the Gauss-Legendre moment (docs/model.md section 6)
     np.testing.assert_allclose(angle, ph.bend_angle(p, A, T, L), rtol=1e-9, atol=0)
     # slope: central difference of the forward model
     h = 1.0
@@ -157,7 +157,7 @@ def test_switch_with_band(on, estimate, expected):
 
 @pytest.mark.parametrize("on", [False, True])
 def test_switch_without_band_is_plain_bang_bang(on):
-    # MODEL.md section 10: V = V_max when theta_hat < theta_ref, else 0
+    # docs/model.md section 10: V = V_max when theta_hat < theta_ref, else 0
     assert _switch(on, 0.999, 1.0, 0.0) is True
     assert _switch(on, 1.0, 1.0, 0.0) is False
     assert _switch(on, 1.001, 1.0, 0.0) is False
@@ -207,7 +207,7 @@ def test_shared_supply_sags_over_internal_resistance():
 def test_control_config_tracks_the_sine():
     ds = _run(_yaml("control.yaml"))
     # the issue's criterion: RMS error under 20 % of the amplitude after the first period;
-    # MODEL.md section 10's independent implementation: "a few percent" (we get 1.2 %)
+    # docs/model.md section 10's independent implementation: "a few percent" (we get 1.2 %)
     assert ds.attrs["rms_error_fraction"] < 0.05
     t = ds["time"].values
     err = (ds["bend_angle"] - ds["bend_angle_reference"]).values[t >= 25.0]
@@ -216,7 +216,7 @@ def test_control_config_tracks_the_sine():
 
 
 def test_large_amplitudes_outrun_the_heating():
-    # MODEL.md section 10: amplitudes above about 45 deg outrun the heating at 1.9 W
+    # docs/model.md section 10: amplitudes above about 45 deg outrun the heating at 1.9 W
     raw = _yaml("control.yaml")
     raw["reference"]["amplitude"] = "60 deg"
     assert run_simulation(parse_sim_config(raw)).attrs["rms_error_fraction"] > 0.2
@@ -225,7 +225,7 @@ def test_large_amplitudes_outrun_the_heating():
 def _time_to_angle(theta):
     """Heating time at 12 V from ambient to a bend angle, by inverting the forward model.
 
-    theta -> p by brentq on physics.bend_angle, p -> s by Boyle (MODEL.md section 3),
+    theta -> p by brentq on physics.bend_angle, p -> s by Boyle (docs/model.md section 3),
     s -> T by physics.temperature_for_stroke, T -> t by eq. (3)'s exact solution.
     """
     p = brentq(lambda x: ph.bend_angle(x, A, T, L) - theta, 0.0, 30e3, xtol=1e-9)

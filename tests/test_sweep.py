@@ -1,14 +1,11 @@
 """The sweep end to end: config -> cube file, round trip, resume, refusals, CLI."""
 
-import os
 import signal
-import subprocess
-import sys
-import time
 
 import h5py
 import numpy as np
 import pytest
+from killing import kill_after_slabs
 import xarray as xr
 import yaml
 
@@ -99,16 +96,7 @@ def _journaled(out):
 
 
 def _kill_halfway(cmd, out, sig, at_least=3):
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    deadline = time.time() + 120
-    while time.time() < deadline and proc.poll() is None:
-        if _journaled(out) >= at_least:
-            proc.send_signal(sig)
-            break
-        time.sleep(0.005)
-    proc.communicate(timeout=120)
-    return proc.returncode
+    return kill_after_slabs(cmd, at_least, sig)
 
 
 BIGGER = {**SMALL, "name": "bigger",
@@ -117,17 +105,16 @@ BIGGER = {**SMALL, "name": "bigger",
                    "wrap_angle": {"values": [3, 5, 8, 12, 20, 30]}}}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
 def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
     cfg_path = write_config(tmp_path, BIGGER)
     out = tmp_path / "run" / "cube.h5"
-    cmd = [sys.executable, "-m", "nylonflex", "sweep", str(cfg_path), "--out", str(out),
-           "--quiet", "--no-charts"]
+    cmd = ["sweep", str(cfg_path), "--out", str(out), "--quiet", "--no-charts"]
     rc = _kill_halfway(cmd, out, sig)
-    if rc == 0:
-        pytest.skip("the sweep finished before it could be killed")
+    assert rc != 0
     done = _journaled(out)
-    assert done >= 3
+    assert done == 3
     if sig == signal.SIGKILL:
         # a killed run never leaves a file that reads as complete
         assert not out.exists()
@@ -279,15 +266,15 @@ def test_workers_out_of_range(tmp_path, capsys):
     assert main(["sweep", str(path), "--out", str(tmp_path / "c.h5"), "--workers", "0"]) == 2
     assert "--workers: must be in [1," in capsys.readouterr().err
 
+@pytest.mark.slow
 
 def test_resume_keeps_the_journal_slab_plan_when_slab_size_changes(tmp_path):
     # slab_megabytes is not part of the config hash: a resume must use the journal's plan
     cfg_path = write_config(tmp_path, BIGGER)
     out = tmp_path / "run" / "cube.h5"
-    cmd = [sys.executable, "-m", "nylonflex", "sweep", str(cfg_path), "--out", str(out),
-           "--quiet", "--no-charts"]
-    if _kill_halfway(cmd, out, signal.SIGKILL) == 0:
-        pytest.skip("the sweep finished before it could be killed")
+    cmd = ["sweep", str(cfg_path), "--out", str(out), "--quiet", "--no-charts"]
+    assert _kill_halfway(cmd, out, signal.SIGKILL) != 0
+    assert _journaled(out) == 3
     assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--resume",
                  "--no-charts", "--set", "slab_megabytes=7"]) == 0
     whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")

@@ -1,4 +1,4 @@
-"""Numba kernels of the closed-loop simulation (MODEL.md section 10, paper figures 8-10).
+"""Numba kernels of the closed-loop simulation (docs/model.md section 10, paper figures 8-10).
 
 Private, unchecked kernels (the caller, :mod:`nylonflex.simulate`, validates and shapes
 everything):

@@ -1,4 +1,4 @@
-"""The physical model of MODEL.md as plain, documented functions (SI in and out).
+"""The physical model of docs/model.md as plain, documented functions (SI in and out).
 
 One module per domain: :mod:`.nylon` (stroke, coil-index table, eq. 1), :mod:`.thermal`
 (eq. 3), :mod:`.chamber` (Boyle), :mod:`.silicone` (Ogden), :mod:`.wrap` (wrap geometry and

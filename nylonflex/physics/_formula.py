@@ -93,7 +93,7 @@ def _short(value, n=40):
 
 
 def check_section(radius, wall_thickness, base_thickness=None):
-    """Checked a, t, b [m] of the cross-section; b = t when None (MODEL.md s. 1 [choice])."""
+    """Checked a, t, b [m] of the cross-section; b = t when None (docs/model.md s. 1 [choice])."""
     a = check_input("radius", radius)
     t = check_input("wall_thickness", wall_thickness)
     b = t if base_thickness is None else check_input("base_thickness", base_thickness)

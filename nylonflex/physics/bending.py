@@ -1,6 +1,6 @@
 """Bending of the actuator: moments, curvature, angle and tip force.
 
-MODEL.md sections 6-7, after Polygerinos et al. (IEEE T-RO 31(3):778, 2015). Constant
+docs/model.md sections 6-7, after Polygerinos et al. (IEEE T-RO 31(3):778, 2015). Constant
 curvature kappa = theta / L; a fibre at height y above the inextensible bottom face is
 stretched to l(y) = 1 + kappa y. The angle solves M_P(p) = M_S(kappa).
 
@@ -102,7 +102,7 @@ def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi):
 @formula
 def _material_moment(kappa, radius, wall_thickness, base_thickness, mu, alpha,
                      x_base, w_base, phi_trig, w_phi):
-    """M_S(kappa) [N m] and dM_S/dkappa [N m^2] (MODEL.md section 6)."""
+    """M_S(kappa) [N m] and dM_S/dkappa [N m^2] (docs/model.md section 6)."""
     m = 0.0
     dm = 0.0
     half = 0.5 * base_thickness
@@ -177,7 +177,7 @@ def pressure_moment(pressure, radius, base_thickness):
 
     References
     ----------
-    Paper eqs. (14), (16); MODEL.md section 6.
+    Paper eqs. (14), (16); docs/model.md section 6.
     """
     p = check("pressure", pressure, 0.0, unit="Pa")
     a = check("radius", radius, 0.0, lo_open=True, unit="m")
@@ -204,7 +204,7 @@ def material_moment(curvature_value, radius, wall_thickness, base_thickness=None
 
     Notes
     -----
-    MODEL.md section 6 [choice]: nominal stress integrated over the undeformed section.
+    docs/model.md section 6 [choice]: nominal stress integrated over the undeformed section.
     """
     k = check("curvature", curvature_value, 0.0, unit="1/m")
     a, t, b = check_section(radius, wall_thickness, base_thickness)
@@ -239,7 +239,7 @@ def curvature(pressure, radius, wall_thickness, base_thickness=None, silicone="t
 
     References
     ----------
-    Paper eqs. (13)-(15); Polygerinos et al. 2015; MODEL.md section 6.
+    Paper eqs. (13)-(15); Polygerinos et al. 2015; docs/model.md section 6.
     """
     p = check("pressure", pressure, 0.0, unit="Pa")
     a, t, b = check_section(radius, wall_thickness, base_thickness)

@@ -1,4 +1,4 @@
-"""Chamber pressure from the muscle's stroke: Boyle's law (paper eqs. 7-8, MODEL.md s. 3)."""
+"""Chamber pressure from the muscle's stroke: Boyle's law (paper eqs. 7-8, docs/model.md s. 3)."""
 
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ def volume_ratio(stroke):
     Notes
     -----
     The wrap shrinks the cross-section by (1 - s) in both directions while the length is
-    held (MODEL.md section 3).
+    held (docs/model.md section 3).
     """
     s = check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-")
     return scalar_or_array(1.0 / (1.0 - s) ** 2)
@@ -58,7 +58,7 @@ def chamber_pressure(stroke, p_atm=P_ATM):
 
     References
     ----------
-    Paper eqs. (7)-(8); MODEL.md section 3.
+    Paper eqs. (7)-(8); docs/model.md section 3.
     """
     s = check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-")
     p_atm = float(check("p_atm", p_atm, 0.0, lo_open=True, unit="Pa"))

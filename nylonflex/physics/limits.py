@@ -1,4 +1,4 @@
-"""Design limits of an actuator (paper section 4, figure 12; MODEL.md section 8).
+"""Design limits of an actuator (paper section 4, figure 12; docs/model.md section 8).
 
 For a design (a, t, L, C, psi): the muscle contracts at most s_max(C) and breaks at
 F_lim(C). s* = min(s_max, s_lim) with F_n(s_lim) = F_lim. Then p* = p(s*), M* = M_P(p*),
@@ -113,7 +113,7 @@ def _inputs(radius, wall_thickness, length, coil_index, wrap_angle, base_thickne
 
 def stroke_limit(radius, wall_thickness, coil_index, wrap_angle, base_thickness=None,
                  silicone="tc5005", nylon="silver_nylon66"):
-    """Usable stroke s* = min(s_max(C), s_lim) of a design [-] (MODEL.md section 8).
+    """Usable stroke s* = min(s_max(C), s_lim) of a design [-] (docs/model.md section 8).
 
     Parameters
     ----------
@@ -149,7 +149,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     wrap_angle : float or array
         Helix angle psi of the wrap from the hoop direction [rad], in (0, pi/2).
     base_thickness : float or array, optional
-        Bottom layer thickness b [m], > 0; b = t when None (MODEL.md section 1 [choice]).
+        Bottom layer thickness b [m], > 0; b = t when None (docs/model.md section 1 [choice]).
     silicone : str, dict or Silicone, default "tc5005"
         Silicone set.
     nylon : str, dict or Nylon, default "silver_nylon66"
@@ -171,7 +171,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 
     References
     ----------
-    Paper section 4 and figure 12; MODEL.md section 8.
+    Paper section 4 and figure 12; docs/model.md section 8.
     """
     ny = nylon_parameters(nylon)
     mu, alpha = silicone_parameters(silicone).arrays()

@@ -1,6 +1,6 @@
 """The coiled nylon muscle: stroke against temperature, coil-index table, eq. (1).
 
-MODEL.md section 2. Temperatures are in K.
+docs/model.md section 2. Temperatures are in K.
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ def _scale(coil_index, ny):
 def stroke_max(coil_index, nylon="silver_nylon66"):
     """Largest stroke s_max(C) of a muscle of coil index C, reached at T_max [-].
 
-    Linear interpolation in the coil-index table (MODEL.md section 9).
+    Linear interpolation in the coil-index table (docs/model.md section 9).
 
     Parameters
     ----------
@@ -114,7 +114,7 @@ def free_strain(temperature, coil_index, nylon="silver_nylon66"):
 
     References
     ----------
-    Paper eq. (2) (Sharafi & Li 2015); MODEL.md section 2.
+    Paper eq. (2) (Sharafi & Li 2015); docs/model.md section 2.
     """
     ny = _nylon(nylon)
     t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
@@ -140,7 +140,7 @@ def stroke(temperature, coil_index, nylon="silver_nylon66"):
 
     Notes
     -----
-    MODEL.md section 2 [choice]: one eq. (2) shape scaled per coil index. The scale is
+    docs/model.md section 2 [choice]: one eq. (2) shape scaled per coil index. The scale is
     s_max(C) over the reference shape's own stroke at T_max (0.1000054 for the default set,
     not the nominal 0.10), so s(T_max) = s_max(C) exactly.
     """

@@ -1,4 +1,4 @@
-"""Incompressible Ogden silicone (paper eqs. 4-6, MODEL.md section 5).
+"""Incompressible Ogden silicone (paper eqs. 4-6, docs/model.md section 5).
 
 Strain energy (paper's convention, eq. 5)::
 
@@ -33,7 +33,7 @@ def _stress_and_slope(stretch, mu, alpha):
     """Plane-strain nominal stress S(l) = sum mu_i (l^(a_i-1) - l^(-a_i-1)) [Pa] and dS/dl.
 
     This is sigma_1 / l with sigma_1 = sum mu_i (l^a_i - l^-a_i), the Ogden Cauchy stress
-    for l2 = 1, l3 = 1/l, sigma_3 = 0 (MODEL.md section 5). The hot spot of every kernel:
+    for l2 = 1, l3 = 1/l, sigma_3 = 0 (docs/model.md section 5). The hot spot of every kernel:
     one log for all terms and one exp a term, since l^(-a-1) = 1 / (l^(a-1) l^2).
     """
     ln = math.log(stretch)
@@ -121,7 +121,7 @@ def bending_stress(stretch, silicone="tc5005"):
 
     Notes
     -----
-    MODEL.md section 5; the material moment integrates this stress over the undeformed
+    docs/model.md section 5; the material moment integrates this stress over the undeformed
     section (section 6).
     """
     lam = check("stretch", stretch, 0.0, lo_open=True, unit="-")
@@ -131,7 +131,7 @@ def bending_stress(stretch, silicone="tc5005"):
 def hoop_stress(stroke, silicone="tc5005"):
     """Nominal hoop stress S_theta of the wall compressed to l_theta = 1 - s [Pa].
 
-    The axial stretch is held at 1 and the radial stress is zero (MODEL.md section 4
+    The axial stretch is held at 1 and the radial stress is zero (docs/model.md section 4
     [choice]: the paper's eq. (10) writes l_l = 1 - s, we hold the length as its eq. (8)
     does). Negative: the wall is in compression.
 

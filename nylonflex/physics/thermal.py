@@ -1,6 +1,6 @@
 """Thermo-electric model of the muscle, eq. (3): C dT/dt = V^2/R - Lambda (T - T_amb).
 
-MODEL.md sections 2 and 10: R = r' l_m, C = c' l_m, Lambda = lambda' l_m for a muscle of
+docs/model.md sections 2 and 10: R = r' l_m, C = c' l_m, Lambda = lambda' l_m for a muscle of
 length l_m, so the time constant tau = c'/lambda' does not depend on the length.
 """
 

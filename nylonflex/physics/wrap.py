@@ -1,4 +1,4 @@
-"""Wrap geometry and the load in the nylon wrap (paper eq. 9, MODEL.md section 4).
+"""Wrap geometry and the load in the nylon wrap (paper eq. 9, docs/model.md section 4).
 
 [choice] One muscle of outer width w = d_f (C + 1) is wound as a helix of angle psi
 (measured from the hoop direction) around the outer contour of the cross-section, of
@@ -54,7 +54,7 @@ def _wrap_force(pressure, hoop_stress, radius, wall_thickness, lever):
 
 @formula
 def _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm):
-    """F_n(s) (MODEL.md section 4) [N] and dF_n/ds [N]; lever = pitch / cos psi [m]."""
+    """F_n(s) (docs/model.md section 4) [N] and dF_n/ds [N]; lever = pitch / cos psi [m]."""
     p = _gauge_pressure(stroke, p_atm)
     dp = _gauge_pressure_slope(stroke, p_atm)
     s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
@@ -80,7 +80,7 @@ def outer_perimeter(radius, wall_thickness, base_thickness=None):
     wall_thickness : float or array
         Wall thickness t [m], > 0.
     base_thickness : float or array, optional
-        Bottom layer thickness b [m], > 0; b = t when None (MODEL.md section 1 [choice]).
+        Bottom layer thickness b [m], > 0; b = t when None (docs/model.md section 1 [choice]).
     """
     a, t, b = check_section(radius, wall_thickness, base_thickness)
     return scalar_or_array(_outer_perimeter(a, t, b))
@@ -162,7 +162,7 @@ def nylon_force(stroke, radius, wall_thickness, wrap_angle, coil_index, base_thi
 
     References
     ----------
-    Paper eq. (9); MODEL.md section 4.
+    Paper eq. (9); docs/model.md section 4.
     """
     s = check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-")
     a, t, b, psi = _geometry(radius, wall_thickness, base_thickness, wrap_angle)
