@@ -210,6 +210,7 @@ def run_simulation(cfg: SimConfig):
     import xarray as xr
 
     from .kernels.control import closed_loop
+    from .kernels.records import AngleTables, Control, Muscles, SimOut, Supply
 
     n, m = len(cfg.actuators), cfg.n_steps
     t = np.arange(m) * cfg.step
@@ -246,15 +247,16 @@ def run_simulation(cfg: SimConfig):
     reference = np.ascontiguousarray(np.array(refs))
     noise = np.ascontiguousarray(np.array(noises))
     outs = {k: np.empty((n, m)) for k in SIM_VARIABLES if k != "bend_angle_reference"}
-    args = (cfg.step, cfg.supply_voltage, cfg.internal_resistance, P_ATM,
-            arr["lm"], arr["r"], arr["c"], arr["loss"], arr["tamb"], arr["t0"],
-            arr["scale"], arr["gamma"], arr["beta"], arr["tg"], arr["sg"],
-            arr["dpp"], _pad(plants, 0.0), _pad(slopes, 0.0), arr["dpe"], _pad(ests, 0.0),
-            arr["band"], arr["keep"], reference, noise,
-            outs["temperature"], outs["stroke"], outs["pressure"], outs["bend_angle"],
-            outs["bend_angle_estimate"], outs["voltage"], outs["current"], outs["power"])
+    supply = Supply(cfg.step, cfg.supply_voltage, cfg.internal_resistance, P_ATM)
+    muscles = Muscles(arr["lm"], arr["r"], arr["c"], arr["loss"], arr["tamb"], arr["t0"],
+                      arr["scale"], arr["gamma"], arr["beta"], arr["tg"], arr["sg"])
+    tables = AngleTables(arr["dpp"], _pad(plants, 0.0), _pad(slopes, 0.0), arr["dpe"],
+                         _pad(ests, 0.0))
+    control = Control(arr["band"], arr["keep"], reference, noise)
+    out = SimOut(outs["temperature"], outs["stroke"], outs["pressure"], outs["bend_angle"],
+                 outs["bend_angle_estimate"], outs["voltage"], outs["current"], outs["power"])
     tic = time.perf_counter()
-    closed_loop(*args)
+    closed_loop(supply, muscles, tables, control, out)
     loop_time = time.perf_counter() - tic
     outs["bend_angle_reference"] = reference
 

@@ -138,13 +138,7 @@ def _switch(on, estimate, reference, half_band):
 
 
 @jit_kernel
-def closed_loop(dt, supply_voltage, internal_resistance, p_atm,
-                muscle_length, r_per_len, c_per_len, loss_per_len, t_amb, t_start,
-                stroke_scale, gamma, beta, t_g, sigma_g,
-                plant_step, plant_angles, plant_slopes, table_step, tables,
-                half_band, filter_keep, reference, noise,
-                out_temperature, out_stroke, out_pressure, out_angle, out_estimate,
-                out_voltage, out_current, out_power):
+def closed_loop(supply, muscles, tables_, control, out):
     """Step the closed loop of ``n`` actuators on one supply through ``m`` samples.
 
     At sample k each actuator's chamber pressure is read (plus ``noise``), turned into an
@@ -155,39 +149,34 @@ def closed_loop(dt, supply_voltage, internal_resistance, p_atm,
 
     Parameters
     ----------
-    dt : float
-        Sample time [s].
-    supply_voltage : float
-        Open-circuit voltage of the supply E [V].
-    internal_resistance : float
-        Internal resistance of the supply [ohm].
-    p_atm : float
-        Initial absolute chamber pressure [Pa].
-    muscle_length, r_per_len, c_per_len, loss_per_len, t_amb, t_start : ndarray, (n,)
-        l_m [m], r' [ohm/m], c' [J/(K m)], lambda' [W/(K m)], T_amb [K], T(0) [K].
-    stroke_scale, gamma, beta, t_g, sigma_g : ndarray, (n,)
-        s_max(C)/s_ref [-] and the eq. (2) shape constants [1/K], [-], [K], [K].
-    plant_step : ndarray, (n,)
-        Spacing of each plant table [Pa].
-    plant_angles, plant_slopes : ndarray, (n, points)
-        The model's theta(k dp) [rad] and d theta/dp [rad/Pa] (:func:`angle_table`).
-    table_step : ndarray, (n,)
-        Spacing of each estimator table [Pa].
-    tables : ndarray, (n, points)
-        Estimator tables theta(k dp) [rad].
-    half_band : ndarray, (n,)
-        Half the hysteresis band [rad].
-    filter_keep : ndarray, (n,)
-        exp(-dt/tau_f) of the estimate's first-order filter; 0 for no filter [-].
-    reference : ndarray, (n, m)
-        Reference angle at each sample [rad].
-    noise : ndarray, (n, m)
-        Additive pressure-sensor noise at each sample [Pa].
-    out_* : ndarray, (n, m)
+    supply : :class:`~.records.Supply`
+        ``dt`` sample time [s], ``voltage`` open-circuit voltage E [V],
+        ``internal_resistance`` [ohm], ``p_atm`` initial absolute chamber pressure [Pa].
+    muscles : :class:`~.records.Muscles`, arrays (n,)
+        ``length`` l_m [m], ``r_per_len`` r' [ohm/m], ``c_per_len`` c' [J/(K m)],
+        ``loss_per_len`` lambda' [W/(K m)], ``t_amb`` [K], ``t_start`` T(0) [K],
+        ``stroke_scale`` s_max(C)/s_ref [-] and the eq. (2) shape ``gamma`` [1/K], ``beta``
+        [-], ``t_g`` [K], ``sigma_g`` [K].
+    tables_ : :class:`~.records.AngleTables`
+        ``plant_step`` (n,) [Pa] and ``plant_angles``, ``plant_slopes`` (n, points): the
+        model's theta(k dp) [rad] and d theta/dp [rad/Pa] (:func:`angle_table`);
+        ``table_step`` (n,) [Pa] and ``tables`` (n, points): the estimators' theta(k dp).
+    control : :class:`~.records.Control`
+        ``half_band`` (n,) half the hysteresis band [rad]; ``filter_keep`` (n,)
+        exp(-dt/tau_f) of the estimate's first-order filter, 0 for none [-]; ``reference``
+        (n, m) [rad] and ``noise`` (n, m) additive pressure-sensor noise [Pa] at each sample.
+    out : :class:`~.records.SimOut`, arrays (n, m)
         Written: temperature [K], stroke [-], pressure [Pa], angle [rad], estimate [rad],
         voltage [V], current [A] and electric power [W] at each sample; the voltage is the
         one held from that sample to the next.
     """
+    dt, supply_voltage, internal_resistance, p_atm = supply
+    (muscle_length, r_per_len, c_per_len, loss_per_len, t_amb, t_start, stroke_scale, gamma,
+     beta, t_g, sigma_g) = muscles
+    plant_step, plant_angles, plant_slopes, table_step, tables = tables_
+    half_band, filter_keep, reference, noise = control
+    (out_temperature, out_stroke, out_pressure, out_angle, out_estimate, out_voltage,
+     out_current, out_power) = out
     n = muscle_length.shape[0]
     m = reference.shape[1]
     temperature = t_start.copy()

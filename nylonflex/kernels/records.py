@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilTable", "GridAxes", "GridOut", "Nodes", "Ogden", "PointDesigns", "PointOut"]
+__all__ = ["AngleTables", "CoilTable", "Control", "GridAxes", "GridOut", "Muscles", "Nodes",
+           "Ogden", "PointDesigns", "PointOut", "SimOut", "Supply"]
 
 #: Ogden constants of one silicone: ``mu`` [Pa] and ``alpha`` [-], one entry per term.
 #: The pointwise kernel takes 2-D arrays (sample, term) with one row or one row a design.
@@ -40,3 +41,26 @@ PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
 
 #: Output of the pointwise kernel: ``design`` (float variables, shape (8, n)) and ``limit``.
 PointOut = namedtuple("PointOut", "design limit")
+
+# ----------------------------------------------------------------- the closed loop
+#: The shared supply and the sampling: ``dt`` [s], ``voltage`` [V],
+#: ``internal_resistance`` [ohm], ``p_atm`` [Pa].
+Supply = namedtuple("Supply", "dt voltage internal_resistance p_atm")
+
+#: Per actuator (arrays (n,)): muscle length [m], r' [ohm/m], c' [J/(K m)], lambda'
+#: [W/(K m)], ambient and initial temperature [K], stroke scale [-], eq. (2) shape.
+Muscles = namedtuple("Muscles", "length r_per_len c_per_len loss_per_len t_amb t_start "
+                                "stroke_scale gamma beta t_g sigma_g")
+
+#: Per actuator: the plant's angle table (step [Pa], values [rad], slopes [rad/Pa]) and
+#: the estimator's (step [Pa], values [rad]).
+AngleTables = namedtuple("AngleTables", "plant_step plant_angles plant_slopes table_step "
+                                        "tables")
+
+#: Per actuator: half hysteresis band [rad], filter factor [-], reference [rad] and sensor
+#: noise [Pa] at each sample.
+Control = namedtuple("Control", "half_band filter_keep reference noise")
+
+#: Outputs (n, m): temperature, stroke, pressure, angle, estimate, voltage, current, power.
+SimOut = namedtuple("SimOut", "temperature stroke pressure angle estimate voltage current "
+                              "power")
