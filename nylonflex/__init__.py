@@ -13,8 +13,6 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0+unknown"
 
-from .materials import NYLON_PARAMETERS, SILICONE_PARAMETERS, nylon_parameters, silicone_parameters
-from .engine import design_limits, evaluate
 
 __all__ = [
     "NYLON_PARAMETERS",
@@ -30,12 +28,19 @@ __all__ = [
     "silicone_parameters",
 ]
 
-_LAZY = {"load_config": "config", "run_sweep": "sweep", "open_cube": "storage",
-         "run_design": "design"}
+#: Public names and the module each comes from, imported on first use: `nylonflex
+#: --version` and `--help` then load nothing but the CLI (no numpy, scipy, numba, xarray).
+_LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
+         "nylon_parameters": "materials", "silicone_parameters": "materials",
+         "design_limits": "engine", "evaluate": "engine", "load_config": "config",
+         "run_sweep": "sweep", "open_cube": "storage", "run_design": "design"}
+
+
+def __dir__():
+    return sorted(__all__)
 
 
 def __getattr__(name):
-    # the sweep side pulls in pydantic, xarray and h5py: load it on first use only
     if name in _LAZY:
         import importlib
 

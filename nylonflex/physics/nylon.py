@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..materials import nylon_parameters
 from ._formula import ZERO_CELSIUS, check, formula, scalar_or_array
@@ -170,6 +169,8 @@ def temperature_for_stroke(stroke_value, coil_index, nylon="silver_nylon66"):
         return ny.t_amb
     k = float(_scale(coil_index, ny))
     f = lambda t: k * _stroke_shape(t, *_shape_args(ny)) - s  # noqa: E731
+    from scipy.optimize import brentq  # imported here: scipy costs 0.4 s of start-up
+
     return brentq(f, ny.t_amb, ny.t_max, xtol=1e-12, rtol=1e-15)
 
 
