@@ -102,6 +102,7 @@ class SweepConfig(_Strict):
     curves: Curves
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
     slab_megabytes: float = 16.0
+    compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
 
     @field_validator("name")
     @classmethod
@@ -128,6 +129,7 @@ class ResolvedConfig:
     charts: tuple[str, ...]
     slab_megabytes: float
     raw: dict = field(compare=False, repr=False)
+    compression: str = "gzip"  # the cube's codec: not part of the design space or its hash
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -399,7 +401,8 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                            cfg.base_thickness.units or "mm", lo, hi, shown)
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
-                          slab_megabytes=cfg.slab_megabytes, raw=copy.deepcopy(raw))
+                          slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
+                          raw=copy.deepcopy(raw))
 
 
 def apply_overrides(raw: dict, overrides) -> dict:

@@ -5,15 +5,66 @@ from __future__ import annotations
 import itertools
 import zlib
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..variables import COORDS, CURVES, DESIGN, slab_done_attrs
 
-__all__ = ["CubeFile"]
+__all__ = ["CODECS", "DEFAULT_CODEC", "Codec", "CubeFile"]
 
-_COMPRESSION = {"compression": "gzip", "compression_opts": 1, "shuffle": True}
+
+@dataclass(frozen=True)
+class Codec:
+    """How the cube's chunks are compressed.
+
+    ``filters`` are the HDF5 dataset options; ``encode(raw_bytes)`` compresses a chunk the
+    way that filter pipeline would (after the shuffle when ``shuffle``), so slabs can be
+    compressed by a thread pool and written directly; None lets HDF5 compress instead.
+    ``plugin``: readers need the hdf5plugin package (``import hdf5plugin``) to open it.
+    """
+
+    name: str
+    filters: dict
+    encode: object
+    shuffle: bool
+    plugin: bool
+    readers: str
+
+
+def _zstd(raw: bytes) -> bytes:
+    import zstandard
+
+    return zstandard.ZstdCompressor(level=1).compress(raw)
+
+
+#: The codecs a config may choose (``compression:``). gzip is the default: every HDF5 and
+#: netCDF reader opens it without a plugin.
+CODECS = {
+    "gzip": Codec("gzip", {"compression": "gzip", "compression_opts": 1, "shuffle": True},
+                  lambda raw: zlib.compress(raw, 1), True, False,
+                  "any HDF5/netCDF4 reader (h5py, netCDF4, xarray, HDFView, MATLAB)"),
+    "zstd": Codec("zstd", {"compression": 32015, "compression_opts": (1,), "shuffle": True},
+                  _zstd, True, True,
+                  "h5py/xarray after `import hdf5plugin` (nylonflex does it), or HDF5 with "
+                  "the zstd filter plugin"),
+    "lz4": Codec("lz4", {"compression": 32004, "compression_opts": (0,), "shuffle": True},
+                 None, True, True,
+                 "h5py/xarray after `import hdf5plugin` (nylonflex does it), or HDF5 with "
+                 "the LZ4 filter plugin"),
+    "none": Codec("none", {}, lambda raw: raw, False, False, "any HDF5/netCDF4 reader"),
+}
+DEFAULT_CODEC = "gzip"
+
+
+def load_filter_plugins():
+    """Register the hdf5plugin filters (zstd, lz4) with HDF5; False if it is not installed."""
+    try:
+        import hdf5plugin  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def _chunks(dims, sizes, radius_chunk):
@@ -28,11 +79,16 @@ def _chunks(dims, sizes, radius_chunk):
 
 
 class CubeFile:
-    """Writes one cube file slab by slab (h5netcdf; gzip level 1 with shuffle)."""
+    """Writes one cube file slab by slab (h5netcdf; by default gzip level 1 with shuffle)."""
 
-    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int):
+    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
+                 codec: str = DEFAULT_CODEC):
         import h5netcdf
 
+        self.codec = CODECS[codec]
+        if self.codec.plugin and not load_filter_plugins():
+            raise RuntimeError(f"compression: {codec} needs the hdf5plugin package "
+                               "(pip install hdf5plugin), or choose gzip")
         self.path = Path(path)
         self.f = h5netcdf.File(self.path, "w")
         sizes = {name: len(values) for name, values in coords.items()}
@@ -44,11 +100,11 @@ class CubeFile:
             fill = None if var.dtype == "int8" else np.nan
             v = self.f.create_variable(var.name, var.dims, var.dtype, fillvalue=fill,
                                        chunks=_chunks(var.dims, sizes, radius_chunk),
-                                       **_COMPRESSION)
+                                       **self.codec.filters)
             v.attrs.update(var.attrs())
         done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
         done.attrs.update(slab_done_attrs())
-        self.f.attrs.update(attrs)
+        self.f.attrs.update({**attrs, "compression": self.codec.name})
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def write(self, i0: int, i1: int, arrays: dict):
@@ -70,7 +126,7 @@ class CubeFile:
             dset = var._h5ds
             i1 = i0 + (np.shape(data)[0] if var.dimensions else 0)
             if var.dimensions and var.dimensions[0] == "radius" and \
-                    self._aligned(dset, i0, i1):
+                    self.codec.encode is not None and self._aligned(dset, i0, i1):
                 jobs.append((name, list(self._compress(dset, i0, data))))
             else:
                 out[name] = np.asarray(data)
@@ -115,7 +171,7 @@ class CubeFile:
         for corner in itertools.product(*starts):
             block = data[tuple(slice(c, c + n) for c, n in zip(corner, chunks))]
             offset = (i0 + corner[0], *corner[1:])
-            yield offset, self._pool.submit(_shuffle_deflate, block, chunks)
+            yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec)
 
     def close(self, attrs: dict | None = None):
         self._pool.shutdown()
@@ -124,14 +180,19 @@ class CubeFile:
         self.f.close()
 
 
-def _shuffle_deflate(block, chunks):
-    """HDF5's shuffle then deflate filters on one chunk (padded to the full chunk shape)."""
+def _encode_chunk(block, chunks, codec: Codec):
+    """One chunk as the codec's HDF5 filter pipeline stores it (padded to the chunk shape)."""
     if block.shape != tuple(chunks):
         full = np.zeros(chunks, dtype=block.dtype)
         full[tuple(slice(0, n) for n in block.shape)] = block
         block = full
     raw = np.ascontiguousarray(block).view(np.uint8)
     size = block.dtype.itemsize
-    if size > 1:  # byte k of every element together, as H5Z_FILTER_SHUFFLE does
+    if codec.shuffle and size > 1:  # byte k of every element together, as H5Z_FILTER_SHUFFLE
         raw = raw.reshape(-1, size).T
-    return zlib.compress(np.ascontiguousarray(raw).tobytes(), _COMPRESSION["compression_opts"])
+    return codec.encode(np.ascontiguousarray(raw).tobytes())
+
+
+def _shuffle_deflate(block, chunks):
+    """HDF5's shuffle then deflate filters on one chunk (padded to the full chunk shape)."""
+    return _encode_chunk(block, chunks, CODECS["gzip"])

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN
+from .cube import load_filter_plugins
 from .journal import Journal
 
 __all__ = ["cube_attrs", "cube_summary", "open_cube"]
@@ -60,6 +61,7 @@ def open_cube(path, *, quiet: bool = False):
     if attrs is None:
         raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
                          "written by 'nylonflex sweep')")
+    load_filter_plugins()  # zstd and lz4 cubes need hdf5plugin's filters registered
     ds = xr.open_dataset(path, engine="h5netcdf")
     if attrs.get("complete") != "true":
         done = ds["slab_done"].values.astype(bool)

@@ -49,14 +49,14 @@ class CubeSink:
 
 def _check_resume(cfg, out, journal, resume, log):
     """Decide what to keep: ``None`` (nothing to do), or the journal's slab plan, its chunk
-    length along radius and the indices of its finished slabs (an empty plan: start
-    afresh)."""
+    length along radius, the indices of its finished slabs (an empty plan: start afresh)
+    and the codec of the journaled chunks."""
     manifest = journal.read_manifest() if journal.exists() else None
     if manifest is not None and not resume:
         raise InputError(f"{out}: an interrupted run of '{manifest.get('name')}' is in "
                          f"{journal.dir}; add --resume to finish it, or delete that folder")
     if not resume:
-        return [], None, set()
+        return [], None, set(), cfg.compression
     if manifest is None:
         attrs = cube_attrs(out)
         if attrs and attrs.get("config_sha256") != cfg.sha256:
@@ -67,7 +67,7 @@ def _check_resume(cfg, out, journal, resume, log):
             log(f"{out} is already complete; nothing to resume")
             return None
         log("nothing to resume; starting the sweep")
-        return [], None, set()
+        return [], None, set(), cfg.compression
     if manifest.get("config_sha256") != cfg.sha256:
         raise InputError(f"--resume: the config changed since the interrupted run "
                          f"(sha256 {manifest.get('config_sha256', '?')[:12]} vs "
@@ -82,7 +82,11 @@ def _check_resume(cfg, out, journal, resume, log):
             not isinstance(chunk, int) or chunk < 1:
         raise InputError(f"--resume: {journal.manifest} is damaged; delete {journal.dir} "
                          "to start over")
-    return slabs, chunk, journal.done() & set(range(len(slabs)))
+    codec = manifest.get("compression", "gzip")  # journaled chunks are in this codec
+    if codec != cfg.compression:
+        log(f"resuming with the journal's compression, {codec} (the config now says "
+            f"{cfg.compression})")
+    return slabs, chunk, journal.done() & set(range(len(slabs))), codec
 
 
 def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, scheduler=None,
@@ -105,7 +109,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
         decision = _check_resume(cfg, out, journal, resume, log)
         if decision is None:
             return out
-        slabs, chunk, keep = decision
+        slabs, chunk, keep, codec = decision
         if slabs:
             log(f"resuming: {len(keep)} of {len(slabs)} slabs already done")
         else:
@@ -121,17 +125,17 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
             if not keep:
                 journal.start({"name": cfg.name, "config_sha256": cfg.sha256,
                                "slabs": [list(s) for s in slabs], "radius_chunk": chunk,
-                               "nylonflex_version": __version__})
-            _write(cfg, out, journal, slabs, keep, chunk, executor, progress, log)
+                               "compression": codec, "nylonflex_version": __version__})
+            _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log)
         finally:
             executor.close()
     return out
 
 
-def _write(cfg, out, journal, slabs, keep, chunk, executor, progress, log):
+def _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     building = out.with_name(out.name + ".building")
-    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk)
+    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec)
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
     for k in sorted(keep):
