@@ -104,12 +104,14 @@ class SweepConfig(_Strict):
     slab_megabytes: float = 16.0
     compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
 
-    @field_validator("name")
-    @classmethod
-    def _name(cls, name):
-        if not valid_name(name):
-            raise ValueError("letters, digits, '-', '_' and '.' only")
-        return name
+    _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
+
+
+def check_run_name(name):
+    """A run name (pydantic validator body): refused unless :func:`valid_name`."""
+    if not valid_name(name):
+        raise ValueError("letters, digits, '-', '_' and '.' only")
+    return name
 
 
 @dataclass(frozen=True)

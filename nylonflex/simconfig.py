@@ -33,8 +33,8 @@ from pydantic import (
     field_validator,
 )
 
-from .config import DESIGN_RANGES, _pydantic_message, _Strict, check_range, range_error, \
-    read_yaml, valid_name
+from .config import DESIGN_RANGES, check_run_name, _pydantic_message, _Strict, check_range, range_error, \
+    read_yaml
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.nylon import stroke
 from .physics.thermal import muscle_resistance, steady_temperature
@@ -200,12 +200,7 @@ class SimConfigModel(_Loop):
     time: Time | None = None
     actuators: list[ActuatorModel] | None = None
 
-    @field_validator("name")
-    @classmethod
-    def _name(cls, name):
-        if not valid_name(name):
-            raise ValueError("letters, digits, '-', '_' and '.' only")
-        return name
+    _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
 
 # ---------------------------------------------------------------------------------------
