@@ -26,6 +26,7 @@ __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "Nylon",
+    "FIELD_UNITS",
     "SHEAR_MODULUS_RANGE",
     "Silicone",
     "check_shear_modulus",
@@ -128,6 +129,18 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
             "section 9",
         },
     },
+}
+
+
+#: Unit of every field of a material set, as the code (and a config override) takes it.
+FIELD_UNITS = {
+    "mu": "Pa", "alpha": "1",
+    "fibre_diameter": "m", "stroke_reference": "1", "gamma": "1/K", "beta": "1",
+    "t_g": "K", "sigma_g": "K", "t_amb": "K", "t_max": "K",
+    "resistance_per_length": "ohm/m", "heat_capacity_per_length": "J/(K m)",
+    "heat_loss_per_length": "W/(K m)", "stiffness": "N/m", "damping": "N s/m",
+    "thermal_force_coefficient": "N/K", "coil_index_table": "1", "stroke_max_table": "1",
+    "tensile_strength_table": "Pa",
 }
 
 

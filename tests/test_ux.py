@@ -68,3 +68,54 @@ def test_warm_up_reports_and_notices_only_when_slow():
     assert seen == [warmup.COMPILE_NOTICE] and seconds > 0
     assert warmup.warm_up_grid(parse_config(TINY)) >= 0.0
     assert warmup.warm_up_points() >= 0.0
+
+
+# ---------------------------------------------------------------------------- init, list
+EXAMPLE_NAMES = ("fig12", "control", "step", "gripper")
+
+
+def test_init_writes_the_examples_and_never_overwrites(tmp_path, capsys):
+    from pathlib import Path
+
+    from nylonflex.config import load_config
+    from nylonflex.simconfig import load_sim_config
+
+    rc, out, _ = run(capsys, "init", tmp_path / "mine")
+    assert rc == 0 and len(out.strip().splitlines()) == 4
+    repo = Path(__file__).resolve().parents[1] / "configs"
+    for name in EXAMPLE_NAMES:  # the packaged files are the repository's configs
+        written = (tmp_path / "mine" / f"{name}.yaml").read_text()
+        assert written == (repo / f"{name}.yaml").read_text(), name
+    assert load_config(tmp_path / "mine" / "fig12.yaml").n_designs == 41 * 6 * 3 * 4 * 4
+    for name in ("control", "step", "gripper"):
+        load_sim_config(tmp_path / "mine" / f"{name}.yaml")
+    edited = tmp_path / "mine" / "step.yaml"
+    edited.write_text("# mine\n")
+    rc, _, err = run(capsys, "init", tmp_path / "mine")
+    assert rc == 2 and "already exist" in err and "nothing written" in err
+    assert edited.read_text() == "# mine\n"
+    rc, _, _ = run(capsys, "init", tmp_path / "other", "--example", "fig12")
+    assert rc == 0 and [p.name for p in (tmp_path / "other").iterdir()] == ["fig12.yaml"]
+
+
+def test_list_materials_charts_variables(capsys):
+    rc, out, _ = run(capsys, "list", "materials")
+    assert rc == 0 and "tc5005" in out and "mu [Pa]" in out and "56190, 10490" in out
+    assert "tensile_strength_table [Pa]" in out and "silver_nylon66" in out
+    rc, out, _ = run(capsys, "list", "charts")
+    from nylonflex.charts import CHARTS
+
+    assert rc == 0 and all(name in out for name in CHARTS)
+    rc, out, _ = run(capsys, "list", "variables")
+    assert rc == 0 and "tip_force_max" in out and "[N m], shown in N mm" in out
+
+
+def test_help_names_the_accepted_values(capsys):
+    from nylonflex.charts import CHARTS
+
+    for command, names in (("chart", list(CHARTS)), ("query", ["tip_force_max", "radius"])):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        out = " ".join(capsys.readouterr().out.split())
+        for name in names:
+            assert name in out, (command, name)
