@@ -94,13 +94,14 @@ def _nearest(ds, name, target):
 def _spread(ds, name, lo, hi, n):
     """Up to ``n`` grid values of ``name`` in [lo, hi] [SI], evenly spread, ends included.
 
-    Falls back to the nearest grid values of ``lo`` and ``hi`` when none lies inside.
+    Where fewer than three (or fewer than the axis has) lie inside, the values spread over
+    the whole axis instead: a chart of a cube on another grid still shows a family.
     """
     values = ds[name].values
     span = max(abs(hi - lo), 1e-300)
     inside = values[(values >= lo - 1e-9 * span) & (values <= hi + 1e-9 * span)]
-    if inside.size == 0:
-        inside = np.unique([_nearest(ds, name, lo), _nearest(ds, name, hi)])
+    if inside.size < min(3, values.size, n):
+        inside = values
     if inside.size <= n:
         return [float(x) for x in inside]
     idx = np.unique(np.round(np.linspace(0, inside.size - 1, n)).astype(int))
@@ -409,7 +410,7 @@ def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None):
         full = "full range of motion" if int(point["limit"]) == 0 else \
             "range of motion cut short"
         if length is None:
-            text += f"; at {_eq('length', at['length'])} tip force " \
+            text += f"\nat {_eq('length', at['length'])} tip force " \
                     f"{float(point['tip_force_max']):.3g} N, {full}"
         else:
             text += f", {full}"

@@ -119,3 +119,130 @@ def test_help_names_the_accepted_values(capsys):
         out = " ".join(capsys.readouterr().out.split())
         for name in names:
             assert name in out, (command, name)
+
+
+# ---------------------------------------------------------------------------- charts
+ODD = {
+    "name": "odd",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 5, "units": "mm"},
+        "wall_thickness": {"values": [1.5, 2, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.25, 1.4, 1.55, 1.7]},
+        "wrap_angle": {"values": [3, 5, 8, 10, 14, 18, 25, 30], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
+}
+
+
+@pytest.fixture(scope="module")
+def odd_cube(tmp_path_factory):
+    return write_cube(tmp_path_factory.mktemp("odd"), ODD)
+
+
+@pytest.fixture(scope="module")
+def odd(odd_cube):
+    from nylonflex.storage import open_cube
+
+    ds = open_cube(odd_cube)
+    yield ds
+    ds.close()
+
+
+def _texts(fig):
+    texts = [t.get_text() for t in fig.texts]
+    for ax in fig.axes:
+        texts += [ax.get_title()] + [t.get_text() for t in ax.texts]
+    return texts
+
+
+def test_design_map_draws_every_coil_index(odd):
+    import matplotlib.pyplot as plt
+
+    from nylonflex import charts
+
+    fig = charts.design_map(odd)
+    titles = [ax.get_title() for ax in fig.axes if ax.get_visible() and ax.get_title()]
+    assert titles == ["C = 1.1", "C = 1.25", "C = 1.4", "C = 1.55", "C = 1.7"]
+    plt.close(fig)
+
+
+def test_examples_only_where_the_slice_holds_them_with_true_values(odd):
+    import matplotlib.pyplot as plt
+
+    from nylonflex import charts
+    from nylonflex.variables import to_display
+
+    # example 2 (7.5 mm, 2 mm, 70 mm, C 1.7) is off this radius grid: no star anywhere;
+    # example 1 (20 mm, 6 mm, 90 mm, C 1.1, 8 deg) is on it: marked at L = 90 mm only
+    fig = charts.fig12c(odd, length=90e-3)
+    notes = [t for t in _texts(fig) if t.startswith("paper example")]
+    assert len(notes) == 1 and "a = 20 mm, C = 1.1" in notes[0]
+    truth = float(to_display("bend_angle_max", odd["bend_angle_max"].sel(
+        radius=20e-3, wall_thickness=6e-3, length=90e-3, coil_index=1.1,
+        wrap_angle=odd["wrap_angle"].values[2])))
+    assert f"{truth:.3g} deg" in notes[0]
+    plt.close(fig)
+    fig = charts.fig12c(odd, length=70e-3)
+    assert not [t for t in _texts(fig) if t.startswith("paper example")]
+    plt.close(fig)
+    fig = charts.fig12b(odd, coil_index=[1.25, 1.7])  # C 1.1 not drawn: no example 1
+    assert not [t for t in _texts(fig) if t.startswith("paper example")]
+    plt.close(fig)
+
+
+def test_many_wrap_angles_are_thinned_and_say_so(odd):
+    import matplotlib.pyplot as plt
+
+    from nylonflex import charts
+
+    fig = charts.fig12b(odd)
+    legend = fig.legends[0]
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert sum(label.startswith("\u03c8 =") for label in labels) == 6
+    assert "the other 2 wrap angles" in labels
+    assert "6 of 8 labelled" in legend.get_title().get_text()
+    # no in-plot labels that would overprint: the legend names them
+    assert not [t for ax in fig.axes for t in ax.texts if t.get_text().startswith("\u03c8")]
+    plt.close(fig)
+
+
+def test_fig6_subtitle_from_the_data(odd):
+    import matplotlib.pyplot as plt
+
+    from nylonflex import charts
+
+    fig = charts.fig6(odd)
+    title = fig._suptitle.get_text()
+    # 6-14 mm holds 10 mm only, 1-4 mm the walls 1.5 and 2 mm: fewer than three, so the
+    # whole axes are drawn, and the subtitle names what is drawn (not the paper's spans)
+    assert "radius 5-25 mm" in title and "wall thickness 1.5-6 mm" in title, title
+    plt.close(fig)
+
+
+def test_chart_command_slices_and_refuses_off_grid(odd_cube, tmp_path, capsys):
+    rc, out, _ = run(capsys, "chart", odd_cube, "--figure", "design_map", "fig12c",
+                     "--at", "length=70mm,wrap_angle=8deg", "--coil-index", "1.1,1.7",
+                     "--out", tmp_path)
+    assert rc == 0 and len(out.split()) == 2
+    rc, _, err = run(capsys, "chart", odd_cube, "--at", "length=75mm", "--out", tmp_path)
+    assert rc == 2 and "length=75 mm is not a grid value of the cube; it has 70, 90 mm" in err
+    rc, _, err = run(capsys, "chart", odd_cube, "--coil-index", "1.3", "--out", tmp_path)
+    assert rc == 2 and "--coil-index: coil_index=1.3 is not a grid value" in err
+
+
+def test_chart_slice_reaches_each_chart_and_progress(odd, tmp_path):
+    import matplotlib.pyplot as plt
+
+    from nylonflex import charts
+
+    chosen = charts.chart_slice(odd, {"length": 70e-3, "wrap_angle": 8 * 3.141592653589793
+                                      / 180}, [1.1, 1.7])
+    fig = charts.design_map(odd, **charts._slice_kwargs(charts.design_map, chosen))
+    assert "L = 70 mm, \u03c8 = 8 deg" in fig._suptitle.get_text()
+    assert [ax.get_title() for ax in fig.axes if ax.get_title()] == ["C = 1.1", "C = 1.7"]
+    plt.close(fig)
+    seen = []
+    charts.draw_charts(odd, ["fig4", "fig6"], tmp_path, progress=lambda d, n: seen.append(d))
+    assert seen[-1] == 2
