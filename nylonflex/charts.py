@@ -294,9 +294,10 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
                for i, a in enumerate(radii)]
     handles += [Line2D([], [], color="0.3", ls=styles[j % len(styles)],
                        label=_eq("wall_thickness", t)) for j, t in enumerate(walls)]
-    left.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4,
+    # two columns each: a legend wider than its panel would run into its neighbour's
+    left.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
                 fontsize=8)
-    right.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4, fontsize=8)
+    right.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8)
     _suptitle(fig, "Figure 12(a): nylon force against muscle stroke",
               "dashed: each coil index's strength limit F_lim(C) up to its largest stroke "
               "s_max(C) (dotted)\nthe force is the same for every coil index and length")
@@ -330,6 +331,9 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
     designs with a full range of motion."""
     x = to_display("radius", ds["radius"].values)
+    # read the panel's slice once (a large cube's chunks span every coil and wrap angle)
+    ds = ds[[var, "limit"]].sel(**sel).load()
+    sel = {}
     for k, c in enumerate(coils):
         cut = ds[[var, "limit"]].sel(coil_index=c, **sel)
         value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
@@ -527,8 +531,9 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
         top.set_xlabel("")
         top.set_ylabel(_label("bend_angle_max"))
         top.set_ylim(bottom=0)
+        fraction = ds["range_fraction"].sel(wrap_angle=psi, **sel).load()
         for k, c in enumerate(coils):
-            rf = ds["range_fraction"].sel(coil_index=c, wrap_angle=psi, **sel).values
+            rf = fraction.sel(coil_index=c).values
             bottom.plot(x, 100 * rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
         bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)} "
                          "(100 % = full range)")
@@ -700,7 +705,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     nrows = math.ceil(len(coils) / ncols)
     fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
                         sharex=True, sharey=True)
-    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi)
+    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi).load()
     force = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
     top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
     levels = _nice_levels(top)
@@ -727,7 +732,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
         for example in _map_examples(ds, length, psi, c):
             ax.plot(to_display("radius", example[0]),
                     to_display("wall_thickness", example[1]), "*", ms=13, mfc="gold",
-                    mec="k", zorder=6)
+                    mec="k", zorder=6, clip_on=False)  # inside the map: stretches nothing
         ax.set_title(_eq("coil_index", c))
         ax.grid(False)
         if i % ncols == 0:

@@ -56,8 +56,13 @@ def run(args) -> int:
     if cfg.charts and not args.no_charts:
         from ..charts import draw_charts
 
+        from ._common import progress_bar
+
         skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
-        for path in draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip):
+        with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
+            paths = draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip,
+                                progress=bar)
+        for path in paths:
             print(path)
     ds.close()
     return 0
