@@ -297,7 +297,7 @@ def _exact_settings(ds):
 
 
 def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=False,
-               progress=None) -> QueryResult:
+               progress=None, log=None) -> QueryResult:
     """Designs of a cube selected by ``--at``, filtered by ``--where``, sorted, limited.
 
     Parameters
@@ -317,6 +317,9 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         exact model (:func:`nylonflex.evaluate`) with the cube's materials and settings.
     progress : callable, optional
         Called as ``progress(done, total)`` [slabs] after each slab of the scan.
+    log : callable, optional
+        Receives a one-line notice while the model's kernels compile (a first exact
+        evaluation).
 
     Returns
     -------
@@ -338,6 +341,10 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
+    if exact and log is not None:
+        from .engine.warmup import warm_up_points
+
+        warm_up_points(settings, notice=log)
 
     # radius slabs: the --at bracket, or the whole axis cut to bounded memory
     if "radius" in at_loc:

@@ -64,7 +64,8 @@ def run(args) -> int:
             res = query_cube(ds, at=parse_at(args.at) if args.at else None,
                              where=parse_where(args.where), sort=args.sort,
                              limit=args.limit, interpolate=args.interpolate,
-                             progress=bar)
+                             progress=bar, log=lambda m: print(f"nylonflex query: {m}",
+                                                               file=sys.stderr))
         if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
             raise InputError("--at: this design is not in the cube yet (an incomplete "
                              "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
