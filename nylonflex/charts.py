@@ -6,7 +6,11 @@ comes from the variable registry (:mod:`nylonflex.variables`) in the unit a desi
 imported lazily with the headless Agg backend (after ``xarray/plot/utils.py``).
 
 Each chart is a function ``f(ds, **slice) -> matplotlib.figure.Figure``; the keyword
-arguments choose the slice in SI (default: the grid values nearest the paper's choices).
+arguments choose the slice in SI (default: the grid values nearest the paper's choices), and
+:func:`draw_charts` passes a slice (``at``, ``coil_index``) to every chart that draws along
+it (``nylonflex chart CUBE --at length=70mm,wrap_angle=8deg --coil-index 1.1,1.7``).
+Subtitles are written from the values drawn; the paper's worked examples are marked only
+where the slice holds them exactly, with the cube's values there.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from .config import CHARTS as _CHART_NAMES
 from .units import InputError
 from .variables import VARIABLES, display_label, to_display
 
-__all__ = ["CHARTS", "FORMATS", "design_map", "draw_charts", "fig4", "fig6",
+__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "design_map", "draw_charts", "fig4", "fig6",
            "fig7", "fig12a", "fig12b", "fig12c"]
 
 #: Image formats a chart can be written in.
@@ -90,17 +94,85 @@ def _nearest(ds, name, target):
 def _spread(ds, name, lo, hi, n):
     """Up to ``n`` grid values of ``name`` in [lo, hi] [SI], evenly spread, ends included.
 
-    Falls back to the nearest grid values of ``lo`` and ``hi`` when none lies inside.
+    Where fewer than three (or fewer than the axis has) lie inside, the values spread over
+    the whole axis instead: a chart of a cube on another grid still shows a family.
     """
     values = ds[name].values
     span = max(abs(hi - lo), 1e-300)
     inside = values[(values >= lo - 1e-9 * span) & (values <= hi + 1e-9 * span)]
-    if inside.size == 0:
-        inside = np.unique([_nearest(ds, name, lo), _nearest(ds, name, hi)])
+    if inside.size < min(3, values.size, n):
+        inside = values
     if inside.size <= n:
         return [float(x) for x in inside]
     idx = np.unique(np.round(np.linspace(0, inside.size - 1, n)).astype(int))
     return [float(inside[i]) for i in idx]
+
+
+def _grid_value(ds, name, value):
+    """The grid value of ``name`` equal to ``value`` [SI] (to rounding), or None."""
+    values = ds[name].values.astype(float)
+    tol = 1e-6 * max(float(np.ptp(values)) if values.size > 1 else 0.0,
+                     float(np.abs(values).max()), 1e-300)
+    i = int(np.argmin(np.abs(values - value)))
+    return float(values[i]) if abs(values[i] - value) <= tol else None
+
+
+def _coils(ds, coil_index=None):
+    """Coil indices to draw: the given ones (on the grid) or every one of the cube."""
+    if coil_index is None:
+        return [float(c) for c in ds["coil_index"].values]
+    return [_nearest(ds, "coil_index", c) for c in np.atleast_1d(coil_index)]
+
+
+def _example_point(ds, example, **fixed):
+    """The grid design of a paper example, or None where the cube's slice does not hold it.
+
+    ``example`` is (radius, wall, length, coil index) [SI] at psi = 8 deg; ``fixed`` are
+    the slice's values [SI] (a panel's wall, length, coil index or wrap angle), which must
+    equal the example's. Every one of the five values must be a grid value: a star never
+    snaps to a neighbour, so the numbers beside it are the paper's design's own.
+    """
+    target = dict(zip(("radius", "wall_thickness", "length", "coil_index"), example),
+                  wrap_angle=_WRAP_DEFAULT)
+    at = {}
+    for name, value in target.items():
+        grid = _grid_value(ds, name, value)
+        if grid is None:
+            return None
+        if name in fixed and fixed[name] is not None and abs(fixed[name] - grid) > \
+                1e-9 * max(abs(grid), 1e-300):
+            return None
+        at[name] = grid
+    return at
+
+
+#: Most wrap angles a fig. 12(b, c) panel labels; more are drawn faint and unlabelled.
+_MAX_LABELLED = 6
+
+
+def _labelled_psis(psis):
+    """The wrap angles to draw in colour and label: all, or up to six spread ones."""
+    if len(psis) <= _MAX_LABELLED:
+        return list(psis)
+    idx = np.unique(np.round(np.linspace(0, len(psis) - 1, _MAX_LABELLED)).astype(int))
+    return [psis[i] for i in idx]
+
+
+def _psi_colour(j, n):
+    """Colour of the j-th of n labelled wrap angles (dark to light, apart from the coils)."""
+    import matplotlib
+
+    return matplotlib.colormaps["plasma"](0.05 + 0.75 * (j / max(n - 1, 1)))
+
+
+def _range_text(name, values) -> str:
+    """``"6-14 mm"`` or ``"2 mm"``: the span of the values drawn, for a subtitle."""
+    lo, hi = min(values), max(values)
+    if abs(hi - lo) <= 1e-12 * max(abs(hi), 1e-300):
+        return _text(name, lo)
+    v = VARIABLES[name]
+    unit = "" if v.display == "1" else (" deg" if v.display == "deg" else f" {v.display}")
+    return f"{float(to_display(name, lo)):.4g}-{float(to_display(name, hi)):.4g}{unit}"
 
 
 def _pick_few(ds, name, n):
@@ -144,7 +216,7 @@ def _stroke_max(ds):
 
 # ---------------------------------------------------------------------------- figure 12
 def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
-           radius=None, wall_thickness=None):
+           radius=None, wall_thickness=None, coil_index=None):
     """Figure 12(a): nylon force against stroke, with each coil index's strength limit.
 
     Parameters
@@ -160,6 +232,8 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
         Wrap angles of the right panel [rad]; default up to four over the grid.
     radius, wall_thickness : float, optional
         Design of the right panel [m]; default nearest 15 mm and 4 mm.
+    coil_index : float or sequence of float, optional
+        Coil indices whose strength limits are drawn [-]; default every one of the cube.
 
     Returns
     -------
@@ -179,7 +253,9 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
     stroke = to_display("stroke", ds["stroke"].values)
     f_lim = to_display("nylon_force_limit", ds["nylon_force_limit"].values)
     s_max = _stroke_max(ds)
-    coils = ds["coil_index"].values
+    chosen = _coils(ds, coil_index)
+    keep = [k for k, c in enumerate(ds["coil_index"].values) if float(c) in chosen]
+    coils, f_lim, s_max = ds["coil_index"].values[keep], f_lim[keep], s_max[keep]
 
     from matplotlib.lines import Line2D
 
@@ -218,9 +294,10 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
                for i, a in enumerate(radii)]
     handles += [Line2D([], [], color="0.3", ls=styles[j % len(styles)],
                        label=_eq("wall_thickness", t)) for j, t in enumerate(walls)]
-    left.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4,
+    # two columns each: a legend wider than its panel would run into its neighbour's
+    left.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
                 fontsize=8)
-    right.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4, fontsize=8)
+    right.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8)
     _suptitle(fig, "Figure 12(a): nylon force against muscle stroke",
               "dashed: each coil index's strength limit F_lim(C) up to its largest stroke "
               "s_max(C) (dotted)\nthe force is the same for every coil index and length")
@@ -254,6 +331,9 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
     designs with a full range of motion."""
     x = to_display("radius", ds["radius"].values)
+    # read the panel's slice once (a large cube's chunks span every coil and wrap angle)
+    ds = ds[[var, "limit"]].sel(**sel).load()
+    sel = {}
     for k, c in enumerate(coils):
         cut = ds[[var, "limit"]].sel(coil_index=c, **sel)
         value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
@@ -262,65 +342,82 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
         solid = np.where(stroke_limited.any(axis=0), np.nanmax(
             np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
         ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
-    for j, (w, points) in enumerate(_cut_ins(ds, var, sel, coils, psis).items()):
+    shown = _labelled_psis(psis)
+    annotate = len(shown) <= 4  # more labels than that overprint: the legend names them
+    for w, points in _cut_ins(ds, var, sel, coils, psis).items():
         if not points:
             continue
         px, py = np.array(points).T
-        ax.plot(px, py, color="k", ls=_DASHES[j % len(_DASHES)], lw=1.2, marker="o",
-                ms=4, mfc="white", mec="k", zorder=4)
-        end = int(np.argmax(px))
-        ax.annotate(f"\u03c8 = {_text('wrap_angle', w)}", (px[end], py[end]),
-                    xytext=(4, -2), textcoords="offset points", fontsize=8, ha="left",
-                    va="top", zorder=6,
-                    bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
-                          "alpha": 0.8})
+        if w not in shown:  # the rest: faint context, unlabelled
+            ax.plot(px, py, color="0.75", lw=0.7, zorder=2)
+            continue
+        j = shown.index(w)
+        ax.plot(px, py, color=_psi_colour(j, len(shown)), ls=_DASHES[j % len(_DASHES)],
+                lw=1.4, marker="o", ms=4, mfc="white",
+                mec=_psi_colour(j, len(shown)), zorder=4)
+        if annotate:
+            end = int(np.argmax(px))
+            ax.annotate(f"\u03c8 = {_text('wrap_angle', w)}", (px[end], py[end]),
+                        xytext=(4, -2), textcoords="offset points", fontsize=8,
+                        ha="left", va="top", zorder=6,
+                        bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
+                              "alpha": 0.8})
     ax.set_xlabel(_label("radius"))
 
 
 def _legend_12bc(fig, coils, psis):
     from matplotlib.lines import Line2D
 
+    shown = _labelled_psis(psis)
     handles = [Line2D([], [], color=_COLOURS[k % len(_COLOURS)], lw=2.0,
                       label=f"C = {c:g}") for k, c in enumerate(coils)]
-    handles += [Line2D([], [], color="k", ls=_DASHES[j % len(_DASHES)], lw=1.2, marker="o",
-                       ms=4, mfc="white", mec="k",
+    handles += [Line2D([], [], color=_psi_colour(j, len(shown)),
+                       ls=_DASHES[j % len(_DASHES)], lw=1.4, marker="o", ms=4, mfc="white",
+                       mec=_psi_colour(j, len(shown)),
                        label=f"\u03c8 = {_text('wrap_angle', w)}")
-                for j, w in enumerate(psis)]
-    fig.legend(handles=handles, loc="outside lower center", ncol=4,
+                for j, w in enumerate(shown)]
+    note = ""
+    if len(shown) < len(psis):
+        handles.append(Line2D([], [], color="0.75", lw=0.7,
+                              label=f"the other {len(psis) - len(shown)} wrap angles"))
+        note = f" ({len(shown)} of {len(psis)} labelled)"
+    fig.legend(handles=handles, loc="outside lower center",
+               ncol=min(6, max(len(coils), len(shown) + (len(shown) < len(psis)))),
                title="coil index C: solid while the design has its full range of motion "
-                     "(stroke-limited)\nwrap angle \u03c8: dashed threshold through the "
-                     "last full-range design of each C; beyond it the nylon's strength "
+                     f"(stroke-limited)\nwrap angle \u03c8{note}: dashed threshold through "
+                     "the last full-range design of each C; beyond it the nylon's strength "
                      "limits")
 
 
-def _examples(ax, ds, var, t, length=None, corner="upper left"):
+def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None):
     """Mark the paper's worked examples (section 4) on a fig. 12(b,c) panel of wall ``t``.
 
-    ``length`` [m] is the panel's length for a length-dependent ``var`` (the star then sits
-    on the panel's curves); None labels the example's own tip force instead.
+    An example is marked only where the cube holds its design exactly (every value a grid
+    value; the panel's wall, and ``length`` [m] for a length-dependent ``var``, equal to
+    the example's; its coil index among ``coils``), with the cube's values there. None for
+    ``length`` (a length-free ``var``) adds the example's own tip force to the label.
     """
     texts = []
-    for a, t_ex, l_ex, c_ex in _EXAMPLES:
-        if abs(_nearest(ds, "wall_thickness", t_ex) - t) > 1e-12:
+    for example in _EXAMPLES:
+        at = _example_point(ds, example, wall_thickness=t, length=length)
+        if at is None or (coils is not None and at["coil_index"] not in coils):
             continue
-        at = {"radius": _nearest(ds, "radius", a), "wall_thickness": t,
-              "length": _nearest(ds, "length", l_ex if length is None else length),
-              "coil_index": _nearest(ds, "coil_index", c_ex),
-              "wrap_angle": _nearest(ds, "wrap_angle", _WRAP_DEFAULT)}
         point = ds[[var, "tip_force_max", "limit"]].sel(**at)
         x, y = float(to_display("radius", at["radius"])), float(to_display(var, point[var]))
         if not np.isfinite(y):  # an incomplete cube without this design
             continue
         ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
+        unit = VARIABLES[var].display
         text = f"paper example: {_eq('radius', at['radius'])}, " \
-               f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}"
+               f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}" \
+               f"\n{VARIABLES[var].long_name} {y:.3g} {unit}"
         full = "full range of motion" if int(point["limit"]) == 0 else \
             "range of motion cut short"
         if length is None:
             text += f"\nat {_eq('length', at['length'])} tip force " \
-                    f"{float(point['tip_force_max']):.2f} N, {full}"
+                    f"{float(point['tip_force_max']):.3g} N, {full}"
         else:
-            text += f"\n{full}"
+            text += f", {full}"
         texts.append(text)
         # an empty corner of the panel (fig. 12(b): curves rise to the right)
         upper, left = corner.split()[0] == "upper", corner.split()[1] == "left"
@@ -334,6 +431,12 @@ def _examples(ax, ds, var, t, length=None, corner="upper left"):
                     bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.6"})
 
 
+def _psis(ds, wrap_angle=None):
+    if wrap_angle is None:
+        return [float(w) for w in ds["wrap_angle"].values]
+    return [_nearest(ds, "wrap_angle", w) for w in np.atleast_1d(wrap_angle)]
+
+
 def _example_walls(ds, walls):
     if walls:
         return [_nearest(ds, "wall_thickness", t) for t in walls]
@@ -341,7 +444,7 @@ def _example_walls(ds, walls):
     return sorted({_nearest(ds, "wall_thickness", t) for t in (2e-3, 6e-3)})
 
 
-def fig12b(ds, *, walls=None, length=None):
+def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     """Figure 12(b): maximum torque against radius, per coil index, with strength limits.
 
     The solid line of each coil index is its torque M* while the design is stroke-limited
@@ -356,6 +459,11 @@ def fig12b(ds, *, walls=None, length=None):
         Wall thicknesses, one panel each [m]; default nearest 2 and 6 mm.
     length : float, optional
         Length at which M* is read [m] (M* does not depend on it); default nearest 90 mm.
+    wrap_angle : float or sequence of float, optional
+        Wrap angles whose thresholds are drawn [rad]; default every one of the cube (up to
+        six labelled, the rest faint).
+    coil_index : float or sequence of float, optional
+        Coil indices drawn [-]; default every one of the cube.
 
     Returns
     -------
@@ -363,13 +471,13 @@ def fig12b(ds, *, walls=None, length=None):
     """
     walls = _example_walls(ds, walls)
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
-    coils = [float(c) for c in ds["coil_index"].values]
-    psis = [float(w) for w in ds["wrap_angle"].values]
+    coils = _coils(ds, coil_index)
+    psis = _psis(ds, wrap_angle)
     fig, axes = _figure(1, len(walls), size=(4.4 * len(walls) + 0.4, 5.4))
     for ax, t in zip(axes[0], walls):
         _limit_lines(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
                      coils, psis)
-        _examples(ax, ds, "torque_max", t)
+        _examples(ax, ds, "torque_max", t, coils=coils)
         ax.set_title(f"wall thickness {_eq('wall_thickness', t)}")
         ax.set_ylabel(_label("torque_max"))
         ax.set_ylim(bottom=0)
@@ -380,7 +488,7 @@ def fig12b(ds, *, walls=None, length=None):
     return fig
 
 
-def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
+def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     """Figure 12(c): maximum bend angle and range of motion against radius.
 
     Top row: the maximum free bend angle theta* per coil index, solid while the design has
@@ -397,7 +505,10 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
     length : float, optional
         Actuator length [m] (theta* grows in proportion); default nearest 90 mm.
     wrap_angle : float, optional
-        Wrap angle of the bottom row [rad]; default nearest 8 deg.
+        Wrap angle of the bottom row [rad] (and the only threshold drawn on the top row when
+        given); default nearest 8 deg, every wrap angle's threshold on top.
+    coil_index : float or sequence of float, optional
+        Coil indices drawn [-]; default every one of the cube.
 
     Returns
     -------
@@ -406,8 +517,8 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
     walls = _example_walls(ds, walls)
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
-    coils = [float(c) for c in ds["coil_index"].values]
-    psis = [float(w) for w in ds["wrap_angle"].values]
+    coils = _coils(ds, coil_index)
+    psis = _psis(ds, wrap_angle)
     fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
                         height_ratios=(3, 2))
     x = to_display("radius", ds["radius"].values)
@@ -415,13 +526,14 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
         sel = {"wall_thickness": t, "length": length}
         top, bottom = axes[0][col], axes[1][col]
         _limit_lines(top, ds, "bend_angle_max", sel, coils, psis)
-        _examples(top, ds, "bend_angle_max", t, length, corner="lower right")
+        _examples(top, ds, "bend_angle_max", t, length, corner="lower right", coils=coils)
         top.set_title(f"wall thickness {_eq('wall_thickness', t)}")
         top.set_xlabel("")
         top.set_ylabel(_label("bend_angle_max"))
         top.set_ylim(bottom=0)
+        fraction = ds["range_fraction"].sel(wrap_angle=psi, **sel).load()
         for k, c in enumerate(coils):
-            rf = ds["range_fraction"].sel(coil_index=c, wrap_angle=psi, **sel).values
+            rf = fraction.sel(coil_index=c).values
             bottom.plot(x, 100 * rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
         bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)} "
                          "(100 % = full range)")
@@ -437,13 +549,15 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None):
 
 
 # ---------------------------------------------------------------------------- figures 4-7
-def fig4(ds):
+def fig4(ds, *, coil_index=None):
     """Figure 4: chamber pressure against muscle stroke, with each coil index's s_max.
 
     Parameters
     ----------
     ds : xarray.Dataset
         A nylonflex cube.
+    coil_index : float or sequence of float, optional
+        Coil indices whose largest stroke is marked [-]; default every one of the cube.
 
     Returns
     -------
@@ -455,8 +569,9 @@ def fig4(ds):
     p = to_display("chamber_pressure", ds["chamber_pressure"].values)
     ax.plot(stroke, p, color=_COLOURS[0], lw=2.0, label="p(s), Boyle's law")
     s_max = _stroke_max(ds)
+    chosen = _coils(ds, coil_index)
     for k, c in enumerate(ds["coil_index"].values):
-        if not np.isfinite(s_max[k]):
+        if not np.isfinite(s_max[k]) or float(c) not in chosen:
             continue
         p_k = float(np.interp(s_max[k], ds["stroke"].values, p))  # reading the curve
         ax.plot([s_max[k]] * 2, [0, p_k], color="k", ls=":", lw=0.9)
@@ -496,7 +611,10 @@ def _held_design(ds, radius, wall_thickness, length):
 
 
 def fig6(ds, *, radius=None, wall_thickness=None, length=None):
-    """Figure 6(b, c): bend angle against pressure, for radius 6-14 mm and wall 1-4 mm.
+    """Figure 6(b, c): bend angle against pressure, varying radius and wall thickness.
+
+    The paper shows radius 6-14 mm and wall 1-4 mm; the cube's grid values in those spans
+    are drawn (the nearest ones where none lies inside), and the subtitle says which.
 
     Parameters
     ----------
@@ -515,14 +633,15 @@ def fig6(ds, *, radius=None, wall_thickness=None, length=None):
     """
     a, t, length = _held_design(ds, radius, wall_thickness, length)
     fig, axes = _figure(1, 2, size=(9.0, 4.2))
-    _curve_panel(axes[0][0], ds, "bend_angle", "radius",
-                 _spread(ds, "radius", 6e-3, 14e-3, 5),
+    radii = _spread(ds, "radius", 6e-3, 14e-3, 5)
+    walls = _spread(ds, "wall_thickness", 1e-3, 4e-3, 5)
+    _curve_panel(axes[0][0], ds, "bend_angle", "radius", radii,
                  {"wall_thickness": t, "length": length})
-    _curve_panel(axes[0][1], ds, "bend_angle", "wall_thickness",
-                 _spread(ds, "wall_thickness", 1e-3, 4e-3, 5),
+    _curve_panel(axes[0][1], ds, "bend_angle", "wall_thickness", walls,
                  {"radius": a, "length": length})
     _suptitle(fig, "Figure 6: bend angle against chamber pressure",
-              "(b) radius 6-14 mm, (c) wall thickness 1-4 mm; free bending")
+              f"(b) radius {_range_text('radius', radii)}, (c) wall thickness "
+              f"{_range_text('wall_thickness', walls)}; free bending")
     _footer(fig, ds)
     return fig
 
@@ -570,7 +689,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     wrap_angle : float, optional
         Wrap angle [rad]; default nearest 8 deg.
     coil_index : float or sequence of float, optional
-        Coil index of each panel [-]; default every coil index of the cube (up to four).
+        Coil index of each panel [-]; default every coil index of the cube.
 
     Returns
     -------
@@ -581,15 +700,12 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     plt = _plt()
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
-    if coil_index is None:
-        coils = _pick_few(ds, "coil_index", 4)
-    else:
-        coils = [_nearest(ds, "coil_index", c) for c in np.atleast_1d(coil_index)]
-    ncols = 1 if len(coils) == 1 else 2
+    coils = _coils(ds, coil_index)
+    ncols = min(3, len(coils)) if len(coils) != 4 else 2
     nrows = math.ceil(len(coils) / ncols)
     fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
                         sharex=True, sharey=True)
-    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi)
+    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi).load()
     force = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
     top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
     levels = _nice_levels(top)
@@ -613,11 +729,10 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
                 ax.contourf(x, y, strength, levels=[0.5, 1.5], colors="none",
                             hatches=["///"])
             ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
-        for a, t_ex, l_ex, c_ex in _EXAMPLES:
-            if (abs(_nearest(ds, "length", l_ex) - length) < 1e-12
-                    and abs(_nearest(ds, "coil_index", c_ex) - c) < 1e-12):
-                ax.plot(to_display("radius", a), to_display("wall_thickness", t_ex), "*", ms=13,
-                        mfc="gold", mec="k", clip_on=False, zorder=6)
+        for example in _map_examples(ds, length, psi, c):
+            ax.plot(to_display("radius", example[0]),
+                    to_display("wall_thickness", example[1]), "*", ms=13, mfc="gold",
+                    mec="k", zorder=6, clip_on=False)  # inside the map: stretches nothing
         ax.set_title(_eq("coil_index", c))
         ax.grid(False)
         if i % ncols == 0:
@@ -628,7 +743,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     handles = [Patch(fc="#2a788e", ec="white", hatch="///",
                      label="strength-limited: nylon breaks first, range of motion cut short"),
                Patch(fc="#2a788e", ec="none", label="stroke-limited: full range of motion")]
-    if any(abs(_nearest(ds, "length", e[2]) - length) < 1e-12 for e in _EXAMPLES):
+    if any(_map_examples(ds, length, psi, c) for c in coils):
         from matplotlib.lines import Line2D
 
         handles.append(Line2D([], [], ls="", marker="*", ms=10, mfc="gold", mec="k",
@@ -639,6 +754,27 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
               "one panel per coil index")
     _footer(fig, ds)
     return fig
+
+
+def _map_examples(ds, length, psi, coil):
+    """The paper's examples a design-map panel holds: its length, wrap angle (8 deg) and
+    coil index on the grid and equal to the panel's, radius and wall inside the map."""
+    out = []
+    for example in _EXAMPLES:
+        a, t, l_ex, c_ex = example
+        fixed = {"length": _grid_value(ds, "length", l_ex),
+                 "coil_index": _grid_value(ds, "coil_index", c_ex),
+                 "wrap_angle": _grid_value(ds, "wrap_angle", _WRAP_DEFAULT)}
+        if any(v is None for v in fixed.values()):
+            continue
+        if (abs(fixed["length"] - length) > 1e-12 or abs(fixed["coil_index"] - coil) > 1e-12
+                or abs(fixed["wrap_angle"] - psi) > 1e-12):
+            continue
+        inside = all(float(ds[n].min()) <= v <= float(ds[n].max())
+                     for n, v in (("radius", a), ("wall_thickness", t)))
+        if inside:
+            out.append(example)
+    return out
 
 
 def _nice_levels(top):
@@ -668,7 +804,71 @@ def _unmet(ds, name):
             "has 1") if short else None
 
 
-def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
+#: Axes a chart slice (``--at``) may fix.
+SLICE_AXES = ("radius", "wall_thickness", "length", "wrap_angle")
+
+
+def _on_grid(ds, name, values, field):
+    out = []
+    for value in np.atleast_1d(values):
+        grid = _grid_value(ds, name, float(value))
+        if grid is None:
+            v = VARIABLES[name]
+            unit = "" if v.display == "1" else f" {v.display}"
+            shown = ", ".join(f"{x:g}" for x in to_display(name, ds[name].values[:12]))
+            more = ", ..." if ds.sizes[name] > 12 else ""
+            raise InputError(f"{field}: {name}={float(to_display(name, value)):g}{unit} is "
+                             f"not a grid value of the cube; it has {shown}{more}{unit}")
+        out.append(grid)
+    return out
+
+
+def chart_slice(ds, at=None, coil_index=None) -> dict:
+    """Check a chart slice against the cube: ``{axis: grid value}`` [SI] and coil indices.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    at : dict, optional
+        ``{axis: value}`` [SI] for axes of :data:`SLICE_AXES`.
+    coil_index : float or sequence of float, optional
+        Coil indices to draw [-].
+
+    Returns
+    -------
+    dict
+        The slice with grid values, ``coil_index`` a list.
+
+    Raises
+    ------
+    InputError
+        An axis that charts cannot fix, or a value that is not a grid value.
+    """
+    out = {}
+    for name, value in (at or {}).items():
+        if name not in SLICE_AXES:
+            raise InputError(f"--at: charts take {', '.join(SLICE_AXES)} (coil indices with "
+                             f"--coil-index), got {name!r}")
+        out[name] = _on_grid(ds, name, value, "--at")[0]
+    if coil_index is not None:
+        out["coil_index"] = _on_grid(ds, "coil_index", coil_index, "--coil-index")
+    return out
+
+
+def _slice_kwargs(func, chosen):
+    """The keyword arguments of chart ``func`` that the slice ``chosen`` sets."""
+    import inspect
+
+    params = inspect.signature(func).parameters
+    kw = {name: value for name, value in chosen.items() if name in params}
+    if "wall_thickness" in chosen and "walls" in params:
+        kw["walls"] = [chosen["wall_thickness"]]
+    return kw
+
+
+def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_index=None,
+                progress=None) -> list[Path]:
     """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
 
     Parameters
@@ -684,6 +884,13 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
     on_skip : callable, optional
         Receives a one-line message for each chart the cube cannot show (an axis it plots
         along has a single value); a warning by default.
+    at : dict, optional
+        The slice, ``{axis: value}`` [SI] for axes of :data:`SLICE_AXES` (grid values):
+        each chart takes the ones it holds fixed.
+    coil_index : float or sequence of float, optional
+        Coil indices to draw [-] (grid values); default every one of the cube.
+    progress : callable, optional
+        Called as ``progress(done, total)`` [charts] after each chart.
 
     Returns
     -------
@@ -703,11 +910,14 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
     if fmt not in FORMATS:
         raise InputError(f"--format: unknown image format {fmt!r}; accepted: "
                          f"{', '.join(FORMATS)}")
+    chosen = chart_slice(ds, at, coil_index)
     plt = _plt()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for name in names:
+    for done, name in enumerate(names, 1):
+        if progress is not None and done > 1:
+            progress(done - 1, len(names))
         reason = _unmet(ds, name)
         if reason:
             if on_skip is None:
@@ -718,7 +928,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
                 on_skip(reason)
             continue
         with plt.rc_context(_RC):
-            fig = CHARTS[name](ds)
+            fig = CHARTS[name](ds, **_slice_kwargs(CHARTS[name], chosen))
             path = out_dir / f"{name}.{fmt}"
             # fixed metadata so that the same cube gives byte-stable PDF/SVG files
             meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
@@ -727,4 +937,6 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
                         pad_inches=0.08)
             plt.close(fig)
         written.append(path)
+    if progress is not None:
+        progress(len(names), len(names))
     return written

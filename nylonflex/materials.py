@@ -26,7 +26,10 @@ __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "Nylon",
+    "FIELD_UNITS",
+    "SHEAR_MODULUS_RANGE",
     "Silicone",
+    "check_shear_modulus",
     "nylon_parameters",
     "silicone_parameters",
 ]
@@ -127,6 +130,58 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
         },
     },
 }
+
+
+#: Unit of every field of a material set, as the code (and a config override) takes it.
+FIELD_UNITS = {
+    "mu": "Pa", "alpha": "1",
+    "fibre_diameter": "m", "stroke_reference": "1", "gamma": "1/K", "beta": "1",
+    "t_g": "K", "sigma_g": "K", "t_amb": "K", "t_max": "K",
+    "resistance_per_length": "ohm/m", "heat_capacity_per_length": "J/(K m)",
+    "heat_loss_per_length": "W/(K m)", "stiffness": "N/m", "damping": "N s/m",
+    "thermal_force_coefficient": "N/K", "coil_index_table": "1", "stroke_max_table": "1",
+    "tensile_strength_table": "Pa",
+}
+
+
+#: Plausible initial shear modulus mu_0 = 1/2 sum mu_i alpha_i of a silicone [Pa]: the
+#: softest gels (about 1 kPa) to stiff rubbers (tens of MPa). Below it, mu was most likely
+#: typed in kPa (or MPa) where the code takes Pa.
+SHEAR_MODULUS_RANGE = (100.0, 100e6)
+
+
+def check_shear_modulus(mu0, field="silicone.mu"):
+    """Refuse an initial shear modulus no silicone has, naming the likely unit slip.
+
+    Parameters
+    ----------
+    mu0 : float or array
+        Initial shear modulus 1/2 sum mu_i alpha_i [Pa].
+    field : str
+        The parameter to name in the message.
+
+    Raises
+    ------
+    ValueError
+        One line: the field, the accepted range [Pa], the value and the likely slip.
+    """
+    arr = np.asarray(mu0, dtype=float)
+    lo, hi = SHEAR_MODULUS_RANGE
+    bad = ~(arr > 0)
+    if np.any(bad):
+        raise ValueError(f"{field}: initial shear modulus 1/2 sum mu_i alpha_i = "
+                         f"{arr[bad].flat[0]:g} Pa; must be > 0")
+    bad = (arr < lo) | (arr > hi)
+    if np.any(bad):
+        got = float(arr[bad].flat[0])
+        msg = (f"{field}: initial shear modulus 1/2 sum mu_i alpha_i = {got:g} Pa is "
+               f"implausible for a silicone; accepted {lo:g} Pa to {hi:g} Pa")
+        for factor, unit in ((1e3, "kPa"), (1e6, "MPa")):
+            if got < lo and lo <= got * factor <= hi:
+                msg += (f"; the mu values look like {unit}: the code takes Pa "
+                        f"(mu_0 would be {got * factor:g} Pa)")
+                break
+        raise ValueError(msg)
 
 
 @dataclass(frozen=True)
@@ -299,11 +354,7 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
     if not all(np.isfinite(mu + alpha)) or any(a == 0 for a in alpha):
         raise ValueError("silicone.alpha: must be finite and non-zero")
-    mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
-    if not mu0 > 0:
-        raise ValueError(
-            f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i = {mu0:g} Pa; must be > 0"
-        )
+    check_shear_modulus(0.5 * sum(m * a for m, a in zip(mu, alpha)))
     return Silicone(
         mu=mu,
         alpha=alpha,

@@ -3,17 +3,21 @@
 A query picks designs three ways, which combine:
 
 * ``--at radius=7.5mm,coil_index=1.7``: fixes the named axes. A value on the grid (within a
-  tiny tolerance) is read as is ("grid point"); between grid points the design variables
-  are interpolated linearly in each axis ("interpolated"). Axes not named keep all their
-  grid values, so a partial ``--at`` lists a slice of the cube (one row per design); naming
-  all five axes gives one design. Outside the grid is refused.
+  tiny tolerance) is read as is ("grid point"); between grid points the model is evaluated
+  exactly at that design with the cube's own materials and settings from its provenance
+  ("exact model", :func:`nylonflex.evaluate`, milliseconds), or, with ``interpolate=True``
+  (``--interpolate``), the design variables are interpolated linearly in each axis
+  ("interpolated"; up to tens of per cent off where the response bends). Axes not named
+  keep all their grid values, so a partial ``--at`` lists a slice of the cube (one row per
+  design); naming all five axes gives one design. Outside the grid is refused.
 * ``--where "tip_force_max >= 0.5 N"``: conditions on axes or design variables, with units;
   several are ANDed.
 * ``--sort NAME`` (``--sort=-NAME`` or ``--sort NAME:desc`` descending; ties keep grid
   order) and ``--limit N``.
 
 The cube is read in slabs of radii, so memory stays bounded on a cube of any size; only the
-matching rows (at most ``--limit`` when sorting) are kept.
+matching rows (at most ``--limit``) are kept, and every match is counted, so that the
+output can say how many rows it held back.
 """
 
 from __future__ import annotations
@@ -29,8 +33,8 @@ import numpy as np
 from .units import InputError, from_si, parse_quantity
 from .variables import AXES, DESIGN, VARIABLES, to_display
 
-__all__ = ["Condition", "QueryResult", "format_csv", "format_json", "format_table",
-           "parse_at", "parse_where", "query_cube"]
+__all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_csv", "format_json", "format_table",
+           "held_back", "parse_at", "parse_where", "query_cube", "rows_note"]
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
@@ -39,6 +43,8 @@ _FIELDS = ", ".join(COLUMNS)
 _GRID_RTOL = 1e-6
 # Slab size when scanning a cube: about this many float64 values per variable.
 _SLAB_VALUES = 2**20
+#: How an ``--at`` design was found: on the grid, by the exact model, interpolated.
+GRID, EXACT, INTERPOLATED = "grid point", "exact model", "interpolated"
 _LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1}
 
 
@@ -53,15 +59,19 @@ def _quantity(name, text, field):
 def parse_at(text) -> dict:
     """Parse ``"radius=7.5mm,wall_thickness=2mm"`` into ``{axis: SI value}``.
 
-    Bare numbers are in the axis's display unit (mm, deg; none for ``coil_index``).
+    Bare numbers are in the axis's display unit (mm, deg; none for ``coil_index``). A list
+    of such texts (``--at`` given several times) is merged into one design.
 
     Raises
     ------
     InputError
-        Not ``NAME=VALUE``, an unknown axis, a repeated axis or a bad value.
+        Not ``NAME=VALUE``, an unknown axis, an axis given twice (in one text or across
+        several) or a bad value.
     """
+    texts = [text] if isinstance(text, str) else list(text or ())
+    repeated = len(texts) > 1
     out = {}
-    for part in [p for p in str(text).split(",") if p.strip()]:
+    for part in [p for t in texts for p in str(t).split(",") if p.strip()]:
         if "=" not in part:
             raise InputError(f"--at: expected NAME=VALUE, got {part.strip()!r}; names: "
                              f"{', '.join(AXES)}")
@@ -69,7 +79,11 @@ def parse_at(text) -> dict:
         if name not in AXES:
             raise InputError(f"--at: unknown axis {name!r}; accepted: {', '.join(AXES)}")
         if name in out:
-            raise InputError(f"--at: {name} given twice")
+            where = " (across repeated --at options, which are merged into one design)" \
+                if repeated else ""
+            raise InputError(f"--at: {name} given twice{where}; --at picks one design: "
+                             f"give each axis once, or use --where for a range, e.g. "
+                             f"--where \"{name} >= ...\"")
         out[name] = float(_quantity(name, value, f"--at {name}"))
     if not out:
         raise InputError(f"--at: expected NAME=VALUE,...; names: {', '.join(AXES)}")
@@ -168,11 +182,13 @@ class QueryResult:
     data : dict of str to numpy.ndarray
         One array per column of :data:`COLUMNS`, SI.
     point : str or None
-        ``"grid point"`` or ``"interpolated"`` for an ``--at`` query, else None.
+        ``"grid point"``, ``"exact model"`` or ``"interpolated"`` for an ``--at`` query,
+        else None.
     interpolated : list of str
-        The ``--at`` axes that were interpolated.
+        The ``--at`` axes that lie between grid points (evaluated exactly, or interpolated
+        when ``point`` is ``"interpolated"``).
     matched : int or None
-        Designs that met the conditions (None when the scan stopped early).
+        Designs that met the conditions (every one is counted, shown or not).
     single : bool
         The query named one design (all five axes in ``--at``).
     """
@@ -236,21 +252,74 @@ def at_value(at_loc, name, ds):
     return float(grid[i0]) if on_grid else float(grid[i0] * (1 - w) + grid[i1] * w)
 
 
-def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
+def _exact_rows(ds, at, at_loc, r0, r1, settings):
+    """Rows of radius indices [r0, r1) with the design variables from the exact model.
+
+    The ``--at`` axes take their typed values (the grid value on a grid point), the others
+    their grid values; :func:`nylonflex.evaluate` computes every design variable there with
+    the cube's materials and settings (``settings``, from its provenance).
+    """
+    from .engine.pointwise import evaluate
+
+    free = [name for name in AXES if name not in at_loc]
+    grids = []
+    for name in free:
+        values = ds[name].values.astype(float)
+        grids.append(values[r0:r1] if name == "radius" else values)
+    mesh = np.meshgrid(*grids, indexing="ij") if grids else []
+    n = int(np.prod([len(g) for g in grids])) if grids else 1
+    rows = {}
+    for name in AXES:
+        if name in at_loc:
+            value = at_value(at_loc, name, ds) if at_loc[name][3] else float(at[name])
+            rows[name] = np.full(n, value)
+        else:
+            rows[name] = mesh[free.index(name)].reshape(-1)
+    out = evaluate(*(rows[name] for name in AXES), **settings)
+    for name in DESIGN:
+        rows[name] = np.asarray(out[name], dtype=float).reshape(-1)
+    return rows
+
+
+def _exact_settings(ds):
+    from .engine.provenance import evaluate_settings
+
+    try:
+        settings = evaluate_settings(ds.attrs)
+    except ValueError as err:
+        raise InputError(f"--at: {err}; use --interpolate to interpolate between grid "
+                         "points instead") from None
+    if isinstance(settings.get("model"), list):
+        raise InputError("--at: this cube holds several models "
+                         f"({', '.join(settings['model'])}); the exact model between grid "
+                         "points needs one: use --interpolate, or query a one-model cube")
+    return settings
+
+
+def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=False,
+               progress=None, log=None) -> QueryResult:
     """Designs of a cube selected by ``--at``, filtered by ``--where``, sorted, limited.
 
     Parameters
     ----------
     ds : xarray.Dataset
         A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab).
-    at : dict or str, optional
-        ``{axis: SI value}`` or the ``--at`` text.
+    at : dict or str or list of str, optional
+        ``{axis: SI value}`` or the ``--at`` text(s).
     where : sequence of str or Condition
         Conditions, ANDed.
     sort : str, optional
         Column to sort by, ``-NAME`` for descending; ties keep grid order.
     limit : int, optional
-        At most this many rows.
+        At most this many rows; every match is still counted (``matched``).
+    interpolate : bool, default False
+        Between grid points, interpolate the cube linearly instead of evaluating the
+        exact model (:func:`nylonflex.evaluate`) with the cube's materials and settings.
+    progress : callable, optional
+        Called as ``progress(done, total)`` [slabs] after each slab of the scan.
+    log : callable, optional
+        Receives a one-line notice while the model's kernels compile (a first exact
+        evaluation).
 
     Returns
     -------
@@ -261,7 +330,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
     InputError
         Bad names, units or values, or an ``--at`` point outside the grid.
     """
-    if isinstance(at, str):
+    if isinstance(at, (str, list, tuple)):
         at = parse_at(at)
     at = dict(at or {})
     conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
@@ -269,7 +338,13 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
     if limit is not None and limit < 0:
         raise InputError(f"--limit: must be 0 or more, got {limit}")
     at_loc = {name: _locate(ds, name, value) for name, value in at.items()}
-    interpolated = [name for name, loc in at_loc.items() if not loc[3]]
+    off_grid = [name for name, loc in at_loc.items() if not loc[3]]
+    exact = bool(off_grid) and not interpolate
+    settings = _exact_settings(ds) if exact else None
+    if exact and log is not None:
+        from .engine.warmup import warm_up_points
+
+        warm_up_points(settings, notice=log)
 
     # radius slabs: the --at bracket, or the whole axis cut to bounded memory
     if "radius" in at_loc:
@@ -282,15 +357,17 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
         step = max(1, _SLAB_VALUES // max(other, 1))
         slabs = [(r, min(r + step, ds.sizes["radius"]))
                  for r in range(0, ds.sizes["radius"], step)]
-    done = ds["slab_done"].values.astype(bool) if "slab_done" in ds else None
+    done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
     kept = {name: np.empty(0) for name in COLUMNS}
     matched = 0
-    early = False
-    for r0, r1 in slabs:
+    for k, (r0, r1) in enumerate(slabs):
         if done is not None and "radius" not in at_loc and not done[r0:r1].any():
+            if progress is not None:
+                progress(k + 1, len(slabs))
             continue  # an incomplete cube: nothing computed here
-        rows = _slab_rows(ds, at_loc, r0, r1)
+        rows = _exact_rows(ds, at, at_loc, r0, r1, settings) if exact else \
+            _slab_rows(ds, at_loc, r0, r1)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
@@ -298,21 +375,24 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None) -> QueryResult:
             mask &= ~np.isnan(rows["tip_force_max"])  # skip masked, uncomputed radii
         n = int(mask.sum())
         matched += n
-        kept = {name: np.concatenate([kept[name], rows[name][mask]]) for name in COLUMNS}
+        room = None if limit is None or sort_name is not None else \
+            limit - len(kept[COLUMNS[0]])
+        if room is None or room > 0:
+            kept = {name: np.concatenate([kept[name], rows[name][mask][:room]])
+                    for name in COLUMNS}
         if limit is not None and sort_name is not None:
             kept = _sorted(kept, sort_name, descending, limit)
-        elif limit is not None and len(kept[COLUMNS[0]]) >= limit:
-            early = (r1 < slabs[-1][1])  # grid order: the first `limit` matches are final
-            break
+        if progress is not None:
+            progress(k + 1, len(slabs))
     if sort_name is not None:
         kept = _sorted(kept, sort_name, descending, limit)
     elif limit is not None:
         kept = {name: v[:limit] for name, v in kept.items()}
     point = None
     if at_loc:
-        point = "interpolated" if interpolated else "grid point"
-    return QueryResult(kept, point, interpolated, None if early else matched,
-                       single=len(at_loc) == len(AXES), at=at)
+        point = (EXACT if exact else INTERPOLATED) if off_grid else GRID
+    return QueryResult(kept, point, off_grid, matched, single=len(at_loc) == len(AXES),
+                       at=at)
 
 
 def _sorted(rows, name, descending, limit):
@@ -361,8 +441,12 @@ def _describe_at(res) -> str:
         parts.append(f"{name}={float(to_display(name, value)):g}"
                      + ("" if unit == "1" else f" {unit}"))
     note = res.point
-    if res.interpolated:
-        note += " (linear in " + ", ".join(res.interpolated) + ")"
+    if res.point == EXACT:
+        note += (" at this design (between grid points in " + ", ".join(res.interpolated)
+                 + "; evaluated with the cube's materials and settings)")
+    elif res.interpolated:
+        note += (" linearly in " + ", ".join(res.interpolated)
+                 + " between grid points (--interpolate; the exact model may differ)")
     return ", ".join(parts) + f": {note}"
 
 
@@ -397,14 +481,24 @@ def format_table(res) -> str:
     print("  ".join(u.rjust(w) for u, w in zip(units, widths)), file=out)
     for r in cells:
         print("  ".join(c.rjust(w) for c, w in zip(r, widths)), file=out)
-    shown = f"{n} design{'s' if n != 1 else ''}"
-    if res.matched is None:
-        print(f"{shown} (the first matches in grid order)", file=out)
-    elif res.matched != n:
-        print(f"{shown} of {res.matched} matching", file=out)
-    else:
-        print(shown, file=out)
+    print(rows_note(res), file=out)
     return out.getvalue()
+
+
+def held_back(res) -> int:
+    """How many matching designs a result does not show (past ``--limit``)."""
+    return 0 if res.matched is None else max(0, res.matched - len(res))
+
+
+def rows_note(res) -> str:
+    """``"20 designs shown of 11808 matching; 11788 held back (--limit N or --limit all)"``."""
+    n = len(res)
+    shown = f"{n} design{'s' if n != 1 else ''}"
+    hidden = held_back(res)
+    if hidden:
+        return (f"{shown} shown of {res.matched} matching; {hidden} held back "
+                "(--limit N for more, --limit all for every one)")
+    return shown
 
 
 def _json_value(x):

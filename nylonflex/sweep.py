@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .config import ResolvedConfig
 
-__all__ = ["default_output", "run_sweep"]
+__all__ = ["default_output", "estimate", "run_sweep"]
 
 
 def default_output(cfg: ResolvedConfig) -> Path:
@@ -50,6 +50,14 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     nylonflex.storage.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
+    if scheduler is None:  # compile first, so that the run's timings exclude it
+        from .engine.slabs import set_workers
+        from .engine.warmup import warm_up_grid
+
+        set_workers(workers)
+        compiled = warm_up_grid(cfg, notice=log)
+        if compiled and log is not None:
+            log(f"kernels compiled in {compiled:.1f} s (not counted below)")
     if out is None:
         return _in_memory(cfg, workers, scheduler, progress)
     from .storage import open_cube, sweep_to_file
@@ -79,3 +87,116 @@ def _in_memory(cfg, workers, scheduler, progress):
     if stats.stopped:
         raise KeyboardInterrupt
     return sink.dataset({**provenance(cfg), **executor.info(), "complete": "true"})
+
+
+def _resident_bytes() -> int:
+    """This process's resident memory now [B] (Python, the libraries, the kernels)."""
+    import psutil
+
+    return int(psutil.Process().memory_info().rss)
+
+
+def _packed_bytes(value, chunks) -> int:
+    """Bytes of ``value`` stored in ``chunks`` with the cube's shuffle and deflate."""
+    import itertools
+
+    from .storage.cube import _shuffle_deflate
+
+    chunks = tuple(min(c, n) for c, n in zip(chunks, value.shape))
+    starts = [range(0, n, c) for n, c in zip(value.shape, chunks)]
+    total = 0
+    for corner in itertools.product(*starts):
+        block = value[tuple(slice(i, i + c) for i, c in zip(corner, chunks))]
+        total += len(_shuffle_deflate(block, chunks))
+    return total
+
+
+#: Designs the dry run computes to measure the rate and the compression (at least one radius).
+_SAMPLE_DESIGNS = 20_000
+
+
+def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
+    """What a sweep of ``cfg`` will cost, measured on a small sample; writes nothing.
+
+    A few radii spread over the grid are computed with the kernel a local run uses (after
+    compiling it, which is not counted), and their arrays compressed as the cube is
+    (shuffle and deflate), so the rate and the compression ratio are this machine's and this
+    design space's.
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        The sweep's config.
+    workers : int, optional
+        Local threads (default: all cores).
+    notice : callable, optional
+        Receives a one-line notice while the kernels compile.
+
+    Returns
+    -------
+    dict
+        ``shape`` (axis -> size), ``designs``, ``slabs``, ``slab_bytes`` [B] (largest
+        slab in memory), ``memory_bytes`` [B] (this process now, plus two slabs and their
+        compressed copies, the most a local run holds), ``raw_bytes`` [B] (the cube uncompressed),
+        ``disk_bytes`` [B] (on disk, at the sample's compression ratio),
+        ``compression_ratio`` [-], ``sample_designs``, ``designs_per_second`` [1/s]
+        (compute), ``compress_seconds`` [s] and ``seconds`` [s] (estimated wall time,
+        compute plus compression; they partly overlap, so a bound), ``compile_seconds`` [s].
+    """
+    import time
+
+    import numpy as np
+
+    from .engine.grid import _bytes_per_radius, compute_slab, global_arrays, plan_slabs
+    from .engine.slabs import set_workers
+    from .engine.warmup import warm_up_grid
+    from .storage.cube import _chunks
+    from .variables import VARIABLES
+
+    set_workers(workers)
+    compiled = warm_up_grid(cfg, notice=notice)
+    slabs, radius_chunk = plan_slabs(cfg)
+    n_radius = cfg.shape[0]
+    per_radius = cfg.n_designs // n_radius
+    k = int(min(n_radius, max(4, -(-_SAMPLE_DESIGNS // per_radius))))
+    # up to four blocks of consecutive radii spread over the axis, each one kernel call
+    groups = 1 if k >= n_radius else min(4, k)
+    size = -(-k // groups)
+    starts = np.unique(np.linspace(0, n_radius - size, groups).round().astype(int))
+    sizes = {name: len(v) for name, v in (*cfg.axes.items(), *cfg.curves.items())}
+    compute = compress = 0.0
+    raw = packed = 0
+    for i in starts:
+        t0 = time.perf_counter()
+        arrays = compute_slab(cfg, int(i), int(i) + size)
+        compute += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        for name, value in arrays.items():
+            raw += value.nbytes
+            packed += _packed_bytes(value, _chunks(VARIABLES[name].dims, sizes,
+                                                   min(radius_chunk, size)))
+        compress += time.perf_counter() - t0
+    picks = range(len(starts) * size)
+    sample = len(picks) * per_radius
+    ratio = packed / raw if raw else 1.0
+    per_slab = max(i1 - i0 for i0, i1 in slabs) * _bytes_per_radius(cfg)
+    globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
+    axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
+    raw_total = n_radius * _bytes_per_radius(cfg) + globals_bytes + axes_bytes
+    rate = sample / compute if compute > 0 else float("inf")
+    compress_seconds = compress * cfg.n_designs / sample
+    return {
+        "shape": {name: len(v) for name, v in cfg.axes.items()},
+        "designs": cfg.n_designs,
+        "slabs": len(slabs),
+        "slab_bytes": per_slab,
+        "memory_bytes": int(_resident_bytes() + 2 * per_slab * (1 + ratio)),
+        "raw_bytes": int(raw_total),
+        "disk_bytes": int(raw_total * ratio),
+        "compression_ratio": ratio,
+        "sample_designs": int(sample),
+        "designs_per_second": rate,
+        "compress_seconds": compress_seconds,
+        "seconds": cfg.n_designs / rate + compress_seconds,
+        "compile_seconds": compiled,
+    }

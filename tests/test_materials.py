@@ -47,3 +47,25 @@ def test_override_field_by_field():
 def test_bad_material_names_the_field(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_silicone_stiffness_in_kpa_is_caught_as_a_unit_slip():
+    # the README's old table listed mu in kPa; a config or a call that copies 56.19, 10.49
+    # gives mu_0 = 22.9 Pa, a thousand times softer than any silicone
+    with pytest.raises(ValueError, match=r"silicone.mu: .* 22.88.. Pa is implausible .*"
+                                         r"accepted 100 Pa to 1e\+08 Pa.* look like kPa"):
+        silicone_parameters("tc5005", mu=[56.19, 10.49])
+    import nylonflex as nf
+    from conftest import EXAMPLE_2
+
+    with pytest.raises(ValueError, match=r"silicone.mu: .*look like kPa"):
+        nf.evaluate(**EXAMPLE_2, silicone={"set": "tc5005", "mu": [[56.19, 10.49]] * 2})
+    with pytest.raises(ValueError, match=r"silicone.mu: .*look like kPa"):
+        nf.design_limits(**EXAMPLE_2, silicone={"set": "tc5005", "mu": [56.19, 10.49]})
+
+
+def test_radius_in_mm_is_caught_as_a_unit_slip(example_2):
+    import nylonflex as nf
+
+    with pytest.raises(ValueError, match=r"radius: must be .* 7.5 looks like mm"):
+        nf.design_limits(**dict(example_2, radius=7.5))

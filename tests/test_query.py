@@ -89,7 +89,7 @@ def test_interpolated_radius_within_1_percent_of_design_limits(tmp_path):
                              "wrap_angle": {"values": [8], "units": "deg"}})
     ds = run_sweep(parse_config(fine), out=tmp_path / "fine.h5")
     at = dict(EXAMPLE_2, radius=7.8e-3)  # between the 7.5 and 8 mm grid radii
-    res = query.query_cube(ds, at=at)
+    res = query.query_cube(ds, at=at, interpolate=True)
     ds.close()
     assert res.point == "interpolated" and res.interpolated == ["radius"]
     exact = nf.design_limits(**at)
@@ -101,7 +101,7 @@ def test_interpolated_radius_within_1_percent_of_design_limits(tmp_path):
 def test_length_interpolation_is_exact(ds):
     # F* = M*/L and theta* = kappa L (docs/model.md s. 8): exact along L, whatever the spacing
     at = dict(EXAMPLE_1, length=77e-3)
-    res = query.query_cube(ds, at=at)
+    res = query.query_cube(ds, at=at, interpolate=True)
     exact = nf.design_limits(**at)
     for name in ("tip_force_max", "bend_angle_max", "torque_max"):
         assert res.data[name][0] == pytest.approx(exact[name], rel=1e-9), name
@@ -113,7 +113,7 @@ def test_limit_between_disagreeing_grid_points_is_unknown(ds):
     i = int(np.argmax(lim[1:] != lim[:-1]))  # last radius before the limit flips
     a = ds["radius"].values
     res = query.query_cube(ds, at=dict(EXAMPLE_2, wrap_angle=20 * DEG,
-                                       radius=0.5 * (a[i] + a[i + 1])))
+                                       radius=0.5 * (a[i] + a[i + 1])), interpolate=True)
     assert np.isnan(res.data["limit"][0])
     assert "boundary" in query.format_table(res) or "disagree" in query.format_table(res)
 
@@ -183,7 +183,7 @@ def test_smallest_designs_giving_half_a_newton(cube, capsys):
     lines = out.strip().splitlines()
     assert lines[0].split()[:2] == ["radius", "wall_thickness"] and "[mm]" in lines[1]
     rows = [line.split() for line in lines[2:7]]
-    assert len(rows) == 5 and lines[7].startswith("5 designs of")
+    assert len(rows) == 5 and lines[7].startswith("5 designs shown of")
     assert all(float(r[9]) >= 0.5 for r in rows)  # tip_force_max column [N]
     radii = [float(r[0]) for r in rows]
     assert radii == sorted(radii)
@@ -235,7 +235,10 @@ def test_slabs_give_the_same_answer(ds, monkeypatch):
         np.testing.assert_array_equal(whole.data[name], cut.data[name])
     assert whole.matched == cut.matched
     first = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], limit=2)
-    assert len(first) == 2 and first.matched is None  # stopped early, in grid order
+    assert len(first) == 2 and first.matched == whole.matched  # first two, all counted
+    every = query.query_cube(ds, where=["tip_force_max >= 0.3 N"])
+    for name in query.COLUMNS:  # the first two in grid order
+        np.testing.assert_array_equal(first.data[name], every.data[name][:2])
 
 
 # ---------------------------------------------------------------------------- formats
@@ -263,7 +266,7 @@ def test_csv_in_si(cube, capsys):
     rows = list(csv.reader(io.StringIO(out)))
     assert rc == 0 and rows[0][:3] == ["point", "radius [m]", "wall_thickness [m]"]
     assert len(rows) == 1 + 3 * 3
-    assert {r[0] for r in rows[1:]} == {"interpolated"}
+    assert {r[0] for r in rows[1:]} == {"exact model"}
     assert float(rows[1][1]) == pytest.approx(8.6e-3)
 
 
@@ -283,10 +286,83 @@ def test_incomplete_cube_is_queried_where_complete(cube, tmp_path, capsys):
     with h5py.File(part, "r+") as f:  # as a sweep stopped after the first 3 radii leaves it
         f.attrs["complete"] = "false"
         f["slab_done"][3:] = 0
-    rc, out, err = run(capsys, part, "--where", "tip_force_max >= 0 N")
+    rc, out, err = run(capsys, part, "--where", "tip_force_max >= 0 N", "--limit", "all")
     assert rc == 0 and "incomplete" in err and "warning" in err
     assert out.strip().splitlines()[-1] == f"{3 * 3 * 2 * 2 * 3} designs"
     rc, out, err = run(capsys, part, "--at", AT_2)  # radius 7.5 mm: computed
     assert rc == 0 and "0.150 N" in out
     rc, out, err = run(capsys, part, "--at", AT_2.replace("7.5mm", "20mm"))
     assert rc == 2 and "not in the cube yet" in err
+
+
+# ---------------------------------------------------------------------------- issue 15
+def test_at_between_grid_points_is_the_exact_model(ds, cube, capsys):
+    # wall 3 mm lies between the 2 and 4 mm grid walls: the answer is design_limits there,
+    # with the cube's materials (tc5005, silver_nylon66, b = t), not an interpolation
+    at = dict(EXAMPLE_2, wall_thickness=3e-3)
+    res = query.query_cube(ds, at=at)
+    exact = nf.design_limits(**at)
+    assert res.point == query.EXACT and res.interpolated == ["wall_thickness"]
+    for name in query.DESIGN:
+        assert res.data[name][0] == exact[name], name
+    linear = query.query_cube(ds, at=at, interpolate=True)
+    assert linear.point == query.INTERPOLATED
+    assert linear.data["bend_angle_max"][0] != pytest.approx(exact["bend_angle_max"],
+                                                           rel=1e-3)
+    rc, out, _ = run(capsys, cube, "--at", AT_2.replace("2mm", "3mm"))
+    assert rc == 0 and "exact model at this design" in out
+    rc, out, _ = run(capsys, cube, "--at", AT_2.replace("2mm", "3mm"), "--interpolate")
+    assert rc == 0 and "interpolated linearly in wall_thickness" in out
+
+
+def test_exact_model_uses_the_cubes_own_materials(tmp_path):
+    # a cube of another silicone and a fixed base: the exact answer must use them too
+    raw = dict(SMALL, name="other", silicone="ecoflex_00_30",
+               base_thickness={"value": 3, "units": "mm"},
+               grid=dict(SMALL["grid"], radius={"values": [7, 9], "units": "mm"}))
+    path = write_cube(tmp_path, raw)
+    with open_cube(path) as ds:
+        res = query.query_cube(ds, at=dict(EXAMPLE_2, radius=8e-3))
+    exact = nf.design_limits(**dict(EXAMPLE_2, radius=8e-3), base_thickness=3e-3,
+                             silicone="ecoflex_00_30")
+    assert res.data["tip_force_max"][0] == exact["tip_force_max"]
+    assert res.data["tip_force_max"][0] != nf.design_limits(
+        **dict(EXAMPLE_2, radius=8e-3))["tip_force_max"]
+
+
+def test_exact_slice_between_grid_points(ds):
+    # a partial --at off the grid: every free-axis grid value, each by the exact model
+    res = query.query_cube(ds, at={"radius": 8.6e-3, "coil_index": 1.7})
+    assert res.point == query.EXACT and len(res) == 3 * 2 * 3
+    i = 4
+    one = nf.design_limits(**{n: res.data[n][i] for n in query.AXES})
+    assert res.data["tip_force_max"][i] == one["tip_force_max"]
+
+
+def test_repeated_at_merges_or_refuses(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--at", "radius=7.5mm,wall_thickness=2mm",
+                     "--at", "length=70mm,coil_index=1.7,wrap_angle=8deg")
+    assert rc == 0 and "0.150 N" in out
+    rc, _, err = run(capsys, cube, "--at", "radius=7.5mm", "--at", "radius=10mm")
+    assert rc == 2 and "radius given twice" in err and "merged" in err
+
+
+def test_default_limit_holds_back_and_says_so(cube, capsys):
+    rc, out, _ = run(capsys, cube)
+    n = 9 * 3 * 2 * 2 * 3
+    lines = out.strip().splitlines()
+    assert rc == 0 and len(lines) == 2 + 20 + 1
+    assert f"20 designs shown of {n} matching; {n - 20} held back" in out
+    rc, out, _ = run(capsys, cube, "--limit", "all")
+    assert out.strip().splitlines()[-1] == f"{n} designs"
+    rc, out, err = run(capsys, cube, "--format", "csv")
+    assert len(out.strip().splitlines()) == 21 and f"{n - 20} held back" in err
+    with pytest.raises(SystemExit) as exit_:  # argparse: a usage error, exit 2
+        run(capsys, cube, "--limit", "lots")
+    assert exit_.value.code == 2 and "'all'" in capsys.readouterr().err
+
+
+def test_query_progress_callback(ds):
+    seen = []
+    query.query_cube(ds, progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1][0] == seen[-1][1]

@@ -29,6 +29,8 @@ COMMANDS = {
     "bench": "bench",
     "fit": "fit",
     "validate": "validate",
+    "init": "init",
+    "list": "listing",
 }
 
 

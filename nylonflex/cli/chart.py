@@ -13,23 +13,48 @@ def add_arguments(c):
 
     c.add_argument("cube")
     c.add_argument("--figure", nargs="+", metavar="NAME",
-                   help=f"figures (default: all): {', '.join(CHARTS)}")
+                   help=f"figures (default: all): {', '.join(CHARTS)} "
+                        "('nylonflex list charts' says what each shows)")
+    c.add_argument("--at", action="append", default=[], metavar="NAME=VALUE,...",
+                   help="the slice, grid values of radius, wall_thickness, length, wrap_angle "
+                        "(e.g. length=70mm,wrap_angle=8deg; bare numbers in mm, deg); each "
+                        "chart takes the ones it holds fixed")
+    c.add_argument("--coil-index", metavar="C,...",
+                   help="coil indices to draw (grid values, e.g. 1.1,1.7); default all")
     c.add_argument("--out", help="folder for the images (default: beside the cube)")
-    c.add_argument("--format", choices=["png", "pdf", "svg"], default="png")
+    c.add_argument("--format", choices=["png", "pdf", "svg"], default="png",
+                   help="image format: png, pdf or svg")
+    c.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _coil_indices(text):
+    from ..units import InputError
+
+    try:
+        return [float(x) for x in str(text).split(",") if x.strip()]
+    except ValueError:
+        raise InputError(f"--coil-index: expected numbers separated by commas, e.g. 1.1,1.7, "
+                         f"got {text!r}") from None
 
 
 def run(args) -> int:
     from ..charts import draw_charts
+    from ..query import parse_at
     from ..units import InputError
-    from ._common import open_cube_for
+    from ._common import open_cube_for, progress_bar
 
     ds = open_cube_for("chart", args.cube)
     out = Path(args.out) if args.out else Path(args.cube).parent
     if out.exists() and not out.is_dir():
         raise InputError(f"--out: {out} is a file; give a folder for the images")
     try:
+        at = parse_at(args.at) if args.at else None
+        coils = _coil_indices(args.coil_index) if args.coil_index else None
         skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
-        for path in draw_charts(ds, args.figure, out, args.format, on_skip=skip):
+        with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
+            paths = draw_charts(ds, args.figure, out, args.format, on_skip=skip, at=at,
+                                coil_index=coils, progress=bar)
+        for path in paths:
             print(path)
     finally:
         ds.close()

@@ -6,28 +6,66 @@ import sys
 
 HELP = "ask a cube about designs"
 
+#: Rows printed when ``--limit`` is not given.
+DEFAULT_LIMIT = 20
+
+
+def _limit(text):
+    import argparse
+
+    if str(text).strip().lower() in ("all", "none"):
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number or 'all', got {text!r}")
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be 0 or more, got {value}")
+    return value
+
 
 def add_arguments(q):
+    from ..query import COLUMNS
+    from ..variables import AXES
+
     q.add_argument("cube")
-    q.add_argument("--at", metavar="NAME=VALUE,...", help="one design, e.g. radius=7.5mm")
+    q.add_argument("--at", action="append", default=[], metavar="NAME=VALUE,...",
+                   help="one design or a slice, e.g. radius=7.5mm,wall_thickness=2mm; names: "
+                        f"{', '.join(AXES)}; bare numbers in mm, deg (none for coil_index); "
+                        "between grid points the exact model is evaluated; repeated --at "
+                        "options are merged (each axis once)")
+    q.add_argument("--interpolate", action="store_true",
+                   help="between grid points, interpolate the cube linearly instead of "
+                        "evaluating the exact model")
     q.add_argument("--where", action="append", default=[], metavar="EXPR",
-                   help='filter, e.g. "tip_force_max >= 0.5 N" (repeatable)')
-    q.add_argument("--sort", metavar="NAME", help="order by a variable or axis (- for desc)")
-    q.add_argument("--limit", type=int, help="at most N rows")
-    q.add_argument("--format", choices=["table", "json", "csv"], default="table")
+                   help='filter, e.g. "tip_force_max >= 0.5 N" (repeatable, ANDed); '
+                        "OP one of <, <=, ==, !=, >=, >")
+    q.add_argument("--sort", metavar="NAME",
+                   help=f"order by one of: {', '.join(COLUMNS)} (-NAME or NAME:desc for "
+                        "descending)")
+    q.add_argument("--limit", type=_limit, default=DEFAULT_LIMIT, metavar="N|all",
+                   help=f"at most N rows (default {DEFAULT_LIMIT}; 'all' for every one)")
+    q.add_argument("--format", choices=["table", "json", "csv"], default="table",
+                   help="table (display units), json or csv (SI)")
+    q.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args) -> int:
     import numpy as np
 
-    from ..query import format_csv, format_json, format_table, parse_at, parse_where, query_cube
+    from ..query import (format_csv, format_json, format_table, held_back, parse_at,
+                         parse_where, query_cube)
     from ..units import InputError
-    from ._common import open_cube_for
+    from ._common import open_cube_for, progress_bar
 
     ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
     try:
-        res = query_cube(ds, at=parse_at(args.at) if args.at else None,
-                         where=parse_where(args.where), sort=args.sort, limit=args.limit)
+        with progress_bar("query", unit="slab", quiet=args.quiet) as bar:
+            res = query_cube(ds, at=parse_at(args.at) if args.at else None,
+                             where=parse_where(args.where), sort=args.sort,
+                             limit=args.limit, interpolate=args.interpolate,
+                             progress=bar, log=lambda m: print(f"nylonflex query: {m}",
+                                                               file=sys.stderr))
         if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
             raise InputError("--at: this design is not in the cube yet (an incomplete "
                              "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
@@ -35,4 +73,8 @@ def run(args) -> int:
         ds.close()
     fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
     sys.stdout.write(fmt(res))
+    hidden = held_back(res)
+    if hidden and args.format != "table":  # the table says so itself
+        print(f"nylonflex query: {len(res)} rows of {res.matched} matching; {hidden} held "
+              "back (--limit N for more, --limit all for every one)", file=sys.stderr)
     return 0

@@ -9,7 +9,7 @@ HELP = "evaluate a design space into a cube"
 
 
 def add_arguments(s):
-    s.add_argument("config", help="YAML config (see configs/)")
+    s.add_argument("config", help="YAML config ('nylonflex init' writes examples to edit)")
     s.add_argument("--out", help="cube path (default sweeps/<name>/cube.h5)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a config key, e.g. grid.radius.num=81 (repeatable)")
@@ -19,6 +19,9 @@ def add_arguments(s):
                    help="run on a Dask distributed cluster, e.g. tcp://host:8786")
     s.add_argument("--no-charts", action="store_true", help="skip the config's charts")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--dry-run", action="store_true",
+                   help="print the grid size, the cube's size on disk, memory and an "
+                        "estimated time (measured on a small sample); write nothing")
 
 
 def _progress(total, quiet):
@@ -43,6 +46,9 @@ def run(args) -> int:
         if not args.quiet:
             print(msg, file=sys.stderr)
 
+    if args.dry_run:
+        return _dry_run(cfg, out, args, log)
+
     with _progress(cfg.n_designs, args.quiet) as bar:
         ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
                        scheduler=args.scheduler, progress=bar.update, log=log)
@@ -50,8 +56,52 @@ def run(args) -> int:
     if cfg.charts and not args.no_charts:
         from ..charts import draw_charts
 
+        from ._common import progress_bar
+
         skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
-        for path in draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip):
+        with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
+            paths = draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip,
+                                progress=bar)
+        for path in paths:
             print(path)
     ds.close()
+    return 0
+
+
+def _size(n) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if n < 1000 or unit == "TB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.3g} {unit}"
+        n /= 1000.0
+
+
+def _duration(seconds) -> str:
+    if seconds < 90:
+        return f"{seconds:.2g} s" if seconds < 10 else f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def _dry_run(cfg, out, args, log) -> int:
+    from ..sweep import estimate
+
+    if args.scheduler:
+        log("dry run: the time is estimated for this machine's threads, not the cluster")
+    e = estimate(cfg, workers=args.workers, notice=log)
+    shape = " x ".join(f"{n} {name}" for name, n in e["shape"].items())
+    print(f"dry run of {args.config} (nothing written)")
+    print(f"  grid        {e['designs']:,} designs = {shape}")
+    print(f"  cube        {out}: about {_size(e['disk_bytes'])} on disk "
+          f"({_size(e['raw_bytes'])} uncompressed, compressed to "
+          f"{100 * e['compression_ratio']:.0f} % as a sample was); the journal holds "
+          "about as much again while it runs")
+    print(f"  memory      about {_size(e['memory_bytes'])} ({e['slabs']} slab"
+          f"{'s' if e['slabs'] != 1 else ''} of up to {_size(e['slab_bytes'])}, two at once, "
+          "plus Python and the kernels)")
+    print(f"  time        about {_duration(e['seconds'])} here "
+          f"({e['designs_per_second']:,.0f} designs/s measured on {e['sample_designs']:,} "
+          f"designs, plus compression{'; charts extra' if cfg.charts else ''})")
+    if out.exists():
+        print(f"  note        {out} exists: a sweep would refuse it (or --resume it)")
     return 0

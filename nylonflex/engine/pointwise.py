@@ -16,7 +16,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
-                         nylon_parameters, silicone_parameters)
+                         check_shear_modulus, nylon_parameters, silicone_parameters)
 from ..physics._formula import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
@@ -189,10 +189,7 @@ def _silicone_arrays(silicone):
                          f"last axis, got shapes {mu.shape} and {alpha.shape}")
     if np.any(alpha == 0):
         raise ValueError("silicone.alpha: must be finite and non-zero")
-    mu0 = 0.5 * np.sum(mu * alpha, axis=-1)
-    if np.any(~(mu0 > 0)):
-        raise ValueError(f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i = "
-                         f"{mu0[~(mu0 > 0)].flat[0]:g} Pa; must be > 0")
+    check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1))
     return mu, alpha
 
 

@@ -8,7 +8,7 @@ from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
 
-__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "provenance"]
+__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "evaluate_settings", "provenance"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
 CUBE_FORMAT = "1"
@@ -57,3 +57,69 @@ def provenance(cfg: ResolvedConfig) -> dict:
                  "nylon artificial muscles' and Polygerinos et al. 2015",
         "complete": "false",
     }
+
+
+def evaluate_settings(attrs) -> dict:
+    """Keyword arguments of :func:`nylonflex.evaluate` that reproduce a cube's designs.
+
+    Rebuilds the silicone and nylon sets, the base thickness and the model (and the supply,
+    when the cube's config names one) from the cube's ``config_yaml`` attribute, the
+    resolved config in SI that :func:`provenance` stores.
+
+    Parameters
+    ----------
+    attrs : mapping
+        Global attributes of a cube (``ds.attrs`` or
+        :func:`nylonflex.storage.cube_attrs`).
+
+    Returns
+    -------
+    dict
+        ``silicone`` (:class:`~nylonflex.materials.Silicone`), ``nylon``
+        (:class:`~nylonflex.materials.Nylon`), ``base_thickness`` [m] or None, and
+        ``model`` (and ``supply_voltage`` [V] when the cube has a supply).
+
+    Raises
+    ------
+    ValueError
+        The attributes hold no readable ``config_yaml`` (not a nylonflex cube).
+    """
+    import dataclasses
+
+    import yaml
+
+    from ..materials import Nylon, Silicone
+
+    text = attrs.get("config_yaml") if attrs is not None else None
+    try:
+        doc = yaml.safe_load(text) if text else None
+    except yaml.YAMLError:
+        doc = None
+    if not isinstance(doc, dict) or "silicone" not in doc or "nylon" not in doc:
+        raise ValueError("cube: no readable config_yaml attribute; cannot rebuild its "
+                         "materials (was it written by 'nylonflex sweep'?)")
+
+    def rebuild(cls, values):
+        known = {f.name for f in dataclasses.fields(cls)} - {"description", "sources"}
+        kw = {k: tuple(float(x) for x in v) if isinstance(v, list) else v
+              for k, v in values.items() if k in known}
+        return cls(**kw)
+
+    base = doc.get("base_thickness", "wall")
+    out = {"silicone": rebuild(Silicone, doc["silicone"]),
+           "nylon": rebuild(Nylon, doc["nylon"]),
+           "base_thickness": None if base in (None, "wall") else float(base),
+           "model": "paper"}
+    model = doc.get("model")
+    if isinstance(model, str):
+        out["model"] = model
+    elif isinstance(model, list) and len(model) == 1:
+        out["model"] = str(model[0])
+    elif model is not None:  # several models: the caller picks one
+        out["model"] = [str(m) for m in model]
+    supply = doc.get("supply")
+    if isinstance(supply, dict) and supply.get("voltage") is not None:
+        out["supply_voltage"] = float(supply["voltage"])
+    elif isinstance(supply, (int, float)):
+        out["supply_voltage"] = float(supply)
+    return out

@@ -1,0 +1,76 @@
+"""``nylonflex list materials|charts|variables``: what a config, a chart or a query can name."""
+
+from __future__ import annotations
+
+import sys
+
+HELP = "list the material sets, charts or cube variables (with units)"
+
+TOPICS = ("materials", "charts", "variables")
+
+
+def add_arguments(p):
+    p.add_argument("topic", choices=TOPICS, help=f"one of: {', '.join(TOPICS)}")
+
+
+def _first_line(doc) -> str:
+    return (doc or "").strip().splitlines()[0].rstrip(".") if doc else ""
+
+
+def _materials(out):
+    from ..materials import (FIELD_UNITS, NYLON_PARAMETERS, SILICONE_PARAMETERS,
+                             nylon_parameters, silicone_parameters)
+
+    def show(value):
+        if isinstance(value, (tuple, list)):
+            return ", ".join(f"{x:g}" for x in value)
+        return f"{value:g}"
+
+    for kind, table, build in (("silicone", SILICONE_PARAMETERS, silicone_parameters),
+                               ("nylon", NYLON_PARAMETERS, nylon_parameters)):
+        print(f"{kind} sets (config key '{kind}:'; override a field with "
+              f"{{set: NAME, FIELD: VALUE}} in the unit shown):", file=out)
+        for name in table:
+            m = build(name)
+            extra = f", initial shear modulus {m.initial_shear_modulus:.4g} Pa" \
+                if kind == "silicone" else ""
+            print(f"  {name}: {m.description}{extra}", file=out)
+            for field, value in m.to_dict().items():
+                if field == "name":
+                    continue
+                unit = FIELD_UNITS.get(field, "1")
+                unit = "" if unit == "1" else f" [{unit}]"
+                source = m.sources.get(field, "")
+                print(f"    {field + unit:<34} {show(value):<28} {source}", file=out)
+        print(file=out)
+
+
+def _charts(out):
+    from ..charts import CHARTS, NEEDS
+
+    print("charts (config 'charts:' list, 'nylonflex chart CUBE --figure NAME'):", file=out)
+    for name, func in CHARTS.items():
+        print(f"  {name:<11} {_first_line(func.__doc__)} (needs 2+ values of "
+              f"{' and '.join(NEEDS[name])})", file=out)
+
+
+def _variables(out):
+    from ..variables import COORDS, CURVES, DESIGN, INPUTS
+
+    for title, table in (("axes and curve coordinates", COORDS), ("design variables "
+                         "(query --where/--sort)", DESIGN), ("curves", CURVES),
+                         ("other inputs", INPUTS)):
+        print(f"{title}:", file=out)
+        for v in table.values():
+            units = f"[{v.units}]" + (f", shown in {v.display}" if v.display != v.units
+                                      else "")
+            print(f"  {v.name:<18} {units:<22} {v.long_name}: {v.description}", file=out)
+            if v.dims and tuple(v.dims) != (v.name,):
+                print(f"  {'':<18} {'':<22} over ({', '.join(v.dims)})", file=out)
+        print(file=out)
+
+
+def run(args) -> int:
+    {"materials": _materials, "charts": _charts, "variables": _variables}[args.topic](
+        sys.stdout)
+    return 0
