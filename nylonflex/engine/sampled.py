@@ -23,7 +23,7 @@ from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
 from .pointwise import evaluate
 
 __all__ = ["FLOAT_NAMES", "perturbed_inputs", "sample_statistics", "slab_statistics",
-           "standard_samples", "uncertain_variables"]
+           "standard_from_unit", "standard_samples", "uncertain_variables"]
 
 #: The design variables that get quantiles (``limit`` is a flag: no quantiles).
 FLOAT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
@@ -50,7 +50,7 @@ def standard_samples(spec: UncertaintySpec, samples: int | None = None) -> np.nd
     Scrambled Sobol' points seeded by ``spec.seed``, through the normal quantile function
     (normal parameters) or scaled to a uniform of unit variance on +-sqrt(3) (uniform).
     """
-    from scipy.stats import norm, qmc
+    from scipy.stats import qmc
 
     n = spec.samples if samples is None else samples
     dims = sum(p.dims for p in spec.parameters)
@@ -61,6 +61,15 @@ def standard_samples(spec: UncertaintySpec, samples: int | None = None) -> np.nd
     with warnings.catch_warnings():  # a sample count not a power of 2: still a valid QMC set
         warnings.simplefilter("ignore", UserWarning)
         u = qmc.Sobol(dims, scramble=True, seed=spec.seed).random(n)
+    return standard_from_unit(spec, u)
+
+
+def standard_from_unit(spec: UncertaintySpec, u) -> np.ndarray:
+    """Points of the unit cube, shape (n, dims), as standard variables (see
+    :func:`standard_samples`); the cube's faces are nudged inside (a normal's 0 and 1)."""
+    from scipy.stats import norm
+
+    u = np.clip(np.asarray(u, float), 1e-12, 1.0 - 1e-12)
     z = np.empty_like(u)
     j = 0
     for p in spec.parameters:
