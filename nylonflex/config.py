@@ -29,7 +29,8 @@ __all__ = ["CHARTS", "SweepConfig", "apply_overrides", "check_range", "load_conf
            "parse_config", "range_error"]
 
 #: Figures a sweep config may name under ``charts``.
-CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map")
+CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
+          "feasibility_map")
 
 Number = Union[float, str]
 
