@@ -29,6 +29,7 @@ COMMANDS = {
     "bench": "bench",
     "fit": "fit",
     "validate": "validate",
+    "sensitivity": "sensitivity",
 }
 
 
