@@ -135,8 +135,8 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
             for k, name in enumerate(p.fields):
                 field, _, idx = name.rpartition("_")
                 if field in table and idx.isdigit():
-                    col = np.broadcast_to(np.asarray(table[field], float), (S, len(
-                        np.atleast_1d(table[field])))).copy()
+                    arr = np.atleast_1d(np.asarray(table[field], float))
+                    col = np.broadcast_to(arr, (S, arr.shape[-1])).copy()
                     col[:, int(idx) - 1] += delta[:, k]
                     table[field] = col
                 else:
