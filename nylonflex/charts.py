@@ -778,7 +778,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
     ds : xarray.Dataset
         A nylonflex cube (:func:`nylonflex.open_cube`).
     names : sequence of str or None
-        Chart names (:data:`CHARTS`); None draws them all.
+        Chart names (:data:`CHARTS`); None draws all the cube can show.
     out_dir : path
         Folder for the images (created if missing).
     fmt : {"png", "pdf", "svg"}
@@ -797,7 +797,9 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None) -> list[Path]:
     InputError
         An unknown chart name or format.
     """
-    names = list(CHARTS) if not names else list(names)
+    if not names:  # every chart the cube can show (feasibility only with requirements)
+        names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
+    names = list(names)
     unknown = [n for n in names if n not in CHARTS]
     if unknown:
         raise InputError(f"--figure: unknown chart {unknown[0]!r}; accepted: "

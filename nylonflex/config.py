@@ -544,7 +544,9 @@ def _uncertainty(unc: Uncertainty, silicone, nylon, raw) -> UncertaintySpec:
         raise InputError(f"uncertainty.quantiles: must be increasing probabilities in (0, 1), "
                          f"got {unc.quantiles}")
     params = []
-    for name, dist in unc.parameters.items():
+    # sorted by name: the Sobol' column of each parameter, like the config hash (sorted
+    # YAML), must not depend on the order the keys were written in
+    for name, dist in sorted(unc.parameters.items()):
         path = f"uncertainty.parameters.{name}"
         kind, _, fld = name.partition(".")
         if dist.from_fit:

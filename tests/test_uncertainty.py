@@ -174,6 +174,9 @@ def test_config_hash_follows_the_uncertainty_section():
     assert "uncertainty" not in plain.text and "requirements" not in plain.text
     a, b = config(THREE), config({**THREE, "seed": 4})
     assert len({plain.sha256, a.sha256, b.sha256}) == 3
+    # the order the parameters are written in changes neither the hash nor the samples
+    shuffled = config({**THREE, "parameters": dict(reversed(THREE["parameters"].items()))})
+    assert shuffled.sha256 == a.sha256 and shuffled.uncertainty == a.uncertainty
 
 
 def test_query_where_feasibility(sampled_cube, capsys):
@@ -202,6 +205,19 @@ def test_charts_feasibility_map_and_bands(sampled_cube, tmp_path):
     ds.close()
     assert [f.name for f in files] == ["feasibility_map.png", "fig12b.png", "fig12c.png"]
     assert all(f.stat().st_size > 10_000 for f in files)
+    import matplotlib.pyplot as plt
+
+    from nylonflex.charts import feasibility_map
+
+    ds = nf.open_cube(path)
+    fig = feasibility_map(ds)
+    labels = " ".join(ax.get_xlabel() + " " + ax.get_ylabel() for ax in fig.axes)
+    assert "chamber radius [mm]" in labels and "wall thickness [mm]" in labels
+    assert "probability of meeting the requirements" in labels
+    title = fig._suptitle.get_text()
+    assert "tip_force_max >= 0.3 N" in title and "64 samples" in title and "L = 90 mm" in title
+    plt.close(fig)
+    ds.close()
 
 
 # ---------------------------------------------------------------------------- config errors
@@ -291,3 +307,37 @@ def test_sensitivity_refusals(tmp_path, capsys):
     unc.write_text(yaml.safe_dump({**SMALL, "uncertainty": THREE}))
     assert main(["sensitivity", str(unc), "--output", "limit"]) == 2
     assert "--output: unknown limit" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- slab loop
+@pytest.mark.slow
+def test_sampled_sweep_on_dask_and_resumed_equals_local(tmp_path):
+    # the sampled variables go through the one slab loop: a Dask run (serial evaluator in
+    # the workers) and a run resumed from a journal give the local cube's values
+    import signal
+
+    import yaml
+    from killing import kill_after_slabs
+
+    distributed = pytest.importorskip("distributed")
+    raw = {**copy.deepcopy(SMALL), "uncertainty": THREE,
+           "requirements": ["tip_force_max >= 0.3 N"], "slab_megabytes": 1.0}
+    raw["grid"]["radius"]["num"] = 40
+    cfg = parse_config(raw)
+    want = nf.run_sweep(cfg)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address="127.0.0.1:0") as c:
+        got = nf.run_sweep(cfg, tmp_path / "dask.h5", scheduler=c.scheduler_address)
+    path = tmp_path / "uq.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    out = tmp_path / "resumed.h5"
+    argv = ["sweep", str(path), "--out", str(out), "--no-charts", "--quiet"]
+    assert kill_after_slabs(argv, 1, signal.SIGTERM) != 0  # stopped after its first slab
+    assert main([*argv, "--resume"]) == 0
+    resumed = nf.open_cube(out)
+    assert resumed.attrs["resumed_slabs"] != "0"
+    for which, ds in (("dask", got), ("resumed", resumed)):
+        for name in ("tip_force_max_quantile", "feasibility", "tip_force_max"):
+            np.testing.assert_allclose(ds[name].values, want[name].values, rtol=1e-12,
+                                       err_msg=f"{which} {name}")
+    resumed.close()

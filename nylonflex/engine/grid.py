@@ -107,7 +107,7 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -
     if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
         from .sampled import slab_statistics
 
-        arrays.update(slab_statistics(cfg, i0, i1, arrays))
+        arrays.update(slab_statistics(cfg, i0, i1, arrays, parallel=parallel))
     return arrays
 
 

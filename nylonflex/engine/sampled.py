@@ -204,12 +204,19 @@ def sample_statistics(out: dict, quantiles, requirements=()) -> dict:
     return stats
 
 
-def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict) -> dict:
+def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
+                    parallel: bool = True) -> dict:
     """The sampled variables of the radii [i0, i1): quantiles and feasibility.
 
     ``nominal`` is the slab's plain result (grid kernel); without ``uncertainty`` the
-    feasibility is that of the nominal designs (0 or 1).
+    feasibility is that of the nominal designs (0 or 1). ``parallel=False`` (Dask workers)
+    runs the evaluator on one Numba thread: one level of parallelism.
     """
+    if not parallel:
+        from .pointwise import serial
+
+        with serial():
+            return slab_statistics(cfg, i0, i1, nominal, parallel=True)
     reqs = parse_requirements(list(cfg.requirements))
     if cfg.uncertainty is None:
         ok = np.ones(nominal[FLOAT_NAMES[0]].shape, dtype=bool)
