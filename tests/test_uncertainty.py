@@ -201,9 +201,9 @@ def test_charts_feasibility_map_and_bands(sampled_cube, tmp_path):
 
     path, _ = sampled_cube
     ds = nf.open_cube(path)
-    files = draw_charts(ds, ["feasibility_map", "fig12b", "fig12c"], tmp_path)
+    files = draw_charts(ds, ["feasibility_map", "fig12b"], tmp_path)
     ds.close()
-    assert [f.name for f in files] == ["feasibility_map.png", "fig12b.png", "fig12c.png"]
+    assert [f.name for f in files] == ["feasibility_map.png", "fig12b.png"]
     assert all(f.stat().st_size > 10_000 for f in files)
     import matplotlib.pyplot as plt
 
