@@ -11,16 +11,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import EXAMPLE_1, EXAMPLE_2
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import nylonflex as nf
 from nylonflex.cli import main
 from nylonflex.config import parse_config
-from nylonflex.units import InputError
 from nylonflex.uncertainty import propagate, sobol_indices, standard_samples
-
-from conftest import EXAMPLE_1, EXAMPLE_2
+from nylonflex.units import InputError
 
 REPO = Path(__file__).resolve().parents[1]
 

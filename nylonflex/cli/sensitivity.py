@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 HELP = "Sobol' sensitivity of design variables to the uncertain parameters"
@@ -34,8 +35,8 @@ def run(args) -> int:
 
     from ..config import load_config
     from ..query import parse_at
-    from ..units import InputError
     from ..uncertainty import sobol_indices
+    from ..units import InputError
     from ..variables import AXES
 
     cfg = load_config(args.config, args.set)
@@ -59,11 +60,12 @@ def run(args) -> int:
     width = max(len(p) for p in res.parameters)
     for o, d in res.indices.items():
         print(f"{o}:")
-        if all(v != v for v in d["first"].values()):  # NaN: the output never varied
+        if all(math.isnan(v) for v in d["first"].values()):  # the output never varied
             print("  does not vary over the samples here: no indices")
             continue
         print(f"  {'parameter':<{width}}  {'first':>15}  {'total':>15}")
         for p in res.parameters:
-            cell = lambda k: f"{d[k][p]:.3f} +- {d[k + '_conf'][p]:.3f}"  # noqa: E731
-            print(f"  {p:<{width}}  {cell('first'):>15}  {cell('total'):>15}")
+            first, total = (f"{d[k][p]:.3f} +- {d[k + '_conf'][p]:.3f}"
+                            for k in ("first", "total"))
+            print(f"  {p:<{width}}  {first:>15}  {total:>15}")
     return 0

@@ -195,7 +195,7 @@ def sample_statistics(out: dict, quantiles, requirements=()) -> dict:
     q = np.asarray(quantiles, float)
     stats = {quantile_name(n): np.moveaxis(np.quantile(out[n], q, axis=-1), 0, -1)
              for n in FLOAT_NAMES}
-    reqs = parse_requirements(list(r if isinstance(r, str) else r.text for r in requirements))
+    reqs = parse_requirements([r if isinstance(r, str) else r.text for r in requirements])
     if reqs:
         ok = np.ones(out[FLOAT_NAMES[0]].shape, dtype=bool)
         for r in reqs:

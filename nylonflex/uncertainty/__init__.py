@@ -9,8 +9,12 @@ variables.
 
 from __future__ import annotations
 
-from ..engine.sampled import (perturbed_inputs, sample_statistics, standard_samples,
-                              uncertain_variables)
+from ..engine.sampled import (
+                              perturbed_inputs,
+                              sample_statistics,
+                              standard_samples,
+                              uncertain_variables,
+)
 from .propagate import propagate
 from .sensitivity import SensitivityResult, sobol_indices
 

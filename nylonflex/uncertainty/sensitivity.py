@@ -43,7 +43,7 @@ class SensitivityResult:
     def to_json(self) -> dict:
         """INTERFACE.md's document: ``{"outputs": {NAME: {"first": {PARAM: value}, ...}}}``
         plus what was computed (``parameters``, ``designs``, ``samples``, ``at`` SI)."""
-        clean = lambda x: None if not np.isfinite(x) else float(x)  # noqa: E731
+        clean = lambda x: None if not np.isfinite(x) else float(x)
         return {"outputs": {o: {k: {p: clean(v) for p, v in d[k].items()} for k in _KEYS}
                             for o, d in self.indices.items()},
                 "parameters": list(self.parameters), "designs": self.designs,
