@@ -41,6 +41,44 @@ def bench_config(sizes: dict):
     })
 
 
+#: The sampled sweep of issue 12: the fig12 grid (41 x 6 x 3 x 4 x 4 = 11,808 designs) x
+#: 256 samples, about 3 million evaluations; quick: the quick grid x 16 samples.
+SAMPLED_FULL = {"grid": {"radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"},
+                         "wall_thickness": {"values": [1, 2, 3, 4, 5, 6], "units": "mm"},
+                         "length": {"values": [70, 90, 120], "units": "mm"},
+                         "coil_index": {"values": [1.1, 1.3, 1.5, 1.7]},
+                         "wrap_angle": {"values": [5, 8, 12, 20], "units": "deg"}},
+                "samples": 256}
+
+
+def sampled_config(quick: bool = False):
+    """The sampled-sweep benchmark: wall sd 0.1 mm, silicone mu and stroke 10 %/5 %."""
+    sizes = QUICK
+    grid = bench_config(sizes).raw["grid"] if quick else SAMPLED_FULL["grid"]
+    return parse_config({
+        "name": "bench_sampled", "grid": grid,
+        "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 11},
+                   "pressure": {"start": 0, "stop": 25, "num": 11, "units": "kPa"}},
+        "uncertainty": {"samples": 16 if quick else SAMPLED_FULL["samples"], "seed": 0,
+                        "parameters": {"wall_thickness": {"sd": 0.1, "units": "mm"},
+                                       "silicone.mu": {"rel_sd": 0.1},
+                                       "nylon.stroke_max": {"rel_sd": 0.05}}},
+        "requirements": ["tip_force_max >= 0.5 N", "range_fraction >= 1"],
+    })
+
+
+def _sampled_seconds(quick: bool) -> tuple[float, int]:
+    """Seconds of a sampled sweep in memory, and its evaluations (designs x samples)."""
+    from .sweep import run_sweep
+
+    cfg = sampled_config(quick)
+    t0 = time.perf_counter()
+    ds = run_sweep(cfg)
+    seconds = time.perf_counter() - t0
+    ds.close()
+    return seconds, cfg.n_designs * cfg.uncertainty.samples
+
+
 def _reference_design(cfg, a, t, c, psi):
     """One design's s*, kappa(s_max) and kappa* by scipy quadrature and brentq."""
     from . import reference as ref
@@ -165,6 +203,8 @@ def run_bench(quick: bool = False, log=None) -> dict:
     sim_duration = 60.0 if quick else 3600.0
     t_loop, t_sim = _closed_loop_seconds(sim_duration)
 
+    t_sampled, n_sampled = _sampled_seconds(quick)
+
     per_design = t_total / cfg.n_designs
     result = {
         "designs": cfg.n_designs,
@@ -185,6 +225,9 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "closed_loop_run_s": t_sim,
         "peak_rss_mb": peak_mb,
         "cube_mb": size_mb,
+        "sampled_s": t_sampled,
+        "sampled_evaluations": n_sampled,
+        "sampled_evaluations_per_s": n_sampled / t_sampled,
     }
     say(f"  kernels only               {t_kernel:8.2f} s  {result['kernel_designs_per_s']:>12,.0f}"
         f" designs/s  {result['angle_solves_per_s']:>10,.0f} angle solves/s")
@@ -201,5 +244,8 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f"reference, {result['pointwise_vs_python_loop']:,.0f} x the python loop (same run)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
+    say(f"  sampled sweep (uncertainty) {t_sampled:7.2f} s  "
+        f"{result['sampled_evaluations_per_s']:>12,.0f} evaluations/s ({n_sampled:,} = "
+        f"designs x samples{', quick grid x 16' if quick else ', fig12 grid x 256'})")
     say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")
     return result

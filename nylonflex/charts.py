@@ -22,9 +22,10 @@ import numpy as np
 
 from .config import CHARTS as _CHART_NAMES
 from .units import InputError
-from .variables import VARIABLES, display_label, to_display
+from .variables import VARIABLES, display_label, quantile_name, to_display
 
-__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "design_map", "draw_charts", "fig4", "fig6",
+__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "design_map", "draw_charts",
+           "feasibility_map", "fig4", "fig6",
            "fig7", "fig12a", "fig12b", "fig12c"]
 
 #: Image formats a chart can be written in.
@@ -477,6 +478,8 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     for ax, t in zip(axes[0], walls):
         _limit_lines(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
                      coils, psis)
+        _quantile_bands(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
+                        coils)
         _examples(ax, ds, "torque_max", t, coils=coils)
         ax.set_title(f"wall thickness {_eq('wall_thickness', t)}")
         ax.set_ylabel(_label("torque_max"))
@@ -526,6 +529,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
         sel = {"wall_thickness": t, "length": length}
         top, bottom = axes[0][col], axes[1][col]
         _limit_lines(top, ds, "bend_angle_max", sel, coils, psis)
+        _quantile_bands(top, ds, "bend_angle_max", sel, coils, psi, note_at=(0.02, 0.98))
         _examples(top, ds, "bend_angle_max", t, length, corner="lower right", coils=coils)
         top.set_title(f"wall thickness {_eq('wall_thickness', t)}")
         top.set_xlabel("")
@@ -785,20 +789,119 @@ def _nice_levels(top):
     return np.arange(0, top + step, step)
 
 
+# ---------------------------------------------------------------------------- uncertainty
+def _band_levels(ds):
+    """Indices of the outermost quantiles (5 and 95 % by default) of a sampled cube."""
+    q = ds["quantile"].values
+    return int(np.argmin(q)), int(np.argmax(q)), q
+
+
+def _quantile_bands(ax, ds, var, sel, coils, wrap_angle=None, note_at=(0.99, 0.01)):
+    """Shade each coil index's band between the cube's lowest and highest quantile of
+    ``var`` (a cube with ``uncertainty``; nothing otherwise), at ``wrap_angle`` (default
+    nearest 8 deg)."""
+    qname = quantile_name(var)
+    if qname not in ds or "quantile" not in ds.coords:
+        return
+    lo, hi, q = _band_levels(ds)
+    psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
+    x = to_display("radius", ds["radius"].values)
+    for k, c in enumerate(coils):
+        cut = ds[qname].sel(coil_index=c, wrap_angle=psi, **sel).transpose("quantile",
+                                                                           "radius").values
+        ax.fill_between(x, to_display(var, cut[lo]), to_display(var, cut[hi]),
+                        color=_COLOURS[k % len(_COLOURS)], alpha=0.18, lw=0, zorder=2)
+    ax.text(*note_at, f"bands: {100 * q[lo]:g}-{100 * q[hi]:g} % at "
+            f"{_eq('wrap_angle', psi)}", transform=ax.transAxes,
+            ha="right" if note_at[0] > 0.5 else "left",
+            va="bottom" if note_at[1] < 0.5 else "top", fontsize=7.5, color="0.3", zorder=8,
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+
+
+def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
+    """Probability that every requirement holds, over radius and wall thickness.
+
+    Filled contours of ``feasibility`` with lines at 50 % and 90 %, one panel per coil
+    index, at one length and wrap angle (a cube swept with ``requirements``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube with ``feasibility``.
+    length : float, optional
+        Actuator length [m]; default nearest 90 mm.
+    wrap_angle : float, optional
+        Wrap angle [rad]; default nearest 8 deg.
+    coil_index : float or sequence of float, optional
+        Coil index of each panel [-]; default every coil index of the cube (up to four).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if "feasibility" not in ds:
+        raise InputError("feasibility_map: the cube has no 'feasibility'; sweep a config "
+                         "with 'requirements'")
+    length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
+    psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
+    coils = _pick_few(ds, "coil_index", 4) if coil_index is None else \
+        [_nearest(ds, "coil_index", c) for c in np.atleast_1d(coil_index)]
+    ncols = 1 if len(coils) == 1 else 2
+    nrows = math.ceil(len(coils) / ncols)
+    fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
+                        sharex=True, sharey=True)
+    cut = ds["feasibility"].sel(length=length, wrap_angle=psi)
+    x = to_display("radius", ds["radius"].values)
+    y = to_display("wall_thickness", ds["wall_thickness"].values)
+    levels = np.linspace(0.0, 1.0, 11)
+    mappable = None
+    for i, ax in enumerate(axes.flat):
+        if i >= len(coils):
+            ax.set_visible(False)
+            continue
+        c = coils[i]
+        p = cut.sel(coil_index=c).transpose("wall_thickness", "radius").values
+        mappable = ax.contourf(x, y, p, levels=levels, cmap="RdYlGn", vmin=0, vmax=1)
+        if np.nanmax(p) > 0.5 > np.nanmin(p) or np.nanmax(p) > 0.9 > np.nanmin(p):
+            lines = ax.contour(x, y, p, levels=[0.5, 0.9], colors="k",
+                               linewidths=[0.9, 1.6], linestyles=["--", "-"])
+            ax.clabel(lines, fmt=lambda v: f"{100 * v:.0f} %", fontsize=7.5)
+        ax.set_title(_eq("coil_index", c))
+        ax.grid(False)
+        if i % ncols == 0:
+            ax.set_ylabel(_label("wall_thickness"))
+        if i >= len(coils) - ncols:
+            ax.set_xlabel(_label("radius"))
+    fig.colorbar(mappable, ax=axes, label=_label("feasibility"), shrink=0.9,
+                 ticks=np.linspace(0, 1, 6))
+    reqs = ds.attrs.get("requirements", "?")
+    samples = ds.attrs.get("uncertainty_samples")
+    how = f"{samples} samples" if samples else "nominal designs (no uncertainty)"
+    _suptitle(fig, "Feasibility: probability that every requirement holds",
+              f"{reqs}; {how}\nslice {_eq('length', length)}, {_eq('wrap_angle', psi)}; "
+              "lines at 50 % (dashed) and 90 %")
+    _footer(fig, ds)
+    return fig
+
+
 # ---------------------------------------------------------------------------- drivers
 #: Chart name -> function, the names a config's ``charts`` list accepts.
 CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
-          "fig6": fig6, "fig7": fig7, "design_map": design_map}
+          "fig6": fig6, "fig7": fig7, "design_map": design_map,
+          "feasibility_map": feasibility_map}
 assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 
 
 #: Axes each chart draws along: a cube with a single value there cannot show it.
 NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
          "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
-         "design_map": ("radius", "wall_thickness")}
+         "design_map": ("radius", "wall_thickness"),
+         "feasibility_map": ("radius", "wall_thickness")}
 
 
 def _unmet(ds, name):
+    if name == "feasibility_map" and "feasibility" not in ds:
+        return "feasibility_map skipped: the cube has no feasibility (no 'requirements')"
     short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
     return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
             "has 1") if short else None
@@ -876,7 +979,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     ds : xarray.Dataset
         A nylonflex cube (:func:`nylonflex.open_cube`).
     names : sequence of str or None
-        Chart names (:data:`CHARTS`); None draws them all.
+        Chart names (:data:`CHARTS`); None draws all the cube can show.
     out_dir : path
         Folder for the images (created if missing).
     fmt : {"png", "pdf", "svg"}
@@ -902,7 +1005,9 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     InputError
         An unknown chart name or format.
     """
-    names = list(CHARTS) if not names else list(names)
+    if not names:  # every chart the cube can show (feasibility only with requirements)
+        names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
+    names = list(names)
     unknown = [n for n in names if n not in CHARTS]
     if unknown:
         raise InputError(f"--figure: unknown chart {unknown[0]!r}; accepted: "

@@ -38,7 +38,9 @@ __all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
-_FIELDS = ", ".join(COLUMNS)
+#: Columns a cube has only when its sweep asked for them (``requirements``).
+OPTIONAL = ("feasibility",)
+_FIELDS = ", ".join(COLUMNS + OPTIONAL)
 # Values this close (relative to the axis span) to a grid value are that grid value.
 _GRID_RTOL = 1e-6
 # Slab size when scanning a cube: about this many float64 values per variable.
@@ -103,7 +105,7 @@ class Condition:
             raise InputError(f"--where: expected 'NAME OP VALUE [UNIT]' with OP one of "
                              f"<, <=, ==, !=, >=, >, got {text!r}")
         self.name, op, value = m.groups()
-        if self.name not in COLUMNS:
+        if self.name not in COLUMNS + OPTIONAL:
             raise InputError(f"--where: unknown name {self.name!r}; accepted: {_FIELDS}")
         self.op = "==" if op == "=" else op
         self.value = float(_quantity(self.name, value, f"--where {self.name}"))
@@ -138,7 +140,7 @@ def _parse_sort(text):
         if order not in ("asc", "desc"):
             raise InputError(f"--sort: order must be 'asc' or 'desc', got {order!r}")
         descending = order == "desc"
-    if name not in COLUMNS:
+    if name not in COLUMNS + OPTIONAL:
         raise InputError(f"--sort: unknown name {name!r}; accepted: {_FIELDS} "
                          "(prefix '-' for descending)")
     return name, descending
@@ -193,9 +195,10 @@ class QueryResult:
         The query named one design (all five axes in ``--at``).
     """
 
-    def __init__(self, data, point, interpolated, matched, single, at):
+    def __init__(self, data, point, interpolated, matched, single, at, columns=COLUMNS):
         self.data, self.point, self.interpolated = data, point, interpolated
         self.matched, self.single, self.at = matched, single, at
+        self.columns = tuple(columns)  # COLUMNS and the cube's OPTIONAL ones
 
     def __len__(self):
         return len(self.data[COLUMNS[0]])
@@ -207,7 +210,7 @@ def _slab_rows(ds, at_loc, r0, r1):
     index = {name: slice(i0, i1 + 1) for name, (i0, i1, _, _) in at_loc.items()
              if name != "radius"}
     index["radius"] = slice(r0, r1)
-    sub = ds[list(DESIGN)].isel(index).load()
+    sub = ds[list(DESIGN) + [n for n in OPTIONAL if n in ds]].isel(index).load()
     sub = sub.astype(float)  # limit: int8 (float when masked); NaN marks unknown below
     for name, (i0, i1, w, on_grid) in at_loc.items():
         if on_grid or i0 == i1:
@@ -240,7 +243,7 @@ def _slab_rows(ds, at_loc, r0, r1):
             rows[name] = np.broadcast_to(coord, shape).reshape(-1)
         else:
             rows[name] = np.full(int(np.prod(shape)), at_value(at_loc, name, ds))
-    for name in DESIGN:
+    for name in [*DESIGN, *(n for n in OPTIONAL if n in sub)]:
         rows[name] = sub[name].transpose(*dims).values.reshape(-1)
     return rows
 
@@ -335,6 +338,11 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     at = dict(at or {})
     conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
+    columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
+    for name in [c.name for c in conditions] + [sort_name]:
+        if name in OPTIONAL and name not in ds:
+            raise InputError(f"{name}: the cube has no {name}; sweep a config with "
+                             "'requirements' (docs/uncertainty.md)")
     if limit is not None and limit < 0:
         raise InputError(f"--limit: must be 0 or more, got {limit}")
     at_loc = {name: _locate(ds, name, value) for name, value in at.items()}
@@ -359,7 +367,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                  for r in range(0, ds.sizes["radius"], step)]
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
-    kept = {name: np.empty(0) for name in COLUMNS}
+    kept = {name: np.empty(0) for name in columns}
     matched = 0
     for k, (r0, r1) in enumerate(slabs):
         if done is not None and "radius" not in at_loc and not done[r0:r1].any():
@@ -379,7 +387,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             limit - len(kept[COLUMNS[0]])
         if room is None or room > 0:
             kept = {name: np.concatenate([kept[name], rows[name][mask][:room]])
-                    for name in COLUMNS}
+                    for name in columns}
         if limit is not None and sort_name is not None:
             kept = _sorted(kept, sort_name, descending, limit)
         if progress is not None:
@@ -392,7 +400,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     if at_loc:
         point = (EXACT if exact else INTERPOLATED) if off_grid else GRID
     return QueryResult(kept, point, off_grid, matched, single=len(at_loc) == len(AXES),
-                       at=at)
+                       at=at, columns=columns)
 
 
 def _sorted(rows, name, descending, limit):
@@ -456,7 +464,7 @@ def format_table(res) -> str:
     n = len(res)
     if res.single and n == 1:
         print(f"design at {_describe_at(res)}", file=out)
-        for name in DESIGN:
+        for name in [*DESIGN, *res.columns[len(COLUMNS):]]:
             x = res.data[name][0]
             unit = _unit(name)
             text = _cell(name, x)
@@ -471,7 +479,7 @@ def format_table(res) -> str:
         return out.getvalue()
     if res.at:
         print(f"at {_describe_at(res)}", file=out)
-    heads = list(COLUMNS)
+    heads = list(res.columns)
     units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
     cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
     widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
@@ -507,13 +515,13 @@ def _json_value(x):
 
 
 def _records(res):
-    units = {name: VARIABLES[name].units for name in COLUMNS}
+    units = {name: VARIABLES[name].units for name in res.columns}
     records = []
     for i in range(len(res)):
         rec = {}
         if res.point:
             rec["point"] = res.point
-        for name in COLUMNS:
+        for name in res.columns:
             x = res.data[name][i]
             rec[name] = (None if not np.isfinite(x) else int(x)) if name == "limit" \
                 else _json_value(x)
@@ -534,11 +542,11 @@ def format_csv(res) -> str:
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     head = ([] if not res.point else ["point"]) + \
-        [f"{n} [{VARIABLES[n].units}]" for n in COLUMNS]
+        [f"{n} [{VARIABLES[n].units}]" for n in res.columns]
     w.writerow(head)
     for i in range(len(res)):
         row = [] if not res.point else [res.point]
-        for name in COLUMNS:
+        for name in res.columns:
             x = res.data[name][i]
             if name == "limit":
                 row.append("" if not np.isfinite(x) else int(x))

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "VARIABLES", "Variable",
-           "display_label", "range_text", "slab_done_attrs", "to_display"]
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "UNCERTAIN", "VARIABLES", "Variable",
+           "display_label", "quantile_name", "range_text", "slab_done_attrs", "to_display"]
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
@@ -108,6 +108,9 @@ COORDS = {v.name: v for v in [
        "dimensionless", lo=0.0, hi=0.5),
     _v("pressure", ["pressure"], "Pa", "chamber pressure", "gauge pressure p of the chamber "
        "(docs/model.md s. 3)", "kPa", "pressure", lo=0.0, hi=100e3),
+    _v("quantile", ["quantile"], "1", "probability level",
+       "probability level of the <variable>_quantile variables (the config's "
+       "uncertainty.quantiles; docs/uncertainty.md)", "1", "dimensionless", lo=0.0, hi=1.0),
 ]}
 
 #: Inputs that are neither axes nor stored variables.
@@ -157,11 +160,34 @@ CURVES = {v.name: v for v in [
        "blocked tip force M_P(p)/L (docs/model.md s. 7)", "N", "force"),
 ]}
 
+
+def quantile_name(name: str) -> str:
+    """``tip_force_max_quantile``: the cube variable of a design variable's quantiles."""
+    return f"{name}_quantile"
+
+
+def _quantile_variable(v: Variable) -> Variable:
+    return Variable(quantile_name(v.name), (*AXES, "quantile"), v.units,
+                    f"{v.long_name} (quantile)", f"quantiles of {v.name} over the sampled "
+                    f"uncertain parameters (docs/uncertainty.md); {v.description}", v.display,
+                    v.kind)
+
+
+#: Variables of a sweep with ``uncertainty`` (quantiles of every float design variable) or
+#: ``requirements`` (``feasibility``); the cube holds them only then (docs/uncertainty.md).
+UNCERTAIN = {v.name: v for v in [
+    *(_quantile_variable(v) for v in DESIGN.values() if v.dtype != "int8"),
+    _v("feasibility", AXES, "1", "probability of meeting the requirements",
+       "P(every requirement holds) over the sampled uncertain parameters; 0 or 1 at the "
+       "nominal design without uncertainty (docs/uncertainty.md)", "1", "dimensionless",
+       lo=0.0, hi=1.0),
+]}
+
 #: The mask of the radii a sweep has stored (1) or not yet (0).
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
                "1 where this radius's slab is in the cube", "1", "dimensionless", "int8")
 
-VARIABLES = {**COORDS, **DESIGN, **CURVES}
+VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN}
 
 
 def slab_done_attrs() -> dict:

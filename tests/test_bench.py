@@ -8,7 +8,7 @@ def test_quick_bench_reports_every_figure():
     result = run_bench(quick=True, log=lines.append)
     text = "\n".join(lines)
     for words in ("designs/s", "angle solves/s", "speed-up per design", "peak memory",
-                  "closed loop"):
+                  "closed loop", "evaluations/s"):
         assert words in text
     assert result["designs"] == 12 * 6 * 4 * 3 * 4
     assert result["angle_solves"] >= 12 * 6 * (9 + 3)  # curve points + full-stroke solves

@@ -31,6 +31,7 @@ COMMANDS = {
     "validate": "validate",
     "init": "init",
     "list": "listing",
+    "sensitivity": "sensitivity",
 }
 
 

@@ -16,8 +16,8 @@ from ..physics.nylon import nylon_force_limit, stroke_max
 from ..physics.wrap import muscle_width
 from ..variables import COORDS, CURVES, DESIGN
 
-__all__ = ["FLOAT_DESIGN", "compute_slab", "coords", "global_arrays", "plan_slabs",
-           "slab_variables"]
+__all__ = ["FLOAT_DESIGN", "compute_slab", "coords", "cube_variables", "global_arrays",
+           "plan_slabs", "slab_variables"]
 
 #: The float design variables in the registry's order (the kernel's ``out.design`` rows).
 FLOAT_DESIGN = tuple(n for n in DESIGN if n != "limit")
@@ -29,14 +29,26 @@ def slab_variables() -> dict:
 
 
 def coords(cfg: ResolvedConfig) -> dict:
-    """Every coordinate of the cube: the five axes and the two curve axes, SI arrays."""
-    return {**cfg.axes, **cfg.curves}
+    """Every coordinate of the cube: the five axes and the two curve axes, SI arrays (and
+    the probability levels ``quantile`` of a sweep with ``uncertainty``)."""
+    out = {**cfg.axes, **cfg.curves}
+    if cfg.uncertainty is not None:
+        out["quantile"] = np.asarray(cfg.uncertainty.quantiles, float)
+    return out
+
+
+def cube_variables(cfg: ResolvedConfig) -> dict:
+    """Registry entries of every variable the cube of ``cfg`` holds, in order."""
+    from .sampled import uncertain_variables
+
+    return {**DESIGN, **CURVES, **uncertain_variables(cfg)}
 
 
 def _bytes_per_radius(cfg: ResolvedConfig) -> int:
     sizes = {k: len(v) for k, v in coords(cfg).items()}
+    variables = {**slab_variables(), **cube_variables(cfg)}
     return sum(int(np.prod([sizes[d] for d in v.dims[1:]])) * np.dtype(v.dtype).itemsize
-               for v in slab_variables().values())
+               for v in variables.values() if v.dims and v.dims[0] == "radius")
 
 
 def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
@@ -92,6 +104,10 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -
     arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
     arrays.update(limit=out.limit, nylon_force=out.nylon_force, bend_angle=out.bend_angle,
                   tip_force=out.tip_force)
+    if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
+        from .sampled import slab_statistics
+
+        arrays.update(slab_statistics(cfg, i0, i1, arrays, parallel=parallel))
     return arrays
 
 

@@ -11,7 +11,9 @@ runs in parallel over the designs; its body is the one the pure-Python reference
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Mapping
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -29,6 +31,8 @@ MODELS = ("paper",)
 
 #: Designs below which the serial loop is used (threads cost more than they save).
 _PARALLEL_FROM = 64
+#: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls use the serial loop.
+_SERIAL = threading.local()
 
 _FLOAT_DESIGN = [n for n in DESIGN if n != "limit"]
 _SILICONE_FIELDS = ("mu", "alpha")
@@ -122,13 +126,25 @@ def _run(shape, n, design_arrays, coil_arrays, ogden):
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
     out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty(n, dtype=np.int8))
-    kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM else \
-        kernels.design_points_serial
+    kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM and \
+        not getattr(_SERIAL, "on", False) else kernels.design_points_serial
     kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
            Nodes(*quadrature_nodes()), P_ATM, out)
     result = {name: out.design[j].reshape(shape) for j, name in enumerate(_FLOAT_DESIGN)}
     result["limit"] = out.limit.reshape(shape)
     return {name: result[name] for name in DESIGN}
+
+
+@contextmanager
+def serial():
+    """Within this block, this thread's :func:`evaluate` calls run the serial loop (Dask
+    workers: one level of parallelism, no Numba thread pool)."""
+    before = getattr(_SERIAL, "on", False)
+    _SERIAL.on = True
+    try:
+        yield
+    finally:
+        _SERIAL.on = before
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,

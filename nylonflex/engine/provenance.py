@@ -56,6 +56,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
         "model": "docs/model.md (nylonflex), after the paper 'Soft fluidic actuator based on "
                  "nylon artificial muscles' and Polygerinos et al. 2015",
         "complete": "false",
+        **_sampling(cfg),
     }
 
 
@@ -122,4 +123,22 @@ def evaluate_settings(attrs) -> dict:
         out["supply_voltage"] = float(supply["voltage"])
     elif isinstance(supply, (int, float)):
         out["supply_voltage"] = float(supply)
+    return out
+
+
+def _sampling(cfg: ResolvedConfig) -> dict:
+    """The distributions, sample count and seed of a sampled sweep; its requirements."""
+    import yaml
+
+    out = {}
+    if cfg.uncertainty is not None:
+        spec = cfg.uncertainty
+        out["uncertainty"] = yaml.safe_dump(spec.to_dict(), sort_keys=False, width=100)
+        out["uncertainty_samples"] = str(spec.samples)
+        out["uncertainty_seed"] = str(spec.seed)
+        out["uncertainty_method"] = ("scrambled Sobol' points (scipy.stats.qmc.Sobol), "
+                                     "normal or uniform quantile functions; a fit's "
+                                     "covariance by its Cholesky factor")
+    if cfg.requirements:
+        out["requirements"] = "; ".join(cfg.requirements)
     return out

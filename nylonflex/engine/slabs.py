@@ -142,12 +142,12 @@ class MemorySink:
     """Collects a sweep's slabs into arrays; :meth:`dataset` makes the cube."""
 
     def __init__(self, cfg: ResolvedConfig):
-        from ..variables import CURVES, DESIGN
+        from .grid import cube_variables
 
         self.cfg = cfg
         self.coords = coords(cfg)
         sizes = {k: len(v) for k, v in self.coords.items()}
-        self.variables = {**DESIGN, **CURVES}
+        self.variables = cube_variables(cfg)
         self.data = {name: np.empty([sizes[d] for d in v.dims], dtype=v.dtype)
                      for name, v in self.variables.items()}
         self.data.update(global_arrays(cfg))

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from ..variables import AXES, CURVES, DESIGN
+from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
 from .cube import load_filter_plugins
 from .journal import Journal
 
@@ -69,7 +69,7 @@ def open_cube(path, *, quiet: bool = False):
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
                           "computed; the rest is masked", stacklevel=2)
         mask = xr.DataArray(done, dims=("radius",), coords={"radius": ds["radius"]})
-        for name in list(DESIGN) + list(CURVES):
+        for name in [n for n in ds.data_vars if n in {**DESIGN, **CURVES, **UNCERTAIN}]:
             if "radius" in ds[name].dims:
                 ds[name] = ds[name].where(mask)
     return ds

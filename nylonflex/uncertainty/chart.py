@@ -1,0 +1,62 @@
+"""The bar chart of Sobol' indices (matplotlib, Agg, imported lazily)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..variables import display_label
+
+__all__ = ["sensitivity_chart"]
+
+
+def sensitivity_chart(result, path) -> Path:
+    """Bars of first-order and total indices with 95 % intervals, one panel an output.
+
+    Parameters
+    ----------
+    result : SensitivityResult
+        From :func:`nylonflex.uncertainty.sobol_indices`.
+    path : path
+        Image file to write (PNG, PDF or SVG by its suffix); its folder is created.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from ..charts import _RC, _figure, _plt
+
+    plt = _plt()
+    outputs = list(result.indices)
+    params = list(result.parameters)
+    with plt.rc_context(_RC):
+        fig, axes = _figure(1, len(outputs), size=(max(4.0, 1.1 * len(params) + 2.0)
+                                                    * len(outputs), 4.2), sharey=True)
+        x = np.arange(len(params))
+        for ax, o in zip(axes[0], outputs):
+            d = result.indices[o]
+            for k, (key, colour, label) in enumerate((("first", "#0072B2", "first order"),
+                                                      ("total", "#E69F00", "total"))):
+                v = np.array([d[key][p] for p in params], float)
+                e = np.array([d[f"{key}_conf"][p] for p in params], float)
+                ax.bar(x + (k - 0.5) * 0.38, np.nan_to_num(v), 0.38, yerr=np.nan_to_num(e),
+                       color=colour, label=label, capsize=3, ecolor="0.2")
+            if all(not np.isfinite(d["first"][p]) for p in params):
+                ax.text(0.5, 0.5, "does not vary over the samples:\nno indices",
+                        transform=ax.transAxes, ha="center", va="center", color="0.3")
+            ax.set_xticks(x, params, rotation=20, ha="right")
+            ax.set_title(display_label(o))
+            ax.axhline(0, color="0.3", lw=0.8)
+            ax.set_ylim(-0.05, 1.1)
+        axes[0][0].set_ylabel("Sobol' index [1]")
+        axes[0][0].legend(loc="upper left", fontsize=8)
+        where = "one design" if result.designs == 1 else \
+            f"mean over {result.designs} grid designs"
+        fig.suptitle(f"Sobol' sensitivity indices ({where}; {result.samples} model runs a "
+                     "design; bars: 95 % intervals)", fontsize=_RC["figure.titlesize"])
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, bbox_inches="tight", pad_inches=0.08)
+        plt.close(fig)
+    return path
