@@ -91,6 +91,13 @@ class FixedThickness(_Strict):
     units: str | None = "mm"
 
 
+class Supply(_Strict):
+    """A steady supply across the muscle: ``voltage`` with ``units`` (V by default)."""
+
+    voltage: Number
+    units: str | None = "V"
+
+
 class SweepConfig(_Strict):
     """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
 
@@ -102,6 +109,8 @@ class SweepConfig(_Strict):
     curves: Curves
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
     slab_megabytes: float = 16.0
+    model: Union[str, list[str]] = "paper"
+    supply: Supply | None = None
 
     @field_validator("name")
     @classmethod
@@ -128,6 +137,8 @@ class ResolvedConfig:
     charts: tuple[str, ...]
     slab_megabytes: float
     raw: dict = field(compare=False, repr=False)
+    models: tuple[str, ...] = ("paper",)
+    supply_voltage: float | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -157,6 +168,11 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         "nylon": cfg.nylon.to_dict(),
         "units": "SI (m, rad, Pa; stroke and coil_index dimensionless)",
     }
+    # only when asked for: the default config hashes as it always did
+    if cfg.models != ("paper",):
+        doc["model"] = list(cfg.models)
+    if cfg.supply_voltage is not None:
+        doc["supply_voltage"] = cfg.supply_voltage
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -399,7 +415,33 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                            cfg.base_thickness.units or "mm", lo, hi, shown)
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
-                          slab_megabytes=cfg.slab_megabytes, raw=copy.deepcopy(raw))
+                          slab_megabytes=cfg.slab_megabytes, raw=copy.deepcopy(raw),
+                          models=_models(cfg.model), supply_voltage=_supply(cfg.supply))
+
+
+def _models(model) -> tuple[str, ...]:
+    """The model variants of a config's ``model`` (one name or a list), checked."""
+    from .physics.limits import MODELS
+
+    names = [model] if isinstance(model, str) else list(model)
+    if not names:
+        raise InputError(f"model: needs at least one of {', '.join(MODELS)}")
+    for i, name in enumerate(names):
+        field_name = "model" if isinstance(model, str) else f"model[{i}]"
+        if name not in MODELS:
+            raise InputError(f"{field_name}: must be one of {', '.join(MODELS)}, got {name!r}")
+    if len(set(names)) != len(names):
+        raise InputError(f"model: each variant once, got {', '.join(names)}")
+    return tuple(names)
+
+
+def _supply(supply) -> float | None:
+    """The supply voltage [V] of a config's ``supply``, or None."""
+    if supply is None:
+        return None
+    v = INPUTS["supply_voltage"]
+    return check_range(supply.voltage, "supply.voltage", v.kind, supply.units or "V", v.lo,
+                       v.hi, "V", lo_open=v.lo_open)
 
 
 def apply_overrides(raw: dict, overrides) -> dict:

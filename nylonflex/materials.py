@@ -38,7 +38,9 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (56.19e3, 10.49e3),
         "alpha": (0.2975, 2.770),
         "description": "BJB TC-5005 (the paper's silicone), stand-in fit",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "D: the fit's data window, stretch <= 4",
             "mu": "D/P: no TC-5005 data is published; Ogden N=2 fit (stretch <= 4) to the raw "
             "tensile data of Ecoflex 00-50, the nearest hardness class, Marechal et al., "
             "Soft Robotics 2021 (Soft-Robotics-Materials-Database)",
@@ -49,7 +51,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (16.11e3, -0.3231e3),
         "alpha": (1.977, -8.149),
         "description": "Smooth-On Ecoflex 00-30",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
+            "stretch <= 4",
             "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
             "alpha": "D: same fit",
         },
@@ -58,7 +63,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (30.30e3, -1.620e3),
         "alpha": (2.970, -6.266),
         "description": "Smooth-On Dragon Skin 10",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
+            "stretch <= 4",
             "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
             "alpha": "D: same fit",
         },
@@ -67,7 +75,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (220e3, 0.0),
         "alpha": (2.0, 1.0),
         "description": "Wacker Elastosil M4601 (neo-Hookean)",
+        "stretch_range": (1.0, 2.0),
         "sources": {
+            "stretch_range": "P: a small-strain neo-Hookean equivalent of a Yeoh fit; trusted "
+            "to stretch 2 only",
             "mu": "D: neo-Hookean equal to Yeoh C1 = 0.11 MPa, Polygerinos et al., "
             "IEEE T-RO 31(3):778, 2015",
             "alpha": "D: neo-Hookean (alpha = 2)",
@@ -148,6 +159,7 @@ class Silicone:
     name: str = "custom"
     description: str = ""
     sources: Mapping[str, str] = field(default_factory=dict, compare=False)
+    stretch_range: tuple[float, float] = (0.0, float("inf"))
 
     @property
     def initial_shear_modulus(self) -> float:
@@ -229,8 +241,10 @@ class Nylon:
 
 
 def _values(material) -> dict:
+    # stretch_range is the fit's provenance, like its sources: not part of the config hash
     return {f.name: (list(v) if isinstance(v, tuple) else v)
-            for f in fields(material) if f.name not in ("description", "sources")
+            for f in fields(material) if f.name not in ("description", "sources",
+                                                        "stretch_range")
             for v in (getattr(material, f.name),)}
 
 
@@ -300,17 +314,46 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
     if not all(np.isfinite(mu + alpha)) or any(a == 0 for a in alpha):
         raise ValueError("silicone.alpha: must be finite and non-zero")
     mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
-    if not mu0 > 0:
-        raise ValueError(
-            f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i = {mu0:g} Pa; must be > 0"
-        )
+    check_shear_modulus(mu0)
+    stretch_range = p.get("stretch_range", (0.0, float("inf")))
+    try:
+        lo, hi = (float(x) for x in stretch_range)
+    except (TypeError, ValueError):
+        raise ValueError("silicone.stretch_range: must be two stretches [lo, hi], got "
+                         f"{stretch_range!r}") from None
+    if not 0.0 <= lo < hi:
+        raise ValueError(f"silicone.stretch_range: must be 0 <= lo < hi, got [{lo:g}, {hi:g}]")
     return Silicone(
         mu=mu,
         alpha=alpha,
         name=name,
         description=p.get("description", ""),
         sources=dict(p.get("sources", {})),
+        stretch_range=(lo, hi),
     )
+
+
+#: Initial shear moduli a silicone may have [Pa]: the soft end of gels to the hard end of
+#: silicone rubbers. Outside it a value is a unit slip (``mu`` typed in kPa or MPa).
+SHEAR_MODULUS_RANGE = (1e3, 100e6)
+
+
+def check_shear_modulus(mu0):
+    """Refuse an initial shear modulus mu_0 [Pa] outside :data:`SHEAR_MODULUS_RANGE`.
+
+    Raises
+    ------
+    ValueError
+        ``silicone.mu: ...`` with the accepted range, the value, and the likely slip.
+    """
+    lo, hi = SHEAR_MODULUS_RANGE
+    arr = np.asarray(mu0, dtype=float)
+    bad = ~((arr >= lo) & (arr <= hi))
+    if np.any(bad):
+        got = float(arr[bad].flat[0])
+        hint = " (mu is in Pa: was it typed in kPa?)" if 0 < got < lo else ""
+        raise ValueError(f"silicone.mu: initial shear modulus 1/2 sum mu_i alpha_i must be in "
+                         f"[1 kPa, 100 MPa] for a silicone, got {got:g} Pa{hint}")
 
 
 def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..variables import COORDS, CURVES, DESIGN, slab_done_attrs
+from ..variables import COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 
 __all__ = ["CubeFile"]
 
@@ -30,20 +30,30 @@ def _chunks(dims, sizes, radius_chunk):
 class CubeFile:
     """Writes one cube file slab by slab (h5netcdf; gzip level 1 with shuffle)."""
 
-    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int):
+    def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
+                 variables: dict | None = None, models=("paper",)):
         import h5netcdf
+        import h5py
 
         self.path = Path(path)
         self.f = h5netcdf.File(self.path, "w")
         sizes = {name: len(values) for name, values in coords.items()}
+        if len(models) > 1:
+            sizes["model"] = len(models)
         self.f.dimensions = sizes
         for name, values in coords.items():
             v = self.f.create_variable(name, (name,), "f8", data=np.asarray(values, float))
             v.attrs.update(COORDS[name].attrs())
-        for var in (*DESIGN.values(), *CURVES.values()):
+        if len(models) > 1:  # the string dimension of a cube of several model variants
+            v = self.f.create_variable("model", ("model",), h5py.string_dtype(),
+                                       data=np.array(models, dtype=object))
+            v.attrs.update(MODEL.attrs())
+        if variables is None:
+            variables = {n: (v, v.dims) for n, v in {**DESIGN, **CURVES}.items()}
+        for var, dims in variables.values():
             fill = None if var.dtype == "int8" else np.nan
-            v = self.f.create_variable(var.name, var.dims, var.dtype, fillvalue=fill,
-                                       chunks=_chunks(var.dims, sizes, radius_chunk),
+            v = self.f.create_variable(var.name, dims, var.dtype, fillvalue=fill,
+                                       chunks=_chunks(dims, sizes, radius_chunk),
                                        **_COMPRESSION)
             v.attrs.update(var.attrs())
         done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)

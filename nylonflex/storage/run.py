@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..config import ResolvedConfig
-from ..engine.grid import coords, global_arrays, plan_slabs
+from ..engine.grid import coords, cube_variables, global_arrays, plan_slabs
 from ..engine.provenance import provenance
 from ..engine.slabs import LocalExecutor, run_slabs
 from ..units import InputError
@@ -131,7 +131,8 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
 def _write(cfg, out, journal, slabs, keep, chunk, executor, progress, log):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     building = out.with_name(out.name + ".building")
-    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk)
+    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, cube_variables(cfg),
+                    cfg.models)
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
     for k in sorted(keep):
