@@ -123,8 +123,7 @@ def _compute_model_slab(cfg, i0, i1, parallel, model):
     shape = lambda name: [sizes[d] for d in CURVES[name].dims]  # noqa: E731
     design_shape = [sizes[d] for d in DESIGN["limit"].dims]
     out = GridOut(design=np.empty((len(FLOAT_DESIGN), *design_shape)),
-                  limit=np.empty(design_shape, dtype=np.int8),
-                  validity=np.empty(design_shape, dtype=np.int8),
+                  flags=np.empty((2, *design_shape), dtype=np.int8),
                   nylon_force=np.empty(shape("nylon_force")),
                   bend_angle=np.empty(shape("bend_angle")),
                   tip_force=np.empty(shape("tip_force")))
@@ -133,7 +132,7 @@ def _compute_model_slab(cfg, i0, i1, parallel, model):
     kernel(grid, _coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
            _muscle(cfg), options, out)
     arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
-    arrays.update(limit=out.limit, validity=out.validity, nylon_force=out.nylon_force,
+    arrays.update(limit=out.flags[0], validity=out.flags[1], nylon_force=out.nylon_force,
                   bend_angle=out.bend_angle, tip_force=out.tip_force)
     return arrays
 

@@ -141,15 +141,14 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
 
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
-    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty(n, dtype=np.int8),
-                   np.empty(n, dtype=np.int8))
+    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty((2, n), dtype=np.int8))
     kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM else \
         kernels.design_points_serial
     kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
            Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
     result = {name: out.design[j].reshape(shape) for j, name in enumerate(_FLOAT_DESIGN)}
-    result["limit"] = out.limit.reshape(shape)
-    result["validity"] = out.validity.reshape(shape)
+    result["limit"] = out.flags[0].reshape(shape)
+    result["validity"] = out.flags[1].reshape(shape)
     return {name: result[name] for name in DESIGN}
 
 

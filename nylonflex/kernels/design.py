@@ -26,7 +26,8 @@ from numba import prange
 from ..physics.bending import NEWTON_RTOL, _curvature, _curvature_of, _pressure_moment
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _design_values, _model_state, _nylon_force_model, _reach,
+                              _design_state, _design_values, _model_state,
+                              _nylon_force_model, _reach,
                               _stroke_state, _thermal_values, _validity,
                               _working_temperatures)
 from ..physics.nylon import _stroke_shape
@@ -59,7 +60,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     mu, alpha = silicone.mu, silicone.alpha
     x_base, w_base, phi_trig, w_phi = nodes.x_base, nodes.w_base, nodes.phi_trig, nodes.w_phi
     # unpacked before the loop: a record's fields written inside prange are lost (Numba)
-    out_design, out_limit, out_valid, out_force, out_angle, out_tip = out
+    out_design, out_flags, out_force, out_angle, out_tip = out
     coil_s_max, coil_force_limit, coil_width = coil
     model, voltage, stretch_max = options
     t_amb = muscle.t_amb[0]
@@ -136,7 +137,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim,
                                        length[il])
                     out_design[0, ia, it, il, ic, ip] = v[0]
-                    out_limit[ia, it, il, ic, ip] = v[1]
+                    out_flags[0, ia, it, il, ic, ip] = v[1]
                     out_design[1, ia, it, il, ic, ip] = v[2]
                     out_design[2, ia, it, il, ic, ip] = v[3]
                     out_design[3, ia, it, il, ic, ip] = v[4]
@@ -147,9 +148,13 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     th = _thermal_values(length[il], pitch, a, t, b, wrap[ip], voltage,
                                          temps[0], temps[1], temps[2], t_amb, r_per_len,
                                          c_per_len, loss_per_len)
-                    for j in range(6):
-                        out_design[8 + j, ia, it, il, ic, ip] = th[j]
-                    out_valid[ia, it, il, ic, ip] = _validity(v[5], st[4], a, t, b,
+                    out_design[8, ia, it, il, ic, ip] = th[0]
+                    out_design[9, ia, it, il, ic, ip] = th[1]
+                    out_design[10, ia, it, il, ic, ip] = th[2]
+                    out_design[11, ia, it, il, ic, ip] = th[3]
+                    out_design[12, ia, it, il, ic, ip] = th[4]
+                    out_design[13, ia, it, il, ic, ip] = th[5]
+                    out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4], a, t, b,
                                                               stretch_max,
                                                               length[il] / pitch, closes)
                 for js in range(ns):
@@ -184,13 +189,12 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     s_max_all, f_lim_all, width_all = coil
     mu_all, alpha_all = silicone
     x_base, w_base, phi_trig, w_phi = nodes
-    out_design, out_limit, out_valid = out
+    out_design, out_flags = out
     model, voltage, stretch_max = options
     t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
         muscle.t_amb, muscle.t_max, muscle.gamma, muscle.beta, muscle.t_g, muscle.sigma_g
     r_all, c_all, loss_all, coeff_all = \
         muscle.r_per_len, muscle.c_per_len, muscle.loss_per_len, muscle.force_coeff
-    default = model == PAPER and voltage <= 0.0
     n = radius.shape[0]
     step = 0 if mu_all.shape[0] == 1 else 1  # one row for all, or one a design
     for i in prange(n):
@@ -209,23 +213,14 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
                                       sigma_g_all[i])
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
-        if default:
-            st = _stroke_state(a, t, b, lever, f_lim, s_max, 0.0, mu, alpha, x_base,
-                               w_base, phi_trig, w_phi, p_atm)
-            closes = False
-            t_reach = t_max
-        else:
-            t_reach, s_free, limited = _reach(
-                s_max, scale, length[i], pitch, a, t, b, psi, voltage, t_amb, t_max,
-                gamma_all[i], beta_all[i], t_g_all[i], sigma_g_all[i], r_all[i], loss_all[i])
-            ms = _model_state(model, a, t, b, lever, f_lim, s_free, s_max,
-                              coeff_all[i] * (t_reach - t_amb), limited, mu, alpha, x_base,
-                              w_base, phi_trig, w_phi, p_atm)
-            st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
-            closes = ms[7]
+        # one call, no branch in the prange body (writes after a branch were lost)
+        st = _design_state(model, voltage, a, t, b, length[i], psi, pitch, lever, f_lim, s_max,
+                           scale, t_amb, t_max, gamma_all[i], beta_all[i], t_g_all[i],
+                           sigma_g_all[i], r_all[i], loss_all[i], coeff_all[i], mu, alpha,
+                           x_base, w_base, phi_trig, w_phi, p_atm)
         v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
         out_design[0, i] = v[0]
-        out_limit[i] = v[1]
+        out_flags[0, i] = v[1]
         out_design[1, i] = v[2]
         out_design[2, i] = v[3]
         out_design[3, i] = v[4]
@@ -233,13 +228,17 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         out_design[5, i] = v[6]
         out_design[6, i] = v[7]
         out_design[7, i] = v[8]
-        temps = _working_temperatures(model, v[0], t_reach, scale, t_amb, t_max, gamma_all[i],
+        temps = _working_temperatures(model, v[0], st[8], scale, t_amb, t_max, gamma_all[i],
                                       beta_all[i], t_g_all[i], sigma_g_all[i])
         th = _thermal_values(length[i], pitch, a, t, b, psi, voltage, temps[0], temps[1],
                              temps[2], t_amb, r_all[i], c_all[i], loss_all[i])
-        for j in range(6):
-            out_design[8 + j, i] = th[j]
-        out_valid[i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, closes)
+        out_design[8, i] = th[0]
+        out_design[9, i] = th[1]
+        out_design[10, i] = th[2]
+        out_design[11, i] = th[3]
+        out_design[12, i] = th[4]
+        out_design[13, i] = th[5]
+        out_flags[1, i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, st[7])
 
 
 #: Threaded (Numba prange) and serial compilations of the same loops. The serial ones are

@@ -31,9 +31,11 @@ GridAxes = namedtuple("GridAxes", "radius wall length wrap base_thickness stroke
 CoilTable = namedtuple("CoilTable", "s_max force_limit width")
 
 #: Output arrays of the grid kernel: ``design`` (float design variables, the registry's
-#: order less ``limit``, then the slab's design shape), ``limit`` (int8), ``nylon_force``,
+#: order less ``limit``, then the slab's design shape), ``flags`` (int8, rows ``limit`` and
+#: ``validity``: one array, since Numba's parallel loops lost the writes to a second int8
+#: output of the same record), ``nylon_force``,
 #: ``bend_angle``, ``tip_force`` (the registry's dims).
-GridOut = namedtuple("GridOut", "design limit validity nylon_force bend_angle tip_force")
+GridOut = namedtuple("GridOut", "design flags nylon_force bend_angle tip_force")
 
 #: The muscle's thermal and eq. (1)-(2) constants, float64 arrays of one entry (the grid
 #: kernel) or one a design (the pointwise kernel): ``t_amb``, ``t_max``, ``t_g`` [K],
@@ -50,6 +52,6 @@ Options = namedtuple("Options", "model voltage stretch_max")
 #: ``wrap`` [rad].
 PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
 
-#: Output of the pointwise kernel: ``design`` (float variables, shape (14, n)), ``limit``
-#: and ``validity`` (int8).
-PointOut = namedtuple("PointOut", "design limit validity")
+#: Output of the pointwise kernel: ``design`` (float variables, shape (14, n)) and ``flags``
+#: (int8, shape (2, n): ``limit`` and ``validity``).
+PointOut = namedtuple("PointOut", "design flags")

@@ -224,6 +224,31 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
 
 
 @formula
+def _design_state(model, voltage, radius, wall_thickness, base_thickness, length, wrap_angle,
+                  pitch, lever, force_limit, s_max, coil_scale, t_amb, t_max, gamma, beta, t_g, sigma_g,
+                  r_per_len, loss_per_len, force_coeff, mu, alpha, x_base, w_base, phi_trig,
+                  w_phi, p_atm):
+    """The stroke state of one design in any model, with or without a supply.
+
+    Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
+    model without a supply is :func:`_stroke_state` itself; otherwise :func:`_model_state`
+    at the reachable temperature (:func:`_reach`).
+    """
+    if model == PAPER and voltage <= 0.0:
+        st = _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
+                           0.0, mu, alpha, x_base, w_base, phi_trig, w_phi, p_atm)
+        return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, t_max
+    t_reach, s_free, limited = _reach(s_max, coil_scale, length, pitch, radius,
+                                      wall_thickness, base_thickness, wrap_angle, voltage,
+                                      t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len,
+                                      loss_per_len)
+    ms = _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
+                      s_max, force_coeff * (t_reach - t_amb), limited, mu, alpha, x_base,
+                      w_base, phi_trig, w_phi, p_atm)
+    return ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6], ms[7], t_reach
+
+
+@formula
 def _nylon_pressure(model, stroke, p_atm, solid):
     """Chamber gauge pressure p(s) of a model variant [Pa]."""
     if model == INCOMPRESSIBLE_WALL:
@@ -446,20 +471,11 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))
         pitch = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0))
         lever = pitch / math.cos(pi)
-        if code == PAPER and voltage <= 0.0:
-            state = _stroke_state(ai, ti, bi, lever, force_limit, s_max, 0.0, mu, alpha,
-                                  *nodes, P_ATM)
-            closes = False
-            t_reach = ny.t_max
-        else:
-            scale = s_max / top
-            t_reach, s_free, limited = _reach(
-                s_max, scale, Li, pitch, ai, ti, bi, pi, voltage, ny.t_amb, ny.t_max,
-                ny.gamma, ny.beta, ny.t_g, ny.sigma_g, ny.resistance_per_length,
-                ny.heat_loss_per_length)
-            f_b = ny.thermal_force_coefficient * (t_reach - ny.t_amb)
-            *state, closes = _model_state(code, ai, ti, bi, lever, force_limit, s_free, s_max,
-                                          f_b, limited, mu, alpha, *nodes, P_ATM)
+        *state, closes, t_reach = _design_state(
+            code, voltage, ai, ti, bi, Li, pi, pitch, lever, force_limit, s_max, s_max / top,
+            ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g,
+            ny.resistance_per_length, ny.heat_loss_per_length, ny.thermal_force_coefficient,
+            mu, alpha, *nodes, P_ATM)
         values = _design_values(*state, force_limit, Li)
         temps = _working_temperatures(code, values[0], t_reach, s_max / top, *shape_args[:1],
                                       ny.t_max, *shape_args[1:])
