@@ -421,7 +421,7 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
 
 def _models(model) -> tuple[str, ...]:
     """The model variants of a config's ``model`` (one name or a list), checked."""
-    from .physics.limits import MODELS
+    from .variables import MODELS
 
     names = [model] if isinstance(model, str) else list(model)
     if not names:

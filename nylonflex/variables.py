@@ -17,8 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "SUPPLY_ONLY", "VARIABLES", "Variable",
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY", "VARIABLES", "Variable",
            "display_label", "range_text", "slab_done_attrs", "to_display"]
+
+#: Model variants, in the order of their integer codes in the kernels (docs/model.md
+#: s. 15-17); ``paper`` is the default.
+MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")

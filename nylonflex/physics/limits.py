@@ -24,8 +24,7 @@ from .wrap import _muscle_length, _nylon_force_and_slope, _pitch, _wrap_force
 
 __all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "stroke_limit"]
 
-#: Model variants, in the order of their integer codes in the kernels (docs/model.md s. 15-17).
-MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment")
+from ..variables import MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT = range(5)
 
 #: Bits of the ``validity`` flag (docs/model.md s. 18).
