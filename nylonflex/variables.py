@@ -21,7 +21,7 @@ __all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONL
            "display_label", "range_text", "slab_done_attrs", "to_display"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
-#: s. 15-17); ``paper`` is the default.
+#: s. 16); ``paper`` is the default.
 MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment")
 
 #: The design axes, in the cube's order.
@@ -96,7 +96,7 @@ _FLAGS = {"limit": ((0, 1, 2, 3),
                     "stroke_limited strength_limited supply_limited load_limited"),
           "slab_done": ((0, 1), "missing done")}
 
-#: CF flag masks and meanings of the bit-field variables (docs/model.md s. 18).
+#: CF flag masks and meanings of the bit-field variables (docs/model.md s. 17).
 _MASKS = {"validity": ((1, 2, 4, 8),
                        "self_contact stretch_beyond_fit under_one_turn chamber_closes")}
 
@@ -143,7 +143,7 @@ INPUTS = {v.name: v for v in [
        "the chamber floor; b = t unless given (docs/model.md s. 1)", "mm", "length",
        lo=0.1e-3, hi=0.05),
     _v("supply_voltage", [], "V", "supply voltage", "steady voltage across the muscle; caps "
-       "its temperature at T_ss (docs/model.md s. 14)", "V", "voltage", lo=0.0, hi=1000.0,
+       "its temperature at T_ss (docs/model.md s. 15)", "V", "voltage", lo=0.0, hi=1000.0,
        lo_open=True),
 ]}
 
@@ -153,7 +153,7 @@ DESIGN = {v.name: v for v in [
        "dimensionless"),
     _m("limit", AXES, "1", "limiting factor",
        "0 stroke-limited (full range of motion), 1 strength-limited, 2 supply-limited, "
-       "3 load-limited (docs/model.md s. 8, 14, 15)", "1",
+       "3 load-limited (docs/model.md s. 8, 15, 16)", "1",
        "dimensionless", "int8"),
     _m("pressure_max", AXES, "Pa", "maximum pressure", "p* = p(s*) (docs/model.md s. 8)", "kPa",
        "pressure"),
@@ -171,20 +171,20 @@ DESIGN = {v.name: v for v in [
     _m("nylon_use", AXES, "1", "nylon strength use", "F_n(s*)/F_lim(C) (docs/model.md s. 4, 8)",
        "1", "dimensionless"),
     _v("muscle_length", AXES, "m", "muscle length", "length of muscle in the wrap "
-       "l_m = n P_out / cos psi (docs/model.md s. 14)", "mm", "length"),
-    _v("resistance", AXES, "ohm", "muscle resistance", "R = r' l_m (docs/model.md s. 14)",
+       "l_m = n P_out / cos psi (docs/model.md s. 15)", "mm", "length"),
+    _v("resistance", AXES, "ohm", "muscle resistance", "R = r' l_m (docs/model.md s. 15)",
        "ohm", "resistance"),
     _m("heating_power", AXES, "W", "heating power", "lambda' l_m (T* - T_amb), the steady "
-       "power that holds the muscle at its working temperature T* (docs/model.md s. 14)", "W",
+       "power that holds the muscle at its working temperature T* (docs/model.md s. 15)", "W",
        "power"),
     _m("heating_voltage", AXES, "V", "heating voltage", "sqrt(R P), the steady supply that "
-       "holds the muscle at T* (docs/model.md s. 14)", "V", "voltage"),
+       "holds the muscle at T* (docs/model.md s. 15)", "V", "voltage"),
     _m("cooling_time", AXES, "s", "cooling time", "time from T* until the free stroke is 5 % "
-       "of its value at T*, eq. (3) with V = 0 (docs/model.md s. 14)", "s", "time"),
+       "of its value at T*, eq. (3) with V = 0 (docs/model.md s. 15)", "s", "time"),
     _m("heating_time", AXES, "s", "heating time", "time at the supply voltage from ambient "
-       "until the free stroke is 95 % of its value at T* (docs/model.md s. 14)", "s", "time"),
+       "until the free stroke is 95 % of its value at T* (docs/model.md s. 15)", "s", "time"),
     _m("validity", AXES, "1", "validity flags", "bits: 1 self_contact, 2 stretch_beyond_fit, "
-       "4 under_one_turn, 8 chamber_closes; 0 a clean design (docs/model.md s. 18)", "1",
+       "4 under_one_turn, 8 chamber_closes; 0 a clean design (docs/model.md s. 17)", "1",
        "dimensionless", "int8"),
 ]}
 
@@ -204,9 +204,9 @@ CURVES = {v.name: v for v in [
        "blocked tip force M_P(p)/L (docs/model.md s. 7)", "N", "force"),
 ]}
 
-#: The string coordinate of a cube of several model variants (docs/model.md s. 15).
+#: The string coordinate of a cube of several model variants (docs/model.md s. 16).
 MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each slice "
-           "(docs/model.md s. 15-17)", "1", "dimensionless", "str")
+           "(docs/model.md s. 16)", "1", "dimensionless", "str")
 
 #: The mask of the radii a sweep has stored (1) or not yet (0).
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",

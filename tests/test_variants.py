@@ -1,4 +1,4 @@
-"""Issue 10: heating and supply, model variants and validity flags (docs/model.md s. 14-18).
+"""Issue 10: heating and supply, model variants and validity flags (docs/model.md s. 15-17).
 
 Each variant is pinned on a closed form or a limit case; each flag on a design that must
 carry it. Expected numbers say where they come from.
@@ -96,7 +96,7 @@ def test_paper_through_the_variant_path_is_the_paper():
 
 
 def test_coupled_muscle_with_an_infinitely_strong_muscle_is_the_paper():
-    # F_b -> inf: the wrap settles at the free stroke (docs/model.md s. 15)
+    # F_b -> inf: the wrap settles at the free stroke (docs/model.md s. 16)
     strong = {"set": "silver_nylon66", "thermal_force_coefficient": 1e12}
     for ex in (EXAMPLE_1, EXAMPLE_2):
         p = nf.design_limits(**ex, nylon=strong)

@@ -27,7 +27,7 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
     """``{name: (Variable, dims)}`` of every design variable and curve of ``cfg``'s cube.
 
     With several models, the variables that depend on the model gain a last ``model``
-    dimension; ``heating_time`` is there only with a supply (docs/model.md s. 14-15).
+    dimension; ``heating_time`` is there only with a supply (docs/model.md s. 15-16).
     """
     return {n: (v, v.dims_for(cfg.models)) for n, v in {**DESIGN, **CURVES}.items()
             if cfg.supply_voltage is not None or n not in SUPPLY_ONLY}
@@ -79,7 +79,7 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -
 
     ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers. With
     several models the kernel runs once a model and the model-dependent variables are
-    stacked along a last axis (docs/model.md s. 15).
+    stacked along a last axis (docs/model.md s. 16).
     """
     from ..physics.limits import MODELS
 

@@ -24,7 +24,7 @@ from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
 
-from ..physics.limits import MODELS  # noqa: E402  (docs/model.md s. 15-17)
+from ..physics.limits import MODELS  # noqa: E402  (docs/model.md s. 16)
 
 #: Designs below which the serial loop is used (threads cost more than they save).
 _PARALLEL_FROM = 64
@@ -66,10 +66,10 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
         value}``; every numeric field may be an array broadcasting against the designs (the
         tables with their columns on the last axis).
     model : str, default "paper"
-        Model variant, one of :data:`MODELS` (docs/model.md s. 15-17).
+        Model variant, one of :data:`MODELS` (docs/model.md s. 16).
     supply_voltage : float, optional
         Steady supply voltage across the muscle [V], in (0, 1000]; None: no supply limit
-        (docs/model.md s. 14).
+        (docs/model.md s. 15).
 
     Returns
     -------

@@ -126,7 +126,7 @@ def _material_moment(kappa, radius, wall_thickness, base_thickness, mu, alpha,
 @formula
 def _material_moment_of(kappa, radius, wall_thickness, base_thickness, mu, alpha,
                         x_base, w_base, phi_trig, w_phi, cauchy):
-    """:func:`_material_moment` with nominal or (``cauchy``) Cauchy stress (docs/model.md s. 17)."""
+    """:func:`_material_moment` with nominal or (``cauchy``) Cauchy stress (docs/model.md s. 16)."""
     m = 0.0
     dm = 0.0
     half = 0.5 * base_thickness
@@ -158,7 +158,7 @@ def _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
     """Solve M_S(kappa) = moment for kappa >= 0 [1/m] by safeguarded Newton.
 
     ``cauchy`` integrates the Cauchy stress l S(l) instead of the nominal S(l)
-    (``cauchy_moment``, docs/model.md s. 17).
+    (``cauchy_moment``, docs/model.md s. 16).
 
     ``guess`` <= 0 starts from the linear (small-angle) solution. M_S is smooth and strictly
     increasing, so the root is unique; a step that leaves the bracket is replaced by

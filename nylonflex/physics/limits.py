@@ -27,7 +27,7 @@ __all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "str
 from ..variables import MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT = range(5)
 
-#: Bits of the ``validity`` flag (docs/model.md s. 18).
+#: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
                   "chamber_closes": 8}
 
@@ -131,7 +131,7 @@ def _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, al
                     rtol):
     """Stroke where the wrap's load meets the muscle's line, F_n(s) = F_b (1 - s/s_free) [-].
 
-    ``coupled_muscle`` (docs/model.md s. 15): g(s) = F_n(s)/F_b - (1 - s/s_free) rises from
+    ``coupled_muscle`` (docs/model.md s. 16): g(s) = F_n(s)/F_b - (1 - s/s_free) rises from
     -1 at s = 0 to F_n(s_free)/F_b >= 0, so the root in [0, s_free] is unique; safeguarded
     Newton from the linearised root. Written over F_b so an infinitely strong muscle
     (F_b -> inf) gives s_free.
@@ -173,7 +173,7 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
     ``force_blocked`` F_b = c (T - T_amb) at that temperature (``coupled_muscle``),
     ``supply_limited`` whether the supply keeps the muscle below T_max. Returns
     (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0 stroke, 1 strength,
-    2 supply, 3 load (docs/model.md s. 8, 14, 15); ``closes`` (``incompressible_wall``) when
+    2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes`` (``incompressible_wall``) when
     the chamber would close before s_max, and then kappa_full is inf (range fraction 0).
     """
     cauchy = model == CAUCHY_MOMENT
@@ -261,7 +261,7 @@ def _reach(s_max, coil_scale, length, pitch, radius, wall_thickness, base_thickn
            loss_per_len):
     """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
 
-    ``voltage`` <= 0: no supply, T_max and s_max itself (docs/model.md s. 14).
+    ``voltage`` <= 0: no supply, T_max and s_max itself (docs/model.md s. 15).
     """
     if voltage > 0.0:
         l_m = _muscle_length(length, pitch, radius, wall_thickness, base_thickness,
@@ -279,7 +279,7 @@ def _working_temperatures(model, s_star, t_reach, coil_scale, t_amb, t_max, gamm
     """T* [K], and the temperatures where the free stroke is 5 % and 95 % of s(T*) [K].
 
     T* is the temperature whose free stroke (eq. 2) is s* (in ``coupled_muscle``: the
-    reachable temperature it is heated to; docs/model.md s. 14).
+    reachable temperature it is heated to; docs/model.md s. 15).
     """
     if model == COUPLED_MUSCLE:
         t_work = t_reach
@@ -300,7 +300,7 @@ def _thermal_values(length, pitch, radius, wall_thickness, base_thickness, wrap_
     """muscle_length, resistance, heating_power, heating_voltage, cooling_time, heating_time.
 
     At the working temperature T* (:func:`_working_temperatures`); heating_time is NaN
-    without a supply (``voltage`` <= 0; docs/model.md s. 14).
+    without a supply (``voltage`` <= 0; docs/model.md s. 15).
     """
     l_m = _muscle_length(length, pitch, radius, wall_thickness, base_thickness, wrap_angle)
     r = r_per_len * l_m
@@ -317,7 +317,7 @@ def _thermal_values(length, pitch, radius, wall_thickness, base_thickness, wrap_
 @formula
 def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch_max,
               turns, closes):
-    """The ``validity`` bits (docs/model.md s. 18): 1 self contact (theta* > 2 pi), 2 the
+    """The ``validity`` bits (docs/model.md s. 17): 1 self contact (theta* > 2 pi), 2 the
     largest axial stretch 1 + kappa* (b + a + t) beyond the silicone's fitted range, 4 fewer
     than one turn of wrap, 8 the chamber closes (``incompressible_wall``)."""
     flags = 0
@@ -421,9 +421,9 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     nylon : str, dict or Nylon, default "silver_nylon66"
         Muscle set.
     model : str, default "paper"
-        Model variant, one of :data:`MODELS` (docs/model.md s. 15-17).
+        Model variant, one of :data:`MODELS` (docs/model.md s. 16).
     supply_voltage : float, optional
-        Steady supply voltage V [V], > 0; None: no supply limit (docs/model.md s. 14).
+        Steady supply voltage V [V], > 0; None: no supply limit (docs/model.md s. 15).
 
     Returns
     -------
