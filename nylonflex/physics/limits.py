@@ -444,7 +444,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 
     References
     ----------
-    Paper section 4 and figure 12; docs/model.md sections 8, 14-18.
+    Paper section 4 and figure 12; docs/model.md sections 8, 15-17.
     """
     if model not in MODELS:
         raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
