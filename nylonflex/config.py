@@ -28,7 +28,7 @@ __all__ = ["CHARTS", "SweepConfig", "apply_overrides", "check_range", "load_conf
            "parse_config", "range_error"]
 
 #: Figures a sweep config may name under ``charts``.
-CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map")
+CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map", "compare")
 
 Number = Union[float, str]
 
