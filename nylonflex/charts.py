@@ -886,9 +886,47 @@ def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
 
 # ---------------------------------------------------------------------------- drivers
 #: Chart name -> function, the names a config's ``charts`` list accepts.
+def compare(ds, *, variable="tip_force_max"):
+    """``variable`` against radius for every model, at the paper's first example's slice.
+
+    Wall 6 mm, length 90 mm, C 1.1, psi 8 deg (the nearest grid values); a cross marks a
+    flagged design (``validity`` != 0, docs/model.md s. 17). docs/model.md s. 16.
+    """
+    import numpy as np
+
+    at = {name: _nearest(ds, name, v) for name, v in (("wall_thickness", 6e-3),
+                                                      ("length", 90e-3), ("coil_index", 1.1),
+                                                      ("wrap_angle", 8 * np.pi / 180))}
+    cut = ds[[variable, "validity"]].sel(**at)
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else \
+        [str(ds.attrs.get("models", "paper"))]
+    fig, axes = _figure()
+    ax = axes[0, 0]
+    styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1))]
+    r = to_display("radius", ds["radius"].values)
+    flagged_any = False
+    for k, m in enumerate(models):
+        one = cut.sel(model=m) if "model" in cut.dims else cut
+        y = to_display(variable, one[variable].values)
+        ax.plot(r, y, linestyle=styles[k % len(styles)], color=f"C{k}", label=m)
+        bad = np.asarray(one["validity"].values) > 0
+        if bad.any():
+            flagged_any = True
+            ax.plot(r[bad], y[bad], "x", color=f"C{k}", ms=5)
+    if flagged_any:
+        ax.plot([], [], "x", color="0.3", label="flagged (validity != 0)")
+    ax.set_xlabel(display_label("radius"))
+    ax.set_ylabel(display_label(variable))
+    ax.legend(fontsize="small")
+    sub = ", ".join(_text(n, float(ds[n].sel({n: v}).values)) for n, v in at.items())
+    _suptitle(fig, f"Figure compare: {VARIABLES[variable].long_name}, every model", sub)
+    _footer(fig, ds)
+    return fig
+
+
 CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
           "fig6": fig6, "fig7": fig7, "design_map": design_map,
-          "feasibility_map": feasibility_map}
+          "feasibility_map": feasibility_map, "compare": compare}
 assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 
 
@@ -896,7 +934,7 @@ assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
          "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
          "design_map": ("radius", "wall_thickness"),
-         "feasibility_map": ("radius", "wall_thickness")}
+         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",)}
 
 
 def _unmet(ds, name):
@@ -1020,9 +1058,11 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for done, name in enumerate(names, 1):
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
+    jobs = [(name, m) for name in names for m in (models if name != "compare" else [None])]
+    for done, (name, model) in enumerate(jobs, 1):
         if progress is not None and done > 1:
-            progress(done - 1, len(names))
+            progress(done - 1, len(jobs))
         reason = _unmet(ds, name)
         if reason:
             if on_skip is None:
@@ -1033,8 +1073,13 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
                 on_skip(reason)
             continue
         with plt.rc_context(_RC):
-            fig = CHARTS[name](ds, **_slice_kwargs(CHARTS[name], chosen))
-            path = out_dir / f"{name}.{fmt}"
+            # a cube of several models: each figure once a model, its name in title and file
+            one = ds if model is None else ds.sel(model=model, drop=True)
+            fig = CHARTS[name](one, **_slice_kwargs(CHARTS[name], chosen))
+            if model is not None:
+                fig.text(0.99, 0.995, f"model: {model}", ha="right", va="top",
+                         fontsize="small", weight="bold")
+            path = out_dir / (f"{name}.{fmt}" if model is None else f"{name}_{model}.{fmt}")
             # fixed metadata so that the same cube gives byte-stable PDF/SVG files
             meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
                     "svg": {"Date": None}}[fmt]
@@ -1043,5 +1088,5 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
             plt.close(fig)
         written.append(path)
     if progress is not None:
-        progress(len(names), len(names))
+        progress(len(jobs), len(jobs))
     return written

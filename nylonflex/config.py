@@ -30,7 +30,7 @@ __all__ = ["CHARTS", "SweepConfig", "apply_overrides", "check_range", "load_conf
 
 #: Figures a sweep config may name under ``charts``.
 CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
-          "feasibility_map")
+          "feasibility_map", "compare")
 
 Number = Union[float, str]
 
@@ -112,6 +112,13 @@ class Uncertainty(_Strict):
     parameters: dict[str, Distribution] = {}
 
 
+class Supply(_Strict):
+    """A steady supply across the muscle: ``voltage`` with ``units`` (V by default)."""
+
+    voltage: Number
+    units: str | None = "V"
+
+
 class SweepConfig(_Strict):
     """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
 
@@ -126,6 +133,8 @@ class SweepConfig(_Strict):
     compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
     uncertainty: Uncertainty | None = None
     requirements: list[str] = []
+    model: Union[str, list[str]] = "paper"
+    supply: Supply | None = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -157,6 +166,8 @@ class ResolvedConfig:
     compression: str = "gzip"  # the cube's codec: not part of the design space or its hash
     uncertainty: "UncertaintySpec | None" = None
     requirements: tuple[str, ...] = ()
+    models: tuple[str, ...] = ("paper",)
+    supply_voltage: float | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -190,6 +201,11 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["uncertainty"] = cfg.uncertainty.to_dict()
     if cfg.requirements:
         doc["requirements"] = list(cfg.requirements)
+    # only when asked for: the default config hashes as it always did
+    if cfg.models != ("paper",):
+        doc["model"] = list(cfg.models)
+    if cfg.supply_voltage is not None:
+        doc["supply_voltage"] = cfg.supply_voltage
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -431,13 +447,43 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
         base = check_range(cfg.base_thickness.value, "base_thickness.value", kind,
                            cfg.base_thickness.units or "mm", lo, hi, shown)
     requirements = tuple(r.text for r in parse_requirements(cfg.requirements))
+    if (cfg.uncertainty is not None or requirements) and not isinstance(cfg.model, str) \
+            and len(cfg.model) > 1:
+        raise InputError("model: a sweep with uncertainty or requirements takes one model; "
+                         "sweep each variant on its own")
     uncertainty = None if cfg.uncertainty is None else \
         _uncertainty(cfg.uncertainty, silicone, nylon, raw)
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
-                          requirements=requirements)
+                          requirements=requirements, models=_models(cfg.model),
+                          supply_voltage=_supply(cfg.supply))
+
+
+def _models(model) -> tuple[str, ...]:
+    """The model variants of a config's ``model`` (one name or a list), checked."""
+    from .variables import MODELS
+
+    names = [model] if isinstance(model, str) else list(model)
+    if not names:
+        raise InputError(f"model: needs at least one of {', '.join(MODELS)}")
+    for i, name in enumerate(names):
+        field_name = "model" if isinstance(model, str) else f"model[{i}]"
+        if name not in MODELS:
+            raise InputError(f"{field_name}: must be one of {', '.join(MODELS)}, got {name!r}")
+    if len(set(names)) != len(names):
+        raise InputError(f"model: each variant once, got {', '.join(names)}")
+    return tuple(names)
+
+
+def _supply(supply) -> float | None:
+    """The supply voltage [V] of a config's ``supply``, or None."""
+    if supply is None:
+        return None
+    v = INPUTS["supply_voltage"]
+    return check_range(supply.voltage, "supply.voltage", v.kind, supply.units or "V", v.lo,
+                       v.hi, "V", lo_open=v.lo_open)
 
 
 # --------------------------------------------------------------------------- uncertainty

@@ -167,6 +167,9 @@ def read_material_set(kind: str, path, table: dict, known=()) -> tuple[str, dict
             sources[key] = note
         sources = {**params["sources"], **sources}
     rng = (doc.get("fitted_range") or {})
+    if kind == "silicone" and isinstance(rng, dict) and rng.get("stretch"):
+        params["stretch_range"] = tuple(float(x) for x in rng["stretch"])
+        sources["stretch_range"] = note
     params["description"] = (f"fitted {doc.get('model', '')} from {data.get('path', '?')}"
                              + (f", range {rng}" if rng else ""))
     params["sources"] = sources

@@ -41,7 +41,9 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (56.19e3, 10.49e3),
         "alpha": (0.2975, 2.770),
         "description": "BJB TC-5005 (the paper's silicone), stand-in fit",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "D: the fit's data window, stretch <= 4",
             "mu": "D/P: no TC-5005 data is published; Ogden N=2 fit (stretch <= 4) to the raw "
             "tensile data of Ecoflex 00-50, the nearest hardness class, Marechal et al., "
             "Soft Robotics 2021 (Soft-Robotics-Materials-Database)",
@@ -52,7 +54,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (16.11e3, -0.3231e3),
         "alpha": (1.977, -8.149),
         "description": "Smooth-On Ecoflex 00-30",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
+            "stretch <= 4",
             "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
             "alpha": "D: same fit",
         },
@@ -61,7 +66,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (30.30e3, -1.620e3),
         "alpha": (2.970, -6.266),
         "description": "Smooth-On Dragon Skin 10",
+        "stretch_range": (1.0, 4.0),
         "sources": {
+            "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
+            "stretch <= 4",
             "mu": "D: Ogden N=2 fit to Marechal et al., Soft Robotics 2021 database",
             "alpha": "D: same fit",
         },
@@ -70,7 +78,10 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (220e3, 0.0),
         "alpha": (2.0, 1.0),
         "description": "Wacker Elastosil M4601 (neo-Hookean)",
+        "stretch_range": (1.0, 2.0),
         "sources": {
+            "stretch_range": "P: a small-strain neo-Hookean equivalent of a Yeoh fit; trusted "
+            "to stretch 2 only",
             "mu": "D: neo-Hookean equal to Yeoh C1 = 0.11 MPa, Polygerinos et al., "
             "IEEE T-RO 31(3):778, 2015",
             "alpha": "D: neo-Hookean (alpha = 2)",
@@ -203,6 +214,7 @@ class Silicone:
     name: str = "custom"
     description: str = ""
     sources: Mapping[str, str] = field(default_factory=dict, compare=False)
+    stretch_range: tuple[float, float] = (0.0, float("inf"))
 
     @property
     def initial_shear_modulus(self) -> float:
@@ -284,8 +296,10 @@ class Nylon:
 
 
 def _values(material) -> dict:
+    # stretch_range is the fit's provenance, like its sources: not part of the config hash
     return {f.name: (list(v) if isinstance(v, tuple) else v)
-            for f in fields(material) if f.name not in ("description", "sources")
+            for f in fields(material) if f.name not in ("description", "sources",
+                                                        "stretch_range")
             for v in (getattr(material, f.name),)}
 
 
@@ -354,13 +368,23 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
     if not all(np.isfinite(mu + alpha)) or any(a == 0 for a in alpha):
         raise ValueError("silicone.alpha: must be finite and non-zero")
-    check_shear_modulus(0.5 * sum(m * a for m, a in zip(mu, alpha)))
+    mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
+    check_shear_modulus(mu0)
+    stretch_range = p.get("stretch_range", (0.0, float("inf")))
+    try:
+        lo, hi = (float(x) for x in stretch_range)
+    except (TypeError, ValueError):
+        raise ValueError("silicone.stretch_range: must be two stretches [lo, hi], got "
+                         f"{stretch_range!r}") from None
+    if not 0.0 <= lo < hi:
+        raise ValueError(f"silicone.stretch_range: must be 0 <= lo < hi, got [{lo:g}, {hi:g}]")
     return Silicone(
         mu=mu,
         alpha=alpha,
         name=name,
         description=p.get("description", ""),
         sources=dict(p.get("sources", {})),
+        stretch_range=(lo, hi),
     )
 
 

@@ -47,7 +47,8 @@ _GRID_RTOL = 1e-6
 _SLAB_VALUES = 2**20
 #: How an ``--at`` design was found: on the grid, by the exact model, interpolated.
 GRID, EXACT, INTERPOLATED = "grid point", "exact model", "interpolated"
-_LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1}
+_LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1,
+                "supply": 2, "supply_limited": 2, "load": 3, "load_limited": 3}
 
 
 # ---------------------------------------------------------------------------- parsing
@@ -100,6 +101,8 @@ class Condition:
     _PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
 
     def __init__(self, text: str):
+        if str(text).strip() == "valid":  # issue 10: clean designs, validity == 0
+            text = "validity == 0"
         m = self._PATTERN.match(str(text))
         if not m:
             raise InputError(f"--where: expected 'NAME OP VALUE [UNIT]' with OP one of "
@@ -124,8 +127,11 @@ class Condition:
 
 
 def parse_where(texts) -> list[Condition]:
-    """Parse ``--where`` strings (ANDed) into :class:`Condition` objects."""
-    return [Condition(t) for t in texts or ()]
+    """Parse ``--where`` strings (ANDed) into :class:`Condition` objects.
+
+    ``model == NAME`` stays a string: :func:`query_cube` selects that model's slice.
+    """
+    return [t if _MODEL_WHERE.match(str(t)) else Condition(t) for t in texts or ()]
 
 
 def _parse_sort(text):
@@ -210,7 +216,8 @@ def _slab_rows(ds, at_loc, r0, r1):
     index = {name: slice(i0, i1 + 1) for name, (i0, i1, _, _) in at_loc.items()
              if name != "radius"}
     index["radius"] = slice(r0, r1)
-    sub = ds[list(DESIGN) + [n for n in OPTIONAL if n in ds]].isel(index).load()
+    names = [n for n in (*DESIGN, *OPTIONAL) if n in ds]
+    sub = ds[names].isel(index).load()
     sub = sub.astype(float)  # limit: int8 (float when masked); NaN marks unknown below
     for name, (i0, i1, w, on_grid) in at_loc.items():
         if on_grid or i0 == i1:
@@ -243,7 +250,10 @@ def _slab_rows(ds, at_loc, r0, r1):
             rows[name] = np.broadcast_to(coord, shape).reshape(-1)
         else:
             rows[name] = np.full(int(np.prod(shape)), at_value(at_loc, name, ds))
-    for name in [*DESIGN, *(n for n in OPTIONAL if n in sub)]:
+    for name in DESIGN:
+        rows[name] = sub[name].transpose(*dims).values.reshape(-1) if name in sub else \
+            np.full(int(np.prod(shape)), np.nan)  # heating_time: only with a supply
+    for name in (n for n in OPTIONAL if n in sub):
         rows[name] = sub[name].transpose(*dims).values.reshape(-1)
     return rows
 
@@ -336,6 +346,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     if isinstance(at, (str, list, tuple)):
         at = parse_at(at)
     at = dict(at or {})
+    ds, where = _select_model(ds, where)
     conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
@@ -403,6 +414,31 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                        at=at, columns=columns)
 
 
+_MODEL_WHERE = re.compile(r"^\s*model\s*(==|=)\s*([A-Za-z0-9_]+)\s*$")
+
+
+def _select_model(ds, where):
+    """The cube at the model a ``--where "model == NAME"`` names, and the other conditions.
+
+    A cube of several models (docs/model.md s. 16) is queried one model at a time; without
+    such a condition it is refused with the models it has.
+    """
+    where = list(where or ())
+    names = [m.group(2) for m in (_MODEL_WHERE.match(str(w)) for w in where) if m]
+    rest = [w for w in where if not _MODEL_WHERE.match(str(w))]
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else \
+        str(ds.attrs.get("models", "paper")).split()
+    for name in names:
+        if name not in models:
+            raise InputError(f"--where model: this cube has {', '.join(models)}, got {name!r}")
+    if "model" not in ds.dims:
+        return ds, rest
+    if len(set(names)) != 1:
+        raise InputError(f"--where: this cube holds the models {', '.join(models)}; pick one "
+                         f"with --where \"model == {models[0]}\"")
+    return ds.sel(model=names[0], drop=True), rest
+
+
 def _sorted(rows, name, descending, limit):
     key = rows[name]
     # stable, NaN last either way; descending keeps ties in grid order too
@@ -434,7 +470,8 @@ def _sig3(x) -> str:
 
 def _cell(name, x) -> str:
     if name == "limit":
-        return {0.0: "stroke", 1.0: "strength"}.get(float(x), "boundary") \
+        return {0.0: "stroke", 1.0: "strength", 2.0: "supply", 3.0: "load"}.get(
+            float(x), "boundary") \
             if np.isfinite(x) else "boundary"
     value = float(to_display(name, x))
     if name in AXES:
@@ -471,6 +508,8 @@ def format_table(res) -> str:
             if name == "limit":
                 text = {"stroke": "stroke-limited (full range of motion)",
                         "strength": "strength-limited (the nylon's strength cuts in)",
+                        "supply": "supply-limited (the supply cannot heat it to T_max)",
+                        "load": "load-limited (the muscle stalls against the wrap's load)",
                         "boundary": "between grid points that disagree: refine the grid"
                         }[text]
             elif unit != "1":

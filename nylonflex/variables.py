@@ -17,8 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "UNCERTAIN", "VARIABLES", "Variable",
-           "display_label", "quantile_name", "range_text", "slab_done_attrs", "to_display"]
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY", "UNCERTAIN",
+           "VARIABLES", "Variable", "display_label", "quantile_name", "range_text",
+           "slab_done_attrs", "to_display"]
+
+#: Model variants, in the order of their integer codes in the kernels (docs/model.md
+#: s. 16); ``paper`` is the default.
+MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
@@ -65,6 +70,7 @@ class Variable:
     hi: float | None = None
     lo_open: bool = False
     hi_open: bool = False
+    by_model: bool = False
 
     def attrs(self) -> dict:
         """The attributes written to the cube (CF flags for flag variables)."""
@@ -74,17 +80,39 @@ class Variable:
             values, meanings = _FLAGS[self.name]
             out["flag_values"] = np.array(values, dtype=np.int8)
             out["flag_meanings"] = meanings
+        if self.name in _MASKS:
+            values, meanings = _MASKS[self.name]
+            out["flag_masks"] = np.array(values, dtype=np.int8)
+            out["flag_meanings"] = meanings
         return out
+
+    def dims_for(self, models) -> tuple[str, ...]:
+        """Dimensions in a cube of ``models`` (a string ``model`` dimension last when there
+        are several and this variable depends on the model)."""
+        return self.dims + ("model",) if self.by_model and len(models) > 1 else self.dims
 
 
 #: CF flag values and meanings of the flag variables.
-_FLAGS = {"limit": ((0, 1), "stroke_limited strength_limited"),
+_FLAGS = {"limit": ((0, 1, 2, 3),
+                    "stroke_limited strength_limited supply_limited load_limited"),
           "slab_done": ((0, 1), "missing done")}
+
+#: CF flag masks and meanings of the bit-field variables (docs/model.md s. 17).
+_MASKS = {"validity": ((1, 2, 4, 8),
+                       "self_contact stretch_beyond_fit under_one_turn chamber_closes")}
+
+#: Variables that are in a cube only when its config gives a supply.
+SUPPLY_ONLY = ("heating_time",)
 
 
 def _v(name, dims, units, long_name, description, display, kind, dtype="float64", **rng):
     return Variable(name, tuple(dims), units, long_name, description, display, kind, dtype,
                     **rng)
+
+
+def _m(*args, **kw):
+    """A variable that depends on the model variant."""
+    return _v(*args, by_model=True, **kw)
 
 
 _DEG = np.pi / 180.0
@@ -118,34 +146,54 @@ INPUTS = {v.name: v for v in [
     _v("base_thickness", [], "m", "base thickness", "thickness b of the bottom layer below "
        "the chamber floor; b = t unless given (docs/model.md s. 1)", "mm", "length",
        lo=0.1e-3, hi=0.05),
+    _v("supply_voltage", [], "V", "supply voltage", "steady voltage across the muscle; caps "
+       "its temperature at T_ss (docs/model.md s. 15)", "V", "voltage", lo=0.0, hi=1000.0,
+       lo_open=True),
 ]}
 
 DESIGN = {v.name: v for v in [
-    _v("usable_stroke", AXES, "1", "usable stroke",
+    _m("usable_stroke", AXES, "1", "usable stroke",
        "s* = min(s_max(C), s_lim), the stroke the muscle can use (docs/model.md s. 8)", "1",
        "dimensionless"),
-    _v("limit", AXES, "1", "limiting factor",
-       "0 stroke-limited (full range of motion), 1 strength-limited (docs/model.md s. 8)", "1",
+    _m("limit", AXES, "1", "limiting factor",
+       "0 stroke-limited (full range of motion), 1 strength-limited, 2 supply-limited, "
+       "3 load-limited (docs/model.md s. 8, 15, 16)", "1",
        "dimensionless", "int8"),
-    _v("pressure_max", AXES, "Pa", "maximum pressure", "p* = p(s*) (docs/model.md s. 8)", "kPa",
+    _m("pressure_max", AXES, "Pa", "maximum pressure", "p* = p(s*) (docs/model.md s. 8)", "kPa",
        "pressure"),
-    _v("torque_max", AXES, "N m", "maximum torque", "M* = M_P(p*) (docs/model.md s. 8)", "N mm",
+    _m("torque_max", AXES, "N m", "maximum torque", "M* = M_P(p*) (docs/model.md s. 8)", "N mm",
        "torque"),
-    _v("tip_force_max", AXES, "N", "maximum tip force", "F* = M*/L, blocked (docs/model.md s. 7-8)",
+    _m("tip_force_max", AXES, "N", "maximum tip force", "F* = M*/L, blocked (docs/model.md s. 7-8)",
        "N", "force"),
-    _v("bend_angle_max", AXES, "rad", "maximum bend angle",
+    _m("bend_angle_max", AXES, "rad", "maximum bend angle",
        "theta* = kappa(p*) L, free bending (docs/model.md s. 6, 8)", "deg", "angle"),
-    _v("range_fraction", AXES, "1", "range of motion fraction",
+    _m("range_fraction", AXES, "1", "range of motion fraction",
        "theta*/theta(s_max); 1 means a full range of motion (docs/model.md s. 8)", "1",
        "dimensionless"),
-    _v("nylon_force_max", AXES, "N", "nylon force at usable stroke", "F_n(s*) (docs/model.md s. 4)",
+    _m("nylon_force_max", AXES, "N", "nylon force at usable stroke", "F_n(s*) (docs/model.md s. 4)",
        "N", "force"),
-    _v("nylon_use", AXES, "1", "nylon strength use", "F_n(s*)/F_lim(C) (docs/model.md s. 4, 8)",
+    _m("nylon_use", AXES, "1", "nylon strength use", "F_n(s*)/F_lim(C) (docs/model.md s. 4, 8)",
        "1", "dimensionless"),
+    _v("muscle_length", AXES, "m", "muscle length", "length of muscle in the wrap "
+       "l_m = n P_out / cos psi (docs/model.md s. 15)", "mm", "length"),
+    _v("resistance", AXES, "ohm", "muscle resistance", "R = r' l_m (docs/model.md s. 15)",
+       "ohm", "resistance"),
+    _m("heating_power", AXES, "W", "heating power", "lambda' l_m (T* - T_amb), the steady "
+       "power that holds the muscle at its working temperature T* (docs/model.md s. 15)", "W",
+       "power"),
+    _m("heating_voltage", AXES, "V", "heating voltage", "sqrt(R P), the steady supply that "
+       "holds the muscle at T* (docs/model.md s. 15)", "V", "voltage"),
+    _m("cooling_time", AXES, "s", "cooling time", "time from T* until the free stroke is 5 % "
+       "of its value at T*, eq. (3) with V = 0 (docs/model.md s. 15)", "s", "time"),
+    _m("heating_time", AXES, "s", "heating time", "time at the supply voltage from ambient "
+       "until the free stroke is 95 % of its value at T* (docs/model.md s. 15)", "s", "time"),
+    _m("validity", AXES, "1", "validity flags", "bits: 1 self_contact, 2 stretch_beyond_fit, "
+       "4 under_one_turn, 8 chamber_closes; 0 a clean design (docs/model.md s. 17)", "1",
+       "dimensionless", "int8"),
 ]}
 
 CURVES = {v.name: v for v in [
-    _v("nylon_force", ["radius", "wall_thickness", "coil_index", "wrap_angle", "stroke"], "N",
+    _m("nylon_force", ["radius", "wall_thickness", "coil_index", "wrap_angle", "stroke"], "N",
        "nylon force", "tension F_n(s) in the wrap (docs/model.md s. 4)", "N", "force"),
     _v("nylon_force_limit", ["coil_index"], "N", "nylon force limit",
        "breaking force F_lim(C) = sigma_u(C) A_f (docs/model.md s. 2)", "N", "force"),
@@ -154,7 +202,7 @@ CURVES = {v.name: v for v in [
        "1", "dimensionless"),
     _v("chamber_pressure", ["stroke"], "Pa", "chamber pressure",
        "gauge pressure p(s), Boyle (docs/model.md s. 3)", "kPa", "pressure"),
-    _v("bend_angle", ["radius", "wall_thickness", "length", "pressure"], "rad", "bend angle",
+    _m("bend_angle", ["radius", "wall_thickness", "length", "pressure"], "rad", "bend angle",
        "free bending angle theta(p) = kappa(p) L (docs/model.md s. 6)", "deg", "angle"),
     _v("tip_force", ["radius", "wall_thickness", "length", "pressure"], "N", "tip force",
        "blocked tip force M_P(p)/L (docs/model.md s. 7)", "N", "force"),
@@ -182,6 +230,10 @@ UNCERTAIN = {v.name: v for v in [
        "nominal design without uncertainty (docs/uncertainty.md)", "1", "dimensionless",
        lo=0.0, hi=1.0),
 ]}
+
+#: The string coordinate of a cube of several model variants (docs/model.md s. 16).
+MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each slice "
+           "(docs/model.md s. 16)", "1", "dimensionless", "str")
 
 #: The mask of the radii a sweep has stored (1) or not yet (0).
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",

@@ -32,7 +32,7 @@ SMALL = {
 #: chart -> units its axes must show (the registry's display units).
 UNITS = {"fig12a": ["[N]"], "fig12b": ["[mm]", "[N mm]"], "fig12c": ["[mm]", "[deg]", "[%]"],
          "fig4": ["[kPa]"], "fig6": ["[kPa]", "[deg]"], "fig7": ["[kPa]", "[N]"],
-         "design_map": ["[mm]", "[N]"]}
+         "design_map": ["[mm]", "[N]"], "compare": ["[mm]", "[N]"]}
 
 
 @pytest.fixture(scope="module")

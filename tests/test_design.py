@@ -62,8 +62,9 @@ def brute_front(F):
 
 
 def cube_rows(ds):
-    flat = ds[list(DESIGN)].to_dataframe().reset_index()
-    return {k: flat[k].to_numpy(float) for k in [*AXES, *DESIGN]}
+    names = [n for n in DESIGN if n in ds]  # heating_time: only with a supply
+    flat = ds[names].to_dataframe().reset_index()
+    return {k: flat[k].to_numpy(float) for k in [*AXES, *names]}
 
 
 # ---------------------------------------------------------------------------- the paper

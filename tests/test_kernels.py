@@ -41,8 +41,11 @@ def test_design_variables_match_design_limits_everywhere(cube):
     exact = design_limits(*grids, base_thickness=cfg.base_thickness, silicone=cfg.silicone,
                           nylon=cfg.nylon)
     for name, expected in exact.items():
+        if name not in ds:  # heating_time: only in a cube with a supply
+            assert name == "heating_time" and np.all(np.isnan(expected))
+            continue
         got = ds[name].values
-        if name == "limit":
+        if name in ("limit", "validity"):
             np.testing.assert_array_equal(got, expected)
         else:
             np.testing.assert_allclose(got, expected, rtol=1e-9, atol=0, err_msg=name)

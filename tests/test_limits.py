@@ -13,7 +13,10 @@ from nylonflex.physics import bending, chamber, nylon, wrap
 from nylonflex.physics.limits import DESIGN_VARIABLES
 
 NAMES = {"usable_stroke", "limit", "pressure_max", "torque_max", "tip_force_max",
-         "bend_angle_max", "range_fraction", "nylon_force_max", "nylon_use"}
+         "bend_angle_max", "range_fraction", "nylon_force_max", "nylon_use",
+         # issue 10: heating, supply and validity
+         "muscle_length", "resistance", "heating_power", "heating_voltage", "cooling_time",
+         "heating_time", "validity"}
 
 
 def test_returns_every_design_variable_of_the_cube_table():

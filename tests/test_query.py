@@ -303,8 +303,9 @@ def test_at_between_grid_points_is_the_exact_model(ds, cube, capsys):
     res = query.query_cube(ds, at=at)
     exact = nf.design_limits(**at)
     assert res.point == query.EXACT and res.interpolated == ["wall_thickness"]
-    for name in query.DESIGN:
-        assert res.data[name][0] == exact[name], name
+    for name in query.DESIGN:  # heating_time: NaN without a supply, on both sides
+        assert res.data[name][0] == exact[name] or \
+            (np.isnan(res.data[name][0]) and np.isnan(exact[name])), name
     linear = query.query_cube(ds, at=at, interpolate=True)
     assert linear.point == query.INTERPOLATED
     assert linear.data["bend_angle_max"][0] != pytest.approx(exact["bend_angle_max"],

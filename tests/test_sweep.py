@@ -65,7 +65,8 @@ def test_cube_is_readable_by_h5py_and_netcdf4_with_units_and_provenance(tmp_path
         for name, var in nc.variables.items():
             assert var.units, name
         assert nc.variables["tip_force_max"].units == "N"
-        assert nc.variables["limit"].flag_meanings == "stroke_limited strength_limited"
+        assert nc.variables["limit"].flag_meanings == \
+            "stroke_limited strength_limited supply_limited load_limited"  # issue 10
     with h5py.File(path, "r") as f:
         assert f["tip_force_max"].compression == "gzip"
         assert f["tip_force_max"].chunks is not None

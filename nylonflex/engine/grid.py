@@ -14,13 +14,29 @@ from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke_max
 from ..physics.wrap import muscle_width
-from ..variables import COORDS, CURVES, DESIGN
+from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
 
 __all__ = ["FLOAT_DESIGN", "compute_slab", "coords", "cube_variables", "global_arrays",
            "plan_slabs", "slab_variables"]
 
 #: The float design variables in the registry's order (the kernel's ``out.design`` rows).
-FLOAT_DESIGN = tuple(n for n in DESIGN if n != "limit")
+FLOAT_DESIGN = tuple(n for n, v in DESIGN.items() if v.dtype == "float64")
+
+
+def cube_variables(cfg: ResolvedConfig) -> dict:
+    """``{name: (Variable, dims)}`` of every variable ``cfg``'s cube holds, in order.
+
+    With several models, the variables that depend on the model gain a last ``model``
+    dimension; ``heating_time`` is there only with a supply (docs/model.md s. 15-16); the
+    quantiles and feasibility only with ``uncertainty``/``requirements``.
+    """
+    from .sampled import uncertain_variables
+
+    out = {n: (v, v.dims_for(cfg.models)) for n, v in {**DESIGN, **CURVES}.items()
+           if cfg.supply_voltage is not None or n not in SUPPLY_ONLY}
+    # a sampled sweep's quantiles and feasibility (docs/uncertainty.md)
+    out.update({n: (v, v.dims) for n, v in uncertain_variables(cfg).items()})
+    return out
 
 
 def slab_variables() -> dict:
@@ -37,18 +53,11 @@ def coords(cfg: ResolvedConfig) -> dict:
     return out
 
 
-def cube_variables(cfg: ResolvedConfig) -> dict:
-    """Registry entries of every variable the cube of ``cfg`` holds, in order."""
-    from .sampled import uncertain_variables
-
-    return {**DESIGN, **CURVES, **uncertain_variables(cfg)}
-
-
 def _bytes_per_radius(cfg: ResolvedConfig) -> int:
     sizes = {k: len(v) for k, v in coords(cfg).items()}
-    variables = {**slab_variables(), **cube_variables(cfg)}
-    return sum(int(np.prod([sizes[d] for d in v.dims[1:]])) * np.dtype(v.dtype).itemsize
-               for v in variables.values() if v.dims and v.dims[0] == "radius")
+    sizes["model"] = len(cfg.models)
+    return sum(int(np.prod([sizes[d] for d in dims[1:]])) * np.dtype(v.dtype).itemsize
+               for v, dims in cube_variables(cfg).values() if dims[0] == "radius")
 
 
 def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
@@ -78,10 +87,39 @@ def _coil_table(cfg: ResolvedConfig):
 def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -> dict:
     """Every radius-dependent variable of the radii [i0, i1), as a dict of arrays.
 
-    ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers.
+    ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers. With
+    several models the kernel runs once a model and the model-dependent variables are
+    stacked along a last axis (docs/model.md s. 16).
     """
+    from ..physics.limits import MODELS
+
+    slabs = [_compute_model_slab(cfg, i0, i1, parallel, MODELS.index(m)) for m in cfg.models]
+    variables = cube_variables(cfg)
+    arrays = {}
+    for name, (v, dims) in variables.items():
+        if dims[0] != "radius":
+            continue
+        if dims[-1] == "model":
+            arrays[name] = np.stack([slab[name] for slab in slabs], axis=-1)
+        else:
+            arrays[name] = slabs[0][name]
+    return arrays
+
+
+def _muscle(cfg: ResolvedConfig):
+    from ..kernels.records import Muscle
+
+    ny = cfg.nylon
+    one = lambda x: np.array([float(x)])  # noqa: E731
+    return Muscle(one(ny.t_amb), one(ny.t_max), one(ny.gamma), one(ny.beta), one(ny.t_g),
+                  one(ny.sigma_g), one(ny.resistance_per_length),
+                  one(ny.heat_capacity_per_length), one(ny.heat_loss_per_length),
+                  one(ny.thermal_force_coefficient))
+
+
+def _compute_model_slab(cfg, i0, i1, parallel, model):
     from ..kernels import design
-    from ..kernels.records import GridAxes, GridOut, Nodes, Ogden
+    from ..kernels.records import GridAxes, GridOut, Nodes, Ogden, Options
 
     kernel = design.design_slab_parallel if parallel else design.design_slab_serial
     grid = GridAxes(radius=np.ascontiguousarray(cfg.axes["radius"][i0:i1]),
@@ -95,15 +133,17 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True) -
     shape = lambda name: [sizes[d] for d in CURVES[name].dims]  # noqa: E731
     design_shape = [sizes[d] for d in DESIGN["limit"].dims]
     out = GridOut(design=np.empty((len(FLOAT_DESIGN), *design_shape)),
-                  limit=np.empty(design_shape, dtype=np.int8),
+                  flags=np.empty((2, *design_shape), dtype=np.int8),
                   nylon_force=np.empty(shape("nylon_force")),
                   bend_angle=np.empty(shape("bend_angle")),
                   tip_force=np.empty(shape("tip_force")))
+    voltage = -1.0 if cfg.supply_voltage is None else float(cfg.supply_voltage)
+    options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
     kernel(grid, _coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
-           out)
+           _muscle(cfg), options, out)
     arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
-    arrays.update(limit=out.limit, nylon_force=out.nylon_force, bend_angle=out.bend_angle,
-                  tip_force=out.tip_force)
+    arrays.update(limit=out.flags[0], validity=out.flags[1], nylon_force=out.nylon_force,
+                  bend_angle=out.bend_angle, tip_force=out.tip_force)
     if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
         from .sampled import slab_statistics
 

@@ -26,15 +26,17 @@ from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
 
-#: Model variants :func:`evaluate` knows (docs/model.md).
-MODELS = ("paper",)
+from ..physics.limits import MODELS  # noqa: E402  (docs/model.md s. 16)
 
 #: Designs below which the serial loop is used (threads cost more than they save).
 _PARALLEL_FROM = 64
 #: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls use the serial loop.
 _SERIAL = threading.local()
 
-_FLOAT_DESIGN = [n for n in DESIGN if n != "limit"]
+_FLOAT_DESIGN = [n for n, v in DESIGN.items() if v.dtype == "float64"]
+_MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistance_per_length",
+                  "heat_capacity_per_length", "heat_loss_per_length",
+                  "thermal_force_coefficient")
 _SILICONE_FIELDS = ("mu", "alpha")
 _NYLON_TABLES = ("coil_index_table", "stroke_max_table", "tensile_strength_table")
 _NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_per_length",
@@ -42,7 +44,7 @@ _NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_
 
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
-             silicone="tc5005", nylon="silver_nylon66", model="paper"):
+             silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None):
     """Every design variable of designs that broadcast together (compiled, parallel).
 
     Parameters
@@ -68,14 +70,17 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
         value}``; every numeric field may be an array broadcasting against the designs (the
         tables with their columns on the last axis).
     model : str, default "paper"
-        Model variant, one of :data:`MODELS`.
+        Model variant, one of :data:`MODELS` (docs/model.md s. 16).
+    supply_voltage : float, optional
+        Steady supply voltage across the muscle [V], in (0, 1000]; None: no supply limit
+        (docs/model.md s. 15).
 
     Returns
     -------
     dict of str to ndarray
         The design variables of :data:`nylonflex.variables.DESIGN` (the same names, units
         and values as :func:`nylonflex.design_limits`), each of the broadcast shape;
-        ``limit`` is int8.
+        ``limit`` and ``validity`` are int8; ``heating_time`` is NaN without a supply.
 
     Raises
     ------
@@ -84,10 +89,13 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     """
     if model not in MODELS:
         raise ValueError(f"model: unknown model {_short(model)}; accepted: {', '.join(MODELS)}")
+    voltage = -1.0 if supply_voltage is None else float(
+        check_input("supply_voltage", supply_voltage))
     a, t, b = check_section(radius, wall_thickness, base_thickness)
     L = check_input("length", length)
     psi = check_wrap_angle(wrap_angle)
     ogden = _silicone_arrays(silicone)
+    stretch_max = _stretch_max(silicone)
     ny = _nylon_arrays(nylon)
     c = check_input("coil_index", coil_index, -np.inf, np.inf)
     table = ny["coil_index_table"]
@@ -115,23 +123,36 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     d_f = flat(ny["fibre_diameter"])
     force_limit = strength * (np.pi * d_f**2 / 4.0)
     width = d_f * (c_flat + 1.0)
+    muscle = [flat(ny[k]) for k in _MUSCLE_FIELDS]
+    options = (MODELS.index(model), voltage, stretch_max)
     return _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
-                (s_max, force_limit, width), ogden)
+                (s_max, force_limit, width), ogden, muscle, options)
 
 
-def _run(shape, n, design_arrays, coil_arrays, ogden):
+def _stretch_max(silicone) -> float:
+    """Top of the silicone set's fitted stretch range [-] (inf when it records none)."""
+    base = silicone
+    if isinstance(silicone, Mapping):
+        base = {k: v for k, v in silicone.items() if np.ndim(v) <= 1 or k == "stretch_range"}
+        base = {k: v for k, v in base.items() if k not in _SILICONE_FIELDS}
+    return float(silicone_parameters(base).stretch_range[1])
+
+
+def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     from ..kernels import design as kernels
-    from ..kernels.records import CoilTable, Nodes, Ogden, PointDesigns, PointOut
+    from ..kernels.records import (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns,
+                                   PointOut)
 
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
-    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty(n, dtype=np.int8))
+    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty((2, n), dtype=np.int8))
     kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM and \
         not getattr(_SERIAL, "on", False) else kernels.design_points_serial
     kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
-           Nodes(*quadrature_nodes()), P_ATM, out)
+           Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
     result = {name: out.design[j].reshape(shape) for j, name in enumerate(_FLOAT_DESIGN)}
-    result["limit"] = out.limit.reshape(shape)
+    result["limit"] = out.flags[0].reshape(shape)
+    result["validity"] = out.flags[1].reshape(shape)
     return {name: result[name] for name in DESIGN}
 
 
@@ -148,7 +169,8 @@ def serial():
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
-                  silicone="tc5005", nylon="silver_nylon66"):
+                  silicone="tc5005", nylon="silver_nylon66", model="paper",
+                  supply_voltage=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
     The compiled :func:`evaluate` with INTERFACE.md's positional signature: floats (and an
@@ -156,10 +178,12 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     units and errors as :func:`evaluate`; docs/model.md s. 8.
     """
     out = evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
-                   base_thickness=base_thickness, silicone=silicone, nylon=nylon)
+                   base_thickness=base_thickness, silicone=silicone, nylon=nylon, model=model,
+                   supply_voltage=supply_voltage)
     if out["limit"].ndim:
         return out
-    return {name: int(v) if name == "limit" else float(v) for name, v in out.items()}
+    return {name: int(v) if name in ("limit", "validity") else float(v)
+            for name, v in out.items()}
 
 
 # --------------------------------------------------------------------------- materials

@@ -29,6 +29,8 @@ def provenance(cfg: ResolvedConfig) -> dict:
 
     def material(m):
         d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}
+        if hasattr(m, "stretch_range"):  # the silicone fit's stretch window
+            d["stretch_range"] = [float(x) for x in m.stretch_range]
         return yaml.safe_dump(d, sort_keys=False, width=100)
 
     return {
@@ -55,6 +57,8 @@ def provenance(cfg: ResolvedConfig) -> dict:
                        f"{NEWTON_RTOL:g}, stroke {STROKE_RTOL:g}"),
         "model": "docs/model.md (nylonflex), after the paper 'Soft fluidic actuator based on "
                  "nylon artificial muscles' and Polygerinos et al. 2015",
+        "models": " ".join(cfg.models),
+        "supply_voltage": "none" if cfg.supply_voltage is None else f"{cfg.supply_voltage:g} V",
         "complete": "false",
         **_sampling(cfg),
     }

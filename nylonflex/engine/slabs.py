@@ -25,7 +25,7 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..units import InputError
-from .grid import compute_slab, coords, global_arrays
+from .grid import compute_slab, coords, cube_variables, global_arrays
 
 __all__ = ["LocalExecutor", "MemorySink", "RunStats", "run_slabs", "set_workers"]
 
@@ -142,14 +142,13 @@ class MemorySink:
     """Collects a sweep's slabs into arrays; :meth:`dataset` makes the cube."""
 
     def __init__(self, cfg: ResolvedConfig):
-        from .grid import cube_variables
-
         self.cfg = cfg
         self.coords = coords(cfg)
         sizes = {k: len(v) for k, v in self.coords.items()}
+        sizes["model"] = len(cfg.models)
         self.variables = cube_variables(cfg)
-        self.data = {name: np.empty([sizes[d] for d in v.dims], dtype=v.dtype)
-                     for name, v in self.variables.items()}
+        self.data = {name: np.empty([sizes[d] for d in dims], dtype=v.dtype)
+                     for name, (v, dims) in self.variables.items()}
         self.data.update(global_arrays(cfg))
         self.done = np.zeros(sizes["radius"], np.int8)
 
@@ -162,12 +161,16 @@ class MemorySink:
         """The cube as an :class:`xarray.Dataset` (every variable with its registry attrs)."""
         import xarray as xr
 
-        from ..variables import COORDS, slab_done_attrs
+        from ..variables import COORDS, MODEL, slab_done_attrs
 
+        coords = {name: (name, values, COORDS[name].attrs())
+                  for name, values in self.coords.items()}
+        if len(self.cfg.models) > 1:
+            coords["model"] = ("model", np.array(self.cfg.models, dtype=object),
+                               MODEL.attrs())
         ds = xr.Dataset(
-            {name: (v.dims, self.data[name], v.attrs()) for name, v in self.variables.items()},
-            coords={name: (name, values, COORDS[name].attrs())
-                    for name, values in self.coords.items()},
-            attrs=attrs)
+            {name: (dims, self.data[name], v.attrs())
+             for name, (v, dims) in self.variables.items()},
+            coords=coords, attrs=attrs)
         ds["slab_done"] = ("radius", self.done, slab_done_attrs())
         return ds

@@ -23,34 +23,59 @@ import math
 import numpy as np
 from numba import prange
 
-from ..physics.bending import NEWTON_RTOL, _curvature, _pressure_moment
-from ..physics.chamber import _gauge_pressure
-from ..physics.limits import _design_values, _stroke_state
-from ..physics.silicone import _stress_and_slope
+from ..physics.bending import NEWTON_RTOL, _curvature, _curvature_of, _pressure_moment
+from ..physics.chamber import _gauge_pressure, _solid_fraction
+from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
+                              _design_state, _design_values, _model_state,
+                              _nylon_force_model, _reach,
+                              _stroke_state, _thermal_values, _validity,
+                              _working_temperatures)
+from ..physics.nylon import _stroke_shape
+from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.wrap import _pitch, _wrap_force
 from ._compile import jit_kernel
 
-#: Number of float design variables in ``out.design``: the registry's design variables
-#: less ``limit``.
-N_FLOAT_DESIGN = 8
+#: Number of float design variables in ``out.design``: the registry's float design
+#: variables (all but ``limit`` and ``validity``), in its order.
+N_FLOAT_DESIGN = 14
 
 
-def _design_slab(grid, coil, silicone, nodes, out):
+def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     """Fill ``out`` (a :class:`~.records.GridOut`) for the radii ``grid.radius``.
 
     ``grid`` is a :class:`~.records.GridAxes` (all other axes whole), ``coil`` a
     :class:`~.records.CoilTable` with one entry a coil index of the axis, ``silicone`` an
     :class:`~.records.Ogden` of 1-D arrays, ``nodes`` the quadrature's
-    :class:`~.records.Nodes`. ``out.design[v]`` holds the float variables in the registry's
-    order less ``limit``; shapes (na, nt, nl, nc, npsi), curves as the registry says.
+    :class:`~.records.Nodes`, ``muscle`` a :class:`~.records.Muscle` of one entry and
+    ``options`` the :class:`~.records.Options` (model code, supply, fitted stretch).
+    ``out.design[v]`` holds the float variables in the registry's order; shapes (na, nt, nl,
+    nc, npsi), curves as the registry says.
+
+    The paper's model without a supply runs the loops it always ran (the stroke state once
+    per (a, t, C, psi)); a variant or a supply runs :func:`_model_state`, per length when
+    the supply makes the reachable stroke depend on the muscle's length.
     """
     radius, wall, length, wrap = grid.radius, grid.wall, grid.length, grid.wrap
     stroke, pressure, p_atm = grid.stroke, grid.pressure, grid.p_atm
     mu, alpha = silicone.mu, silicone.alpha
     x_base, w_base, phi_trig, w_phi = nodes.x_base, nodes.w_base, nodes.phi_trig, nodes.w_phi
     # unpacked before the loop: a record's fields written inside prange are lost (Numba)
-    out_design, out_limit, out_force, out_angle, out_tip = out
+    out_design, out_flags, out_force, out_angle, out_tip = out
     coil_s_max, coil_force_limit, coil_width = coil
+    model, voltage, stretch_max = options
+    t_amb = muscle.t_amb[0]
+    t_max = muscle.t_max[0]
+    gamma = muscle.gamma[0]
+    beta = muscle.beta[0]
+    t_g = muscle.t_g[0]
+    sigma_g = muscle.sigma_g[0]
+    r_per_len = muscle.r_per_len[0]
+    c_per_len = muscle.c_per_len[0]
+    loss_per_len = muscle.loss_per_len[0]
+    force_coeff = muscle.force_coeff[0]
+    default = model == PAPER and voltage <= 0.0
+    cauchy = model == CAUCHY_MOMENT
+    top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
     b_fixed = grid.base_thickness
     na = radius.shape[0]
     nt = wall.shape[0]
@@ -64,28 +89,55 @@ def _design_slab(grid, coil, silicone, nodes, out):
     stroke_hoop = np.empty(ns)
     for js in range(ns):
         stroke_pressure[js] = _gauge_pressure(stroke[js], p_atm)
-        stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
+        if model == PAPER_EQ10:
+            stroke_hoop[js] = _equibiaxial_stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
+        else:
+            stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
     for k in prange(na * nt):
         ia = k // nt
         it = k % nt
         a = radius[ia]
         t = wall[it]
         b = t if b_fixed <= 0.0 else b_fixed
+        solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         for ic in range(nc):
             s_max = coil_s_max[ic]
             f_lim = coil_force_limit[ic]
-            kappa_full = _curvature(_pressure_moment(_gauge_pressure(s_max, p_atm), a, b),
-                                    a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi, 0.0,
-                                    NEWTON_RTOL)
+            scale = s_max / top
+            kappa_full = 0.0
+            if default:
+                kappa_full = _curvature(_pressure_moment(_gauge_pressure(s_max, p_atm), a, b),
+                                        a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi,
+                                        0.0, NEWTON_RTOL)
             for ip in range(npsi):
-                lever = _pitch(a, t, b, wrap[ip], coil_width[ic]) / math.cos(wrap[ip])
-                st = _stroke_state(a, t, b, lever, f_lim, s_max, kappa_full, mu, alpha,
-                                   x_base, w_base, phi_trig, w_phi, p_atm)
+                pitch = _pitch(a, t, b, wrap[ip], coil_width[ic])
+                lever = pitch / math.cos(wrap[ip])
+                if default:
+                    st = _stroke_state(a, t, b, lever, f_lim, s_max, kappa_full, mu, alpha,
+                                       x_base, w_base, phi_trig, w_phi, p_atm)
+                    closes = False
+                    temps = _working_temperatures(model, st[0], t_max, scale, t_amb, t_max,
+                                                  gamma, beta, t_g, sigma_g)
+                else:
+                    st = (0.0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)
+                    closes = False
+                    temps = (0.0, 0.0, 0.0)
                 for il in range(nl):
+                    if not default and (il == 0 or voltage > 0.0):
+                        t_reach, s_free, limited = _reach(
+                            s_max, scale, length[il], pitch, a, t, b, wrap[ip], voltage,
+                            t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len, loss_per_len)
+                        ms = _model_state(model, a, t, b, lever, f_lim, s_free, s_max,
+                                          force_coeff * (t_reach - t_amb), limited, mu, alpha,
+                                          x_base, w_base, phi_trig, w_phi, p_atm)
+                        st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
+                        closes = ms[7]
+                        temps = _working_temperatures(model, ms[0], t_reach, scale, t_amb,
+                                                      t_max, gamma, beta, t_g, sigma_g)
                     v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim,
                                        length[il])
                     out_design[0, ia, it, il, ic, ip] = v[0]
-                    out_limit[ia, it, il, ic, ip] = v[1]
+                    out_flags[0, ia, it, il, ic, ip] = v[1]
                     out_design[1, ia, it, il, ic, ip] = v[2]
                     out_design[2, ia, it, il, ic, ip] = v[3]
                     out_design[3, ia, it, il, ic, ip] = v[4]
@@ -93,33 +145,56 @@ def _design_slab(grid, coil, silicone, nodes, out):
                     out_design[5, ia, it, il, ic, ip] = v[6]
                     out_design[6, ia, it, il, ic, ip] = v[7]
                     out_design[7, ia, it, il, ic, ip] = v[8]
+                    th = _thermal_values(length[il], pitch, a, t, b, wrap[ip], voltage,
+                                         temps[0], temps[1], temps[2], t_amb, r_per_len,
+                                         c_per_len, loss_per_len)
+                    out_design[8, ia, it, il, ic, ip] = th[0]
+                    out_design[9, ia, it, il, ic, ip] = th[1]
+                    out_design[10, ia, it, il, ic, ip] = th[2]
+                    out_design[11, ia, it, il, ic, ip] = th[3]
+                    out_design[12, ia, it, il, ic, ip] = th[4]
+                    out_design[13, ia, it, il, ic, ip] = th[5]
+                    out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4], a, t, b,
+                                                              stretch_max,
+                                                              length[il] / pitch, closes)
                 for js in range(ns):
-                    out_force[ia, it, ic, ip, js] = _wrap_force(
-                        stroke_pressure[js], stroke_hoop[js], a, t, lever)
+                    if model == INCOMPRESSIBLE_WALL:
+                        f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
+                                               alpha, p_atm)[0]
+                        out_force[ia, it, ic, ip, js] = f if f < math.inf else math.nan
+                    else:
+                        out_force[ia, it, ic, ip, js] = _wrap_force(
+                            stroke_pressure[js], stroke_hoop[js], a, t, lever)
         kappa = 0.0
         for jp in range(npr):
             moment = _pressure_moment(pressure[jp], a, b)
             guess = kappa * pressure[jp] / pressure[jp - 1] if kappa > 0.0 else 0.0
-            kappa = _curvature(moment, a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi,
-                               guess, NEWTON_RTOL)
+            kappa = _curvature_of(moment, a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi,
+                                  guess, NEWTON_RTOL, cauchy)
             for il in range(nl):
                 out_angle[ia, it, il, jp] = kappa * length[il]
                 out_tip[ia, it, il, jp] = moment / length[il]
 
 
-def _design_points(designs, coil, silicone, nodes, p_atm, out):
+def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     """Every design variable of scattered designs, one a design (``prange`` over them).
 
-    ``designs`` is a :class:`~.records.PointDesigns` and ``coil`` a
-    :class:`~.records.CoilTable`, one entry a design. ``silicone`` holds 2-D arrays
-    (row, term) with one row for all designs or one row a design. The loop body is the one
-    :func:`nylonflex.physics.design_limits` runs, so both give the same numbers.
+    ``designs`` is a :class:`~.records.PointDesigns`, ``coil`` a
+    :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
+    design. ``silicone`` holds 2-D arrays (row, term) with one row for all designs or one
+    row a design. The loop body is the one :func:`nylonflex.physics.design_limits` runs, so
+    both give the same numbers.
     """
     radius, wall, base, length, wrap = designs
     s_max_all, f_lim_all, width_all = coil
     mu_all, alpha_all = silicone
     x_base, w_base, phi_trig, w_phi = nodes
-    out_design, out_limit = out
+    out_design, out_flags = out
+    model, voltage, stretch_max = options
+    t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
+        muscle.t_amb, muscle.t_max, muscle.gamma, muscle.beta, muscle.t_g, muscle.sigma_g
+    r_all, c_all, loss_all, coeff_all = \
+        muscle.r_per_len, muscle.c_per_len, muscle.loss_per_len, muscle.force_coeff
     n = radius.shape[0]
     step = 0 if mu_all.shape[0] == 1 else 1  # one row for all, or one a design
     for i in prange(n):
@@ -131,12 +206,21 @@ def _design_points(designs, coil, silicone, nodes, p_atm, out):
         b = base[i]
         psi = wrap[i]
         f_lim = f_lim_all[i]
-        lever = _pitch(a, t, b, psi, width_all[i]) / math.cos(psi)
-        st = _stroke_state(a, t, b, lever, f_lim, s_max_all[i], 0.0, mu, alpha, x_base,
-                           w_base, phi_trig, w_phi, p_atm)
+        s_max = s_max_all[i]
+        t_amb = t_amb_all[i]
+        t_max = t_max_all[i]
+        scale = s_max / _stroke_shape(t_max, t_amb, gamma_all[i], beta_all[i], t_g_all[i],
+                                      sigma_g_all[i])
+        pitch = _pitch(a, t, b, psi, width_all[i])
+        lever = pitch / math.cos(psi)
+        # one call, no branch in the prange body (writes after a branch were lost)
+        st = _design_state(model, voltage, a, t, b, length[i], psi, pitch, lever, f_lim, s_max,
+                           scale, t_amb, t_max, gamma_all[i], beta_all[i], t_g_all[i],
+                           sigma_g_all[i], r_all[i], loss_all[i], coeff_all[i], mu, alpha,
+                           x_base, w_base, phi_trig, w_phi, p_atm)
         v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
         out_design[0, i] = v[0]
-        out_limit[i] = v[1]
+        out_flags[0, i] = v[1]
         out_design[1, i] = v[2]
         out_design[2, i] = v[3]
         out_design[3, i] = v[4]
@@ -144,6 +228,17 @@ def _design_points(designs, coil, silicone, nodes, p_atm, out):
         out_design[5, i] = v[6]
         out_design[6, i] = v[7]
         out_design[7, i] = v[8]
+        temps = _working_temperatures(model, v[0], st[8], scale, t_amb, t_max, gamma_all[i],
+                                      beta_all[i], t_g_all[i], sigma_g_all[i])
+        th = _thermal_values(length[i], pitch, a, t, b, psi, voltage, temps[0], temps[1],
+                             temps[2], t_amb, r_all[i], c_all[i], loss_all[i])
+        out_design[8, i] = th[0]
+        out_design[9, i] = th[1]
+        out_design[10, i] = th[2]
+        out_design[11, i] = th[3]
+        out_design[12, i] = th[4]
+        out_design[13, i] = th[5]
+        out_flags[1, i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, st[7])
 
 
 #: Threaded (Numba prange) and serial compilations of the same loops. The serial ones are

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["AngleTables", "CoilTable", "Control", "GridAxes", "GridOut", "Muscles", "Nodes",
-           "Ogden", "PointDesigns", "PointOut", "SimOut", "Supply"]
+__all__ = ["AngleTables", "CoilTable", "Control", "GridAxes", "GridOut", "Muscle", "Muscles",
+           "Nodes", "Ogden", "Options", "PointDesigns", "PointOut", "SimOut", "Supply"]
 
 #: Ogden constants of one silicone: ``mu`` [Pa] and ``alpha`` [-], one entry per term.
 #: The pointwise kernel takes 2-D arrays (sample, term) with one row or one row a design.
@@ -31,16 +31,30 @@ GridAxes = namedtuple("GridAxes", "radius wall length wrap base_thickness stroke
 CoilTable = namedtuple("CoilTable", "s_max force_limit width")
 
 #: Output arrays of the grid kernel: ``design`` (float design variables, the registry's
-#: order less ``limit``, then the slab's design shape), ``limit`` (int8), ``nylon_force``,
+#: order less ``limit``, then the slab's design shape), ``flags`` (int8, rows ``limit`` and
+#: ``validity``: one array, since Numba's parallel loops lost the writes to a second int8
+#: output of the same record), ``nylon_force``,
 #: ``bend_angle``, ``tip_force`` (the registry's dims).
-GridOut = namedtuple("GridOut", "design limit nylon_force bend_angle tip_force")
+GridOut = namedtuple("GridOut", "design flags nylon_force bend_angle tip_force")
+
+#: The muscle's thermal and eq. (1)-(2) constants, float64 arrays of one entry (the grid
+#: kernel) or one a design (the pointwise kernel): ``t_amb``, ``t_max``, ``t_g`` [K],
+#: ``gamma`` [1/K], ``beta`` [-], ``sigma_g`` [K], ``r_per_len`` r' [ohm/m], ``c_per_len``
+#: c' [J/(K m)], ``loss_per_len`` lambda' [W/(K m)], ``force_coeff`` c of eq. (1) [N/K].
+Muscle = namedtuple("Muscle", "t_amb t_max gamma beta t_g sigma_g r_per_len c_per_len "
+                              "loss_per_len force_coeff")
+
+#: Run options: ``model`` (int code of ``physics.limits.MODELS``), ``voltage`` the supply
+#: [V] (<= 0: none), ``stretch_max`` the top of the silicone's fitted stretch range [-].
+Options = namedtuple("Options", "model voltage stretch_max")
 
 #: Scattered designs, one entry each: ``radius``, ``wall``, ``base``, ``length`` [m],
 #: ``wrap`` [rad].
 PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
 
-#: Output of the pointwise kernel: ``design`` (float variables, shape (8, n)) and ``limit``.
-PointOut = namedtuple("PointOut", "design limit")
+#: Output of the pointwise kernel: ``design`` (float variables, shape (14, n)) and ``flags``
+#: (int8, shape (2, n): ``limit`` and ``validity``).
+PointOut = namedtuple("PointOut", "design flags")
 
 # ----------------------------------------------------------------- the closed loop
 #: The shared supply and the sampling: ``dt`` [s], ``voltage`` [V],

@@ -80,8 +80,24 @@ def _pressure_moment(pressure, radius, base_thickness):
 
 
 @formula
+def _section_stress(stretch, mu, alpha, cauchy):
+    """Stress of the moment integral and its slope [Pa]: nominal S(l), or Cauchy l S(l)."""
+    s, ds = _stress_and_slope(stretch, mu, alpha)
+    if cauchy:
+        return stretch * s, s + stretch * ds
+    return s, ds
+
+
+@formula
 def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi):
-    """int over the half disc of radius R of S(1 + kappa y) y dA, and its kappa-derivative.
+    """int over the half disc of radius R of S(1 + kappa y) y dA, and its kappa-derivative."""
+    return _half_disc_moment_of(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi,
+                                False)
+
+
+@formula
+def _half_disc_moment_of(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi, cauchy):
+    """:func:`_half_disc_moment` with nominal (``cauchy`` False) or Cauchy stress.
 
     ``phi_trig`` holds cos and sin of the nodes phi_i on [0, pi/2] (rows 0 and 1).
     """
@@ -92,7 +108,7 @@ def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi):
     for i in range(w_phi.shape[0]):
         c = phi_trig[0, i]
         y = base_thickness + outer * phi_trig[1, i]
-        s, ds = _stress_and_slope(1.0 + kappa * y, mu, alpha)
+        s, ds = _section_stress(1.0 + kappa * y, mu, alpha, cauchy)
         w = w_phi[i] * half * r2 * c * c * y
         m += w * s
         dm += w * ds * y
@@ -103,26 +119,46 @@ def _half_disc_moment(kappa, outer, base_thickness, mu, alpha, phi_trig, w_phi):
 def _material_moment(kappa, radius, wall_thickness, base_thickness, mu, alpha,
                      x_base, w_base, phi_trig, w_phi):
     """M_S(kappa) [N m] and dM_S/dkappa [N m^2] (docs/model.md section 6)."""
+    return _material_moment_of(kappa, radius, wall_thickness, base_thickness, mu, alpha,
+                               x_base, w_base, phi_trig, w_phi, False)
+
+
+@formula
+def _material_moment_of(kappa, radius, wall_thickness, base_thickness, mu, alpha,
+                        x_base, w_base, phi_trig, w_phi, cauchy):
+    """:func:`_material_moment` with nominal or (``cauchy``) Cauchy stress (docs/model.md s. 16)."""
     m = 0.0
     dm = 0.0
     half = 0.5 * base_thickness
     width = 2.0 * (radius + wall_thickness)
     for i in range(x_base.shape[0]):
         y = half * (x_base[i] + 1.0)
-        s, ds = _stress_and_slope(1.0 + kappa * y, mu, alpha)
+        s, ds = _section_stress(1.0 + kappa * y, mu, alpha, cauchy)
         w = w_base[i] * half * width * y
         m += w * s
         dm += w * ds * y
-    mo, dmo = _half_disc_moment(kappa, radius + wall_thickness, base_thickness, mu, alpha,
-                                phi_trig, w_phi)
-    mi, dmi = _half_disc_moment(kappa, radius, base_thickness, mu, alpha, phi_trig, w_phi)
+    mo, dmo = _half_disc_moment_of(kappa, radius + wall_thickness, base_thickness, mu, alpha,
+                                   phi_trig, w_phi, cauchy)
+    mi, dmi = _half_disc_moment_of(kappa, radius, base_thickness, mu, alpha, phi_trig, w_phi,
+                                   cauchy)
     return m + mo - mi, dm + dmo - dmi
 
 
 @formula
 def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
                x_base, w_base, phi_trig, w_phi, guess, rtol):
+    """Solve M_S(kappa) = moment for kappa >= 0 [1/m] (nominal stress; :func:`_curvature_of`)."""
+    return _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
+                         x_base, w_base, phi_trig, w_phi, guess, rtol, False)
+
+
+@formula
+def _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
+                  x_base, w_base, phi_trig, w_phi, guess, rtol, cauchy):
     """Solve M_S(kappa) = moment for kappa >= 0 [1/m] by safeguarded Newton.
+
+    ``cauchy`` integrates the Cauchy stress l S(l) instead of the nominal S(l)
+    (``cauchy_moment``, docs/model.md s. 16).
 
     ``guess`` <= 0 starts from the linear (small-angle) solution. M_S is smooth and strictly
     increasing, so the root is unique; a step that leaves the bracket is replaced by
@@ -133,14 +169,14 @@ def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
     if guess > 0.0:
         k = guess
     else:
-        m0, dm0 = _material_moment(0.0, radius, wall_thickness, base_thickness, mu, alpha,
-                                   x_base, w_base, phi_trig, w_phi)
+        m0, dm0 = _material_moment_of(0.0, radius, wall_thickness, base_thickness, mu,
+                                      alpha, x_base, w_base, phi_trig, w_phi, cauchy)
         k = moment / dm0
     lo = 0.0
     hi = math.inf
     for _ in range(200):
-        m, dm = _material_moment(k, radius, wall_thickness, base_thickness, mu, alpha,
-                                 x_base, w_base, phi_trig, w_phi)
+        m, dm = _material_moment_of(k, radius, wall_thickness, base_thickness, mu, alpha,
+                                    x_base, w_base, phi_trig, w_phi, cauchy)
         f = m - moment
         if f == 0.0:
             return k

@@ -14,11 +14,29 @@ import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
 from ._formula import check_input, check_section, check_wrap_angle, formula, scalar_or_array
-from .bending import NEWTON_RTOL, _curvature, _pressure_moment, quadrature_nodes
-from .chamber import P_ATM, _gauge_pressure
-from .wrap import _nylon_force_and_slope, _pitch
+from .bending import NEWTON_RTOL, _curvature, _curvature_of, _pressure_moment, quadrature_nodes
+from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
+                      _solid_fraction)
+from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke
+from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
+from .thermal import _cooling_time, _heating_power, _heating_time, _steady_temperature
+from .wrap import _muscle_length, _nylon_force_and_slope, _pitch, _wrap_force
 
-__all__ = ["DESIGN_VARIABLES", "design_limits", "stroke_limit"]
+__all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "stroke_limit"]
+
+from ..variables import MODELS  # noqa: E402  (the registry holds the names)
+PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT = range(5)
+
+#: Bits of the ``validity`` flag (docs/model.md s. 17).
+VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
+                  "chamber_closes": 8}
+
+#: Fraction of the free stroke that counts as reached (heating) or let go (cooling) [-].
+HEATED_FRACTION = 0.95
+COOLED_FRACTION = 0.05
+
+#: Relative shortfall below the free stroke that counts as load-limited [-].
+LOAD_RTOL = 1e-9
 
 #: The names :func:`design_limits` returns, in the cube's order (INTERFACE.md).
 DESIGN_VARIABLES = (
@@ -31,10 +49,39 @@ DESIGN_VARIABLES = (
     "range_fraction",
     "nylon_force_max",
     "nylon_use",
+    "muscle_length",
+    "resistance",
+    "heating_power",
+    "heating_voltage",
+    "cooling_time",
+    "heating_time",
+    "validity",
 )
 
 #: Relative Newton step below which s_lim counts as converged [-].
 STROKE_RTOL = 1e-10
+
+
+@formula
+def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
+    """F_n(s) and dF_n/ds [N] of a model variant (``solid`` = A_s/A_out, wall variant only).
+
+    ``paper_eq10`` takes the hoop stress of the paper's eqs. (10)-(12),
+    ``incompressible_wall`` the chamber pressure with a conserved wall area; the others
+    are the paper's F_n (docs/model.md s. 4, 15).
+    """
+    if model == PAPER_EQ10:
+        p = _gauge_pressure(stroke, p_atm)
+        dp = _gauge_pressure_slope(stroke, p_atm)
+        s_theta, ds_dlam = _equibiaxial_stress_and_slope(1.0 - stroke, mu, alpha)
+    elif model == INCOMPRESSIBLE_WALL:
+        p, dp = _gauge_pressure_wall(stroke, p_atm, solid)
+        s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
+    else:
+        return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
+    sign = 1.0 if s_theta >= 0.0 else -1.0
+    force = _wrap_force(p, s_theta, radius, wall_thickness, lever)
+    return force, (dp * radius - sign * ds_dlam * wall_thickness) * lever
 
 
 @formula
@@ -44,7 +91,16 @@ def _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu, alpha, 
     s_lim solves F_n(s) = F_lim on (0, s_max) by Newton from s_max, safeguarded by
     bisection; F_n is increasing with F_n(0) = 0.
     """
-    f, df = _nylon_force_and_slope(s_max, radius, wall_thickness, lever, mu, alpha, p_atm)
+    return _stroke_limit_model(PAPER, force_limit, s_max, radius, wall_thickness, lever, 0.0,
+                               mu, alpha, p_atm, rtol)
+
+
+@formula
+def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever, solid, mu,
+                        alpha, p_atm, rtol):
+    """:func:`_stroke_limit` for a model variant's F_n, below the stroke ``s_max``."""
+    f, df = _nylon_force_model(model, s_max, radius, wall_thickness, lever, solid, mu, alpha,
+                               p_atm)
     if f <= force_limit:
         return s_max, 0, f
     lo = 0.0
@@ -63,9 +119,217 @@ def _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu, alpha, 
             s = s_new
             break
         s = s_new
-        f, df = _nylon_force_and_slope(s, radius, wall_thickness, lever, mu, alpha, p_atm)
-    f, df = _nylon_force_and_slope(s, radius, wall_thickness, lever, mu, alpha, p_atm)
+        f, df = _nylon_force_model(model, s, radius, wall_thickness, lever, solid, mu, alpha,
+                                   p_atm)
+    f, df = _nylon_force_model(model, s, radius, wall_thickness, lever, solid, mu, alpha,
+                               p_atm)
     return s, 1, f
+
+
+@formula
+def _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, alpha, p_atm,
+                    rtol):
+    """Stroke where the wrap's load meets the muscle's line, F_n(s) = F_b (1 - s/s_free) [-].
+
+    ``coupled_muscle`` (docs/model.md s. 16): g(s) = F_n(s)/F_b - (1 - s/s_free) rises from
+    -1 at s = 0 to F_n(s_free)/F_b >= 0, so the root in [0, s_free] is unique; safeguarded
+    Newton from the linearised root. Written over F_b so an infinitely strong muscle
+    (F_b -> inf) gives s_free.
+    """
+    if force_blocked <= 0.0:
+        return 0.0
+    f_top = _nylon_force_and_slope(s_free, radius, wall_thickness, lever, mu, alpha, p_atm)[0]
+    lo = 0.0
+    hi = s_free
+    s = s_free / (1.0 + f_top / force_blocked)
+    for _ in range(200):
+        f, df = _nylon_force_and_slope(s, radius, wall_thickness, lever, mu, alpha, p_atm)
+        g = f / force_blocked - (1.0 - s / s_free)
+        if g == 0.0:
+            return s
+        if g > 0.0:
+            hi = s
+        else:
+            lo = s
+        step = g / (df / force_blocked + 1.0 / s_free)
+        s_new = s - step
+        if not (lo < s_new < hi):
+            s_new = 0.5 * (lo + hi)
+        elif abs(step) <= rtol * s:
+            return s_new
+        if hi - lo <= rtol * s:
+            return s_new
+        s = s_new
+    return s
+
+
+@formula
+def _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
+                 s_max, force_blocked, supply_limited, mu, alpha, x_base, w_base, phi_trig,
+                 w_phi, p_atm):
+    """The length-free design limits of a model variant, with a reachable free stroke.
+
+    ``s_free`` is the free stroke at the reachable temperature (s_max without a supply),
+    ``force_blocked`` F_b = c (T - T_amb) at that temperature (``coupled_muscle``),
+    ``supply_limited`` whether the supply keeps the muscle below T_max. Returns
+    (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0 stroke, 1 strength,
+    2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes`` (``incompressible_wall``) when
+    the chamber would close before s_max, and then kappa_full is inf (range fraction 0).
+    """
+    cauchy = model == CAUCHY_MOMENT
+    solid = 0.0
+    closes = False
+    s_top = s_free
+    if model == INCOMPRESSIBLE_WALL:
+        solid = _solid_fraction(radius, wall_thickness, base_thickness)
+        s_close = 1.0 - math.sqrt(solid)
+        if s_close <= s_max:
+            closes = True
+            if s_top > s_close * (1.0 - 1e-9):
+                s_top = s_close * (1.0 - 1e-9)
+    if closes:
+        kappa_full = math.inf
+        p_full = math.inf
+    else:
+        p_full = _nylon_pressure(model, s_max, p_atm, solid)
+        kappa_full = _curvature_of(_pressure_moment(p_full, radius, base_thickness), radius,
+                                   wall_thickness, base_thickness, mu, alpha, x_base, w_base,
+                                   phi_trig, w_phi, 0.0, NEWTON_RTOL, cauchy)
+    if model == COUPLED_MUSCLE:
+        s_eq = _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, alpha,
+                               p_atm, STROKE_RTOL)
+    else:
+        s_eq = s_top
+    s, strength, force = _stroke_limit_model(model, force_limit, s_eq, radius,
+                                             wall_thickness, lever, solid, mu, alpha, p_atm,
+                                             STROKE_RTOL)
+    if strength == 1:
+        limit = 1
+    elif supply_limited:
+        limit = 2
+    elif model == COUPLED_MUSCLE and s_eq < s_free * (1.0 - LOAD_RTOL):
+        limit = 3
+    else:
+        limit = 0
+    p = _nylon_pressure(model, s, p_atm, solid)
+    moment = _pressure_moment(p, radius, base_thickness)
+    if limit == 0:
+        kappa = kappa_full
+    else:
+        guess = kappa_full * p / p_full if p_full < math.inf else 0.0
+        kappa = _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
+                              x_base, w_base, phi_trig, w_phi, guess, NEWTON_RTOL, cauchy)
+    return s, limit, p, moment, kappa, force, kappa_full, closes
+
+
+@formula
+def _design_state(model, voltage, radius, wall_thickness, base_thickness, length, wrap_angle,
+                  pitch, lever, force_limit, s_max, coil_scale, t_amb, t_max, gamma, beta, t_g, sigma_g,
+                  r_per_len, loss_per_len, force_coeff, mu, alpha, x_base, w_base, phi_trig,
+                  w_phi, p_atm):
+    """The stroke state of one design in any model, with or without a supply.
+
+    Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
+    model without a supply is :func:`_stroke_state` itself; otherwise :func:`_model_state`
+    at the reachable temperature (:func:`_reach`).
+    """
+    if model == PAPER and voltage <= 0.0:
+        st = _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
+                           0.0, mu, alpha, x_base, w_base, phi_trig, w_phi, p_atm)
+        return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, t_max
+    t_reach, s_free, limited = _reach(s_max, coil_scale, length, pitch, radius,
+                                      wall_thickness, base_thickness, wrap_angle, voltage,
+                                      t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len,
+                                      loss_per_len)
+    ms = _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
+                      s_max, force_coeff * (t_reach - t_amb), limited, mu, alpha, x_base,
+                      w_base, phi_trig, w_phi, p_atm)
+    return ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6], ms[7], t_reach
+
+
+@formula
+def _nylon_pressure(model, stroke, p_atm, solid):
+    """Chamber gauge pressure p(s) of a model variant [Pa]."""
+    if model == INCOMPRESSIBLE_WALL:
+        return _gauge_pressure_wall(stroke, p_atm, solid)[0]
+    return _gauge_pressure(stroke, p_atm)
+
+
+@formula
+def _reach(s_max, coil_scale, length, pitch, radius, wall_thickness, base_thickness,
+           wrap_angle, voltage, t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len,
+           loss_per_len):
+    """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
+
+    ``voltage`` <= 0: no supply, T_max and s_max itself (docs/model.md s. 15).
+    """
+    if voltage > 0.0:
+        l_m = _muscle_length(length, pitch, radius, wall_thickness, base_thickness,
+                             wrap_angle)
+        t_ss = _steady_temperature(voltage, l_m, t_amb, r_per_len, loss_per_len)
+        if t_ss < t_max:
+            return t_ss, _free_stroke(t_ss, coil_scale, t_amb, gamma, beta, t_g,
+                                      sigma_g), True
+    return t_max, s_max, False
+
+
+@formula
+def _working_temperatures(model, s_star, t_reach, coil_scale, t_amb, t_max, gamma, beta, t_g,
+                          sigma_g):
+    """T* [K], and the temperatures where the free stroke is 5 % and 95 % of s(T*) [K].
+
+    T* is the temperature whose free stroke (eq. 2) is s* (in ``coupled_muscle``: the
+    reachable temperature it is heated to; docs/model.md s. 15).
+    """
+    if model == COUPLED_MUSCLE:
+        t_work = t_reach
+    else:
+        t_work = _temperature_for_stroke(s_star, coil_scale, t_amb, t_max, gamma, beta, t_g,
+                                         sigma_g)
+    s_work = _free_stroke(t_work, coil_scale, t_amb, gamma, beta, t_g, sigma_g)
+    t_cool = _temperature_for_stroke(COOLED_FRACTION * s_work, coil_scale, t_amb, t_max,
+                                     gamma, beta, t_g, sigma_g)
+    t_hot = _temperature_for_stroke(HEATED_FRACTION * s_work, coil_scale, t_amb, t_max,
+                                    gamma, beta, t_g, sigma_g)
+    return t_work, t_cool, t_hot
+
+
+@formula
+def _thermal_values(length, pitch, radius, wall_thickness, base_thickness, wrap_angle, voltage,
+                    t_work, t_cool, t_hot, t_amb, r_per_len, c_per_len, loss_per_len):
+    """muscle_length, resistance, heating_power, heating_voltage, cooling_time, heating_time.
+
+    At the working temperature T* (:func:`_working_temperatures`); heating_time is NaN
+    without a supply (``voltage`` <= 0; docs/model.md s. 15).
+    """
+    l_m = _muscle_length(length, pitch, radius, wall_thickness, base_thickness, wrap_angle)
+    r = r_per_len * l_m
+    power = _heating_power(t_work, l_m, t_amb, loss_per_len)
+    tau = c_per_len / loss_per_len
+    cooling = _cooling_time(t_work, t_cool, t_amb, tau)
+    heating = math.nan
+    if voltage > 0.0:
+        heating = _heating_time(t_hot, _steady_temperature(voltage, l_m, t_amb, r_per_len,
+                                                           loss_per_len), t_amb, tau)
+    return l_m, r, power, math.sqrt(r * power), cooling, heating
+
+
+@formula
+def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch_max,
+              turns, closes):
+    """The ``validity`` bits (docs/model.md s. 17): 1 self contact (theta* > 2 pi), 2 the
+    largest axial stretch 1 + kappa* (b + a + t) beyond the silicone's fitted range, 4 fewer
+    than one turn of wrap, 8 the chamber closes (``incompressible_wall``)."""
+    flags = 0
+    if bend_angle > 2.0 * math.pi:
+        flags += 1
+    if 1.0 + kappa * (base_thickness + radius + wall_thickness) > stretch_max:
+        flags += 2
+    if turns < 1.0:
+        flags += 4
+    if closes:
+        flags += 8
+    return flags
 
 
 @formula
@@ -133,8 +397,10 @@ def stroke_limit(radius, wall_thickness, coil_index, wrap_angle, base_thickness=
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
-                  silicone="tc5005", nylon="silver_nylon66"):
+                  silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
+
+    The slow, obviously-right pure-Python loop the compiled engine is tested against.
 
     Parameters
     ----------
@@ -151,18 +417,25 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     base_thickness : float or array, optional
         Bottom layer thickness b [m], > 0; b = t when None (docs/model.md section 1 [choice]).
     silicone : str, dict or Silicone, default "tc5005"
-        Silicone set.
+        Silicone set (its ``stretch_range`` sets the ``stretch_beyond_fit`` bit).
     nylon : str, dict or Nylon, default "silver_nylon66"
         Muscle set.
+    model : str, default "paper"
+        Model variant, one of :data:`MODELS` (docs/model.md s. 16).
+    supply_voltage : float, optional
+        Steady supply voltage V [V], > 0; None: no supply limit (docs/model.md s. 15).
 
     Returns
     -------
     dict
-        ``usable_stroke`` s* [-], ``limit`` (0 stroke-limited, 1 strength-limited),
+        ``usable_stroke`` s* [-], ``limit`` (0 stroke, 1 strength, 2 supply, 3 load),
         ``pressure_max`` p* [Pa], ``torque_max`` M* [N m], ``tip_force_max`` F* [N],
         ``bend_angle_max`` theta* [rad], ``range_fraction`` theta*/theta(s_max) [-],
-        ``nylon_force_max`` F_n(s*) [N], ``nylon_use`` F_n(s*)/F_lim [-]. Floats for
-        scalar input, arrays of the broadcast shape otherwise.
+        ``nylon_force_max`` F_n(s*) [N], ``nylon_use`` F_n(s*)/F_lim [-],
+        ``muscle_length`` [m], ``resistance`` [ohm], ``heating_power`` [W],
+        ``heating_voltage`` [V], ``cooling_time`` [s], ``heating_time`` [s] (NaN without a
+        supply) and ``validity`` (bits of :data:`VALIDITY_FLAGS`). Floats (ints for the
+        flags) for scalar input, arrays of the broadcast shape otherwise.
 
     Raises
     ------
@@ -171,26 +444,45 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 
     References
     ----------
-    Paper section 4 and figure 12; docs/model.md section 8.
+    Paper section 4 and figure 12; docs/model.md sections 8, 15-17.
     """
+    if model not in MODELS:
+        raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+    code = MODELS.index(model)
+    voltage = 0.0 if supply_voltage is None else float(
+        check_input("supply_voltage", supply_voltage))
     ny = nylon_parameters(nylon)
-    mu, alpha = silicone_parameters(silicone).arrays()
+    sil = silicone_parameters(silicone)
+    mu, alpha = sil.arrays()
+    stretch_max = float(sil.stretch_range[1])
     a, t, L, c, psi, b = _inputs(radius, wall_thickness, length, coil_index, wrap_angle,
                                  base_thickness, ny)
     a, t, L, c, psi, b = np.broadcast_arrays(a, t, L, c, psi, b)
     nodes = quadrature_nodes()
     c_tab = np.asarray(ny.coil_index_table)
-    out = {name: np.empty(a.shape, dtype=np.int8 if name == "limit" else float)
+    shape_args = (ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    top = _stroke_shape(ny.t_max, *shape_args)
+    out = {name: np.empty(a.shape, dtype=np.int8 if name in ("limit", "validity") else float)
            for name in DESIGN_VARIABLES}
     for idx in np.ndindex(a.shape):
         ai, ti, bi, Li, ci, pi = (float(x[idx]) for x in (a, t, b, L, c, psi))
         force_limit = float(np.interp(ci, c_tab, ny.tensile_strength_table)) * ny.fibre_area
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))
-        lever = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0)) / math.cos(pi)
-        state = _stroke_state(ai, ti, bi, lever, force_limit, s_max, 0.0, mu, alpha, *nodes,
-                              P_ATM)
+        pitch = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0))
+        lever = pitch / math.cos(pi)
+        *state, closes, t_reach = _design_state(
+            code, voltage, ai, ti, bi, Li, pi, pitch, lever, force_limit, s_max, s_max / top,
+            ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g,
+            ny.resistance_per_length, ny.heat_loss_per_length, ny.thermal_force_coefficient,
+            mu, alpha, *nodes, P_ATM)
         values = _design_values(*state, force_limit, Li)
-        for name, v in zip(DESIGN_VARIABLES, values):
+        temps = _working_temperatures(code, values[0], t_reach, s_max / top, *shape_args[:1],
+                                      ny.t_max, *shape_args[1:])
+        thermal = _thermal_values(Li, pitch, ai, ti, bi, pi, voltage, *temps, ny.t_amb,
+                                  ny.resistance_per_length, ny.heat_capacity_per_length,
+                                  ny.heat_loss_per_length)
+        flags = _validity(values[5], state[4], ai, ti, bi, stretch_max, Li / pitch, closes)
+        for name, v in zip(DESIGN_VARIABLES, (*values, *thermal, flags)):
             out[name][idx] = v
-    return {name: (int(v) if name == "limit" and v.ndim == 0 else scalar_or_array(v))
-            for name, v in out.items()}
+    return {name: (int(v) if name in ("limit", "validity") and v.ndim == 0
+                   else scalar_or_array(v)) for name, v in out.items()}

@@ -42,6 +42,61 @@ def _stroke_scale(coil_index, c_table, smax_table, t_amb, t_max, gamma, beta, t_
     )
 
 
+@formula
+def _stroke_shape_slope(temperature, t_amb, gamma, beta, t_g, sigma_g):
+    """d/dT of :func:`_stroke_shape` [1/K]; positive for gamma, beta > 0."""
+    c = 1.0 / (sigma_g * _SQRT2)
+    x = (temperature - t_g) * c
+    return gamma + beta * 2.0 / math.sqrt(math.pi) * c * math.exp(-x * x)
+
+
+@formula
+def _free_stroke(temperature, scale, t_amb, gamma, beta, t_g, sigma_g):
+    """Free stroke s(T) = k (eps_ref(T_amb) - eps_ref(T)) of eq. (2) at coil scale k [-]."""
+    return scale * _stroke_shape(temperature, t_amb, gamma, beta, t_g, sigma_g)
+
+
+#: Relative Newton step below which the inverse of eq. (2) counts as converged [-].
+TEMPERATURE_RTOL = 1e-13
+
+
+@formula
+def _temperature_for_stroke(stroke_value, scale, t_amb, t_max, gamma, beta, t_g, sigma_g):
+    """Temperature T in [T_amb, T_max] whose free stroke (eq. 2) is ``stroke_value`` [K].
+
+    Safeguarded Newton (a step that leaves the bracket is replaced by bisection), so it
+    compiles with Numba; the stroke is increasing in T. Strokes at or beyond s(T_max)
+    return T_max, strokes <= 0 return T_amb.
+    """
+    if stroke_value <= 0.0:
+        return t_amb
+    target = stroke_value / scale
+    top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
+    if target >= top:
+        return t_max
+    lo = t_amb
+    hi = t_max
+    temp = t_amb + (t_max - t_amb) * target / top
+    for _ in range(200):
+        f = _stroke_shape(temp, t_amb, gamma, beta, t_g, sigma_g) - target
+        if f == 0.0:
+            return temp
+        if f > 0.0:
+            hi = temp
+        else:
+            lo = temp
+        step = f / _stroke_shape_slope(temp, t_amb, gamma, beta, t_g, sigma_g)
+        new = temp - step
+        if not (lo < new < hi):
+            new = 0.5 * (lo + hi)
+        elif abs(step) <= TEMPERATURE_RTOL * temp:
+            return new
+        if hi - lo <= TEMPERATURE_RTOL * temp:
+            return new
+        temp = new
+    return temp
+
+
 def _nylon(nylon):
     return nylon_parameters(nylon)
 

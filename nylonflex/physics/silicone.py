@@ -48,6 +48,23 @@ def _stress_and_slope(stretch, mu, alpha):
     return s, ds / stretch
 
 
+@formula
+def _equibiaxial_stress_and_slope(stretch, mu, alpha):
+    """Nominal hoop stress of the paper's eq. (10)-(12) state and its slope [Pa].
+
+    l_theta = l_l = l, l_r = 1/l^2, sigma_r = 0: sigma_theta = sum mu_i (l^a_i - l^-2a_i),
+    S = sigma_theta / l = sum mu_i (l^(a_i-1) - l^(-2a_i-1)) (``paper_eq10``).
+    """
+    s = 0.0
+    ds = 0.0
+    for i in range(mu.shape[0]):
+        a = alpha[i]
+        s += mu[i] * (stretch ** (a - 1.0) - stretch ** (-2.0 * a - 1.0))
+        ds += mu[i] * ((a - 1.0) * stretch ** (a - 2.0) + (2.0 * a + 1.0)
+                       * stretch ** (-2.0 * a - 2.0))
+    return s, ds
+
+
 def _ogden(silicone):
     return silicone_parameters(silicone).arrays()
 

@@ -6,6 +6,8 @@ length l_m, so the time constant tau = c'/lambda' does not depend on the length.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..materials import nylon_parameters
@@ -31,6 +33,35 @@ def _temperature_step(temperature, voltage, dt, muscle_length, t_amb, r_per_len,
     loss = loss_per_len * muscle_length
     t_ss = t_amb + voltage * voltage / (r * loss)
     return t_ss + (temperature - t_ss) * np.exp(-dt * loss_per_len / c_per_len)
+
+
+@formula
+def _steady_temperature(voltage, muscle_length, t_amb, r_per_len, loss_per_len):
+    """T_ss = T_amb + V^2 / (r' lambda' l_m^2), the steady state of eq. (3) [K]."""
+    return t_amb + voltage * voltage / (r_per_len * loss_per_len * muscle_length * muscle_length)
+
+
+@formula
+def _heating_power(temperature, muscle_length, t_amb, loss_per_len):
+    """Steady power that holds the muscle at T, P = lambda' l_m (T - T_amb) [W]."""
+    return loss_per_len * muscle_length * (temperature - t_amb)
+
+
+@formula
+def _cooling_time(t_start, t_end, t_amb, tau):
+    """Time for eq. (3) with V = 0 to cool from t_start to t_end [s]: tau ln(dT0/dT1)."""
+    return tau * math.log((t_start - t_amb) / (t_end - t_amb))
+
+
+@formula
+def _heating_time(t_end, t_ss, t_amb, tau):
+    """Time for eq. (3) at constant V to heat from T_amb to t_end < T_ss [s]; inf if not reached.
+
+    T(t) = T_ss - (T_ss - T_amb) exp(-t/tau), so t = -tau ln(1 - (T - T_amb)/(T_ss - T_amb)).
+    """
+    if t_end >= t_ss:
+        return math.inf
+    return -tau * math.log(1.0 - (t_end - t_amb) / (t_ss - t_amb))
 
 
 def _lengths(muscle_length):

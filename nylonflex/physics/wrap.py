@@ -43,6 +43,13 @@ def _pitch(radius, wall_thickness, base_thickness, wrap_angle, width):
 
 
 @formula
+def _muscle_length(length, pitch, radius, wall_thickness, base_thickness, wrap_angle):
+    """Muscle in the wrap l_m = n P_out / cos psi with n = L / pitch turns [m]."""
+    return length / pitch * _outer_perimeter(radius, wall_thickness, base_thickness) \
+        / math.cos(wrap_angle)
+
+
+@formula
 def _wrap_force(pressure, hoop_stress, radius, wall_thickness, lever):
     """F_n = (p a + |S_theta| t) pitch / cos psi [N] from the pressure and hoop stress.
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..variables import COORDS, CURVES, DESIGN, slab_done_attrs
+from ..variables import COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 
 __all__ = ["CODECS", "DEFAULT_CODEC", "Codec", "CubeFile"]
 
@@ -82,8 +82,10 @@ class CubeFile:
     """Writes one cube file slab by slab (h5netcdf; by default gzip level 1 with shuffle)."""
 
     def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
-                 codec: str = DEFAULT_CODEC, variables: dict | None = None):
+                 codec: str = DEFAULT_CODEC, variables: dict | None = None,
+                 models=("paper",)):
         import h5netcdf
+        import h5py
 
         self.codec = CODECS[codec]
         if self.codec.plugin and not load_filter_plugins():
@@ -92,15 +94,24 @@ class CubeFile:
         self.path = Path(path)
         self.f = h5netcdf.File(self.path, "w")
         sizes = {name: len(values) for name, values in coords.items()}
+        if len(models) > 1:
+            sizes["model"] = len(models)
         self.f.dimensions = sizes
         for name, values in coords.items():
             v = self.f.create_variable(name, (name,), "f8", data=np.asarray(values, float))
             v.attrs.update(COORDS[name].attrs())
-        # the variables the config asks for (registry entries); a plain sweep's by default
-        for var in (variables or {**DESIGN, **CURVES}).values():
+        if len(models) > 1:  # the string dimension of a cube of several model variants
+            v = self.f.create_variable("model", ("model",), h5py.string_dtype(),
+                                       data=np.array(models, dtype=object))
+            v.attrs.update(MODEL.attrs())
+        # the variables the config asks for, {name: (registry entry, dims)}; a plain
+        # sweep's by default
+        if variables is None:
+            variables = {n: (v, v.dims) for n, v in {**DESIGN, **CURVES}.items()}
+        for var, dims in variables.values():
             fill = None if var.dtype == "int8" else np.nan
-            v = self.f.create_variable(var.name, var.dims, var.dtype, fillvalue=fill,
-                                       chunks=_chunks(var.dims, sizes, radius_chunk),
+            v = self.f.create_variable(var.name, dims, var.dtype, fillvalue=fill,
+                                       chunks=_chunks(dims, sizes, radius_chunk),
                                        **self.codec.filters)
             v.attrs.update(var.attrs())
         done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)

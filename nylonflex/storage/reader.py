@@ -75,6 +75,22 @@ def open_cube(path, *, quiet: bool = False):
     return ds
 
 
+def _validity_lines(ds) -> list[str]:
+    """How many designs carry each validity bit (docs/model.md s. 17), per model."""
+    if "validity" not in ds:
+        return []
+    v = ds["validity"].values
+    v = v[~np.isnan(v)].astype(np.int64) if v.dtype.kind == "f" else v.astype(np.int64)
+    n = v.size or 1
+    meanings = str(ds["validity"].attrs.get("flag_meanings", "")).split()
+    bits = [int(x) for x in np.atleast_1d(ds["validity"].attrs.get("flag_masks", []))]
+    parts = [f"{name} {int(np.sum((v & bit) > 0)):,}" for bit, name in zip(bits, meanings)]
+    flagged = int(np.sum(v > 0))
+    per = " (counted over every model)" if "model" in ds.dims else ""
+    return [f"flagged   {flagged:,} of {v.size:,} design values ({100 * flagged / n:.1f} %)"
+            f"{per}: " + ", ".join(parts)]
+
+
 def cube_summary(path) -> list[str]:
     """Lines that describe a cube: dims, ranges, variables, provenance, completeness."""
     from ..variables import VARIABLES, to_display
@@ -93,6 +109,11 @@ def cube_summary(path) -> list[str]:
                f"({done}/{ds.sizes['radius']} radii)")
     n = int(np.prod([ds.sizes[d] for d in AXES]))
     out.append(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES))
+    if "model" in ds.dims:
+        out.append(f"models    {', '.join(str(m) for m in ds['model'].values)}")
+    if a.get("supply_voltage", "none") != "none":
+        out.append(f"supply    {a['supply_voltage']}")
+    out.extend(_validity_lines(ds))
     out.append("axes")
     for name in (*AXES, "stroke", "pressure"):
         v = VARIABLES[name]

@@ -135,7 +135,8 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
 def _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     building = out.with_name(out.name + ".building")
-    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg))
+    cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
+                    cfg.models)
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
     for k in sorted(keep):
