@@ -127,7 +127,8 @@ def test_refined_front_dominates_or_equals_the_grid_front(ds):
 
 
 # ---------------------------------------------------------------------------- property
-_NAMES = [n for n in [*AXES, *DESIGN] if n != "limit"]
+# heating_time is in a cube only with a supply (asked of this one, it is refused)
+_NAMES = [n for n in [*AXES, *DESIGN] if n not in ("limit", "heating_time")]
 
 
 @st.composite

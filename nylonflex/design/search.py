@@ -137,6 +137,11 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
     """
     from .spec import fixed_axes
 
+    asked = [*(o.name for o in spec.objectives), *(c.name for c in spec.constraints)]
+    missing = [n for n in asked if n not in ds.variables]
+    if missing:
+        raise InputError(f"{missing[0]}: this cube holds no {missing[0]} (heating_time needs a "
+                         "sweep with supply:; feasibility one with requirements:)")
     ranges = {a: (float(ds[a].values.min()), float(ds[a].values.max())) for a in AXES}
     empty = {k: np.empty(0) for k in COLUMNS}
     fixed = fixed_axes(spec)
