@@ -34,7 +34,9 @@ class CubeFile:
         import h5netcdf
 
         self.path = Path(path)
-        self.f = h5netcdf.File(self.path, "w")
+        # the caller holds the writer's lock on this file (storage.journal.exclusive), so
+        # HDF5's own lock, which would conflict with it, is off
+        self.f = h5netcdf.File(self.path, "w", locking=False)
         sizes = {name: len(values) for name, values in coords.items()}
         self.f.dimensions = sizes
         for name, values in coords.items():
