@@ -35,7 +35,7 @@ def _progress(total, quiet):
 def run(args) -> int:
     from ..config import load_config
     from ..sweep import default_output, run_sweep
-    from ..storage.journal import refuse_special
+    from ..files import refuse_special
 
     cfg = load_config(args.config, args.set)
     out = Path(args.out) if args.out else default_output(cfg)

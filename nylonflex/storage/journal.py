@@ -21,11 +21,11 @@ import hashlib
 import json
 import os
 import shutil
-import stat
 from pathlib import Path
 
 import numpy as np
 
+from ..files import fsync_dir, publish, refuse_special
 from ..units import InputError
 
 __all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "exclusive", "fsync_dir",
@@ -40,41 +40,6 @@ _LOCK_TEXT = b"nylonflex sweep lock\n"
 
 class SlabInvalid(Exception):
     """A journaled slab that fails verification (its message says why)."""
-
-
-def fsync_dir(path):
-    """fsync a folder, so that a rename inside it survives a crash."""
-    with contextlib.suppress(OSError):
-        fd = os.open(path, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-
-
-def publish(tmp: Path, final: Path):
-    """Rename ``tmp`` onto ``final`` durably: fsync the file, rename, fsync the folder."""
-    with open(tmp, "rb+") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, final)
-    fsync_dir(final.parent)
-
-
-def refuse_special(path: Path, what: str):
-    """Refuse a path that exists and is not a regular file (a device, fifo, socket, link
-    to one, or folder): nothing is ever written over it."""
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return
-    except OSError as exc:
-        raise InputError(f"{what}: {path} cannot be read ({exc.strerror})") from None
-    if stat.S_ISDIR(mode):
-        raise InputError(f"{what}: {path} is a folder; give a file path such as "
-                         f"{path}/cube.h5")
-    if not stat.S_ISREG(mode):
-        raise InputError(f"{what}: {path} is a special file (device, fifo or socket); "
-                         "nylonflex writes only regular files")
 
 
 def _digest(config_sha, k, i0, i1, arrays: dict) -> str:
