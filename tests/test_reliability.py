@@ -190,8 +190,9 @@ def _tamper_arrays(parts):
         np.savez(fh, **arrays)
 
 
-@pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_empty, _tamper_deflate,
-                                    _tamper_arrays])
+@pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_deflate,
+                                    pytest.param(_tamper_empty, marks=pytest.mark.slow),
+                                    pytest.param(_tamper_arrays, marks=pytest.mark.slow)])
 def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
     out = tmp_path / "cube.h5"
     interrupted(out, k=3)
@@ -308,6 +309,7 @@ def test_a_finished_cube_is_replaced_only_with_overwrite(tmp_path, small_cfg, ca
     assert open_cube(out).attrs["name"] == "other"
 
 
+@pytest.mark.slow
 def test_an_interrupted_overwrite_keeps_the_old_cube(tmp_path, whole):
     out = tmp_path / "cube.h5"
     raw = {**MULTI, "name": "old", "grid": {**MULTI["grid"],
@@ -578,8 +580,10 @@ def test_a_signal_while_a_slab_computes_stops_after_it(tmp_path):
 _SIGNAL_AT = """
 import os, random, signal, sys, threading, time
 delay, sig = float(sys.argv[1]), int(sys.argv[2])
-threading.Timer(delay, lambda: os.kill(os.getpid(), sig)).start()
-from nylonflex.cli import main
+from nylonflex.cli import main  # a signal during Python's own start-up is not covered
+timer = threading.Timer(delay, lambda: os.kill(os.getpid(), sig))
+timer.daemon = True  # a run that finishes first exits without waiting for it
+timer.start()
 sys.exit(main(sys.argv[3:]))
 """
 

@@ -119,6 +119,19 @@ class CubeFile:
             offset = (i0 + corner[0], *corner[1:])
             yield offset, self._pool.submit(_shuffle_deflate, block, chunks)
 
+    def abandon(self):
+        """Close after a failure (a full disk, an error) without raising, and without
+        leaving h5netcdf a second close to try (and print) at garbage collection."""
+        import contextlib
+
+        self._pool.shutdown(cancel_futures=True)
+        with contextlib.suppress(Exception):
+            self.f.close()
+        if not self.f._closed:
+            with contextlib.suppress(Exception):
+                self.f._h5file.close()
+            self.f._closed = True
+
     def close(self, attrs: dict | None = None):
         self._pool.shutdown()
         if attrs:

@@ -217,6 +217,16 @@ def _write(cfg, out, building, journal, slabs, keep, chunk, executor, progress, 
            replaces=False):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk)
+    try:
+        _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
+              replaces)
+    except BaseException:
+        cube.abandon()
+        raise
+
+
+def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
+          replaces):
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
     kept = set()
