@@ -17,22 +17,36 @@ from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, Tag, ValidationError, field_validator, \
-    model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Tag, ValidationError, \
+    field_validator, model_validator
 
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .requirements import parse_requirements
-from .units import InputError, from_si, parse_quantity, to_si
+from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
+from .units import InputError, from_si, parse_quantity, short, to_si
 from .variables import AXES, INPUTS, VARIABLES
 
-__all__ = ["CHARTS", "SweepConfig", "apply_overrides", "check_range", "load_config",
-           "parse_config", "range_error"]
+__all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", "cube_bytes",
+           "load_config", "load_yaml", "parse_config", "range_error"]
 
 #: Figures a sweep config may name under ``charts``.
 CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
           "feasibility_map", "compare")
 
-Number = Union[float, str]
+
+
+def _no_bool(value):
+    if isinstance(value, bool):  # YAML's true/false/yes/no are not numbers
+        raise ValueError(f"must be a number, got {str(value).lower()}")
+    return value
+
+
+Number = Annotated[Union[float, str], BeforeValidator(_no_bool)]
+Count = Annotated[int, BeforeValidator(_no_bool)]
+
+#: Default budget of one sweep (config key ``limits``): designs in the grid, and gigabytes
+#: of the cube before compression. Checked before any file is created.
+LIMITS = {"designs": 1_000_000_000, "gigabytes": 200.0}
 
 #: quantity -> (kind, default unit, accepted SI range lo, hi, display unit for messages),
 #: read off the registry (nylonflex.variables), for sweeps and simulations alike; the coil
@@ -61,7 +75,7 @@ class Axis(_Strict):
 
     start: Number | None = None
     stop: Number | None = None
-    num: int | None = None
+    num: Count | None = None
     values: list[Number] | None = None
     units: str | None = None
 
@@ -119,6 +133,13 @@ class Supply(_Strict):
     units: str | None = "V"
 
 
+class Limits(_Strict):
+    """The budget of one sweep: at most ``designs`` designs and a cube of ``gigabytes``."""
+
+    designs: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["designs"]
+    gigabytes: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["gigabytes"]
+
+
 class SweepConfig(_Strict):
     """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
 
@@ -129,7 +150,8 @@ class SweepConfig(_Strict):
     base_thickness: Union[Literal["wall"], FixedThickness] = "wall"
     curves: Curves
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
-    slab_megabytes: float = 16.0
+    slab_megabytes: Annotated[float, BeforeValidator(_no_bool)] = 16.0
+    limits: Limits = Limits()
     compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
     uncertainty: Uncertainty | None = None
     requirements: list[str] = []
@@ -366,7 +388,7 @@ def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
     path, tp = _walk(model, e["loc"])
     msg = e["msg"].removeprefix("Value error, ")
     got = e.get("input")
-    tail = "" if isinstance(got, dict) else f", got {got!r}"
+    tail = "" if isinstance(got, dict) else f", got {short(got)}"
     kind = e["type"]
     if kind == "extra_forbidden":
         parent = _walk(model, e["loc"][:-1])[1]
@@ -382,7 +404,7 @@ def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
         path = f"{path}.{key}" if path else key
         tags = [t for m in get_args(tp) for t in get_args(_strip(m).model_fields[key].annotation)]
         msg = f"must be one of {', '.join(tags)}"
-        tail = f", got {e['ctx']['tag']!r}" if kind == "union_tag_invalid" else ""
+        tail = f", got {short(e['ctx']['tag'])}" if kind == "union_tag_invalid" else ""
         msg = msg if tail else f"missing key; accepted: {', '.join(tags)}"
     else:
         msg = _TYPE_MESSAGES.get(kind, msg)
@@ -402,6 +424,9 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
     if axis.values is not None:
         if len(axis.values) == 0:
             raise InputError(f"{path}.values: needs at least one value")
+        if len(axis.values) > _MAX_POINTS:
+            raise InputError(f"{path}.values: at most {_MAX_POINTS:,} values, got "
+                             f"{len(axis.values):,}")
         vals = np.array([value(v, f"{path}.values[{i}]") for i, v in enumerate(axis.values)])
     else:
         if not 1 <= axis.num <= _MAX_POINTS:
@@ -440,6 +465,7 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
             for name in Grid.model_fields}
     curves = {name: _axis_values(name, getattr(cfg.curves, name), f"curves.{name}", nylon)
               for name in Curves.model_fields}
+    _check_budget(cfg.limits, axes, curves)
     if cfg.base_thickness == "wall":
         base = None
     else:
@@ -646,25 +672,56 @@ def _uncertainty(unc: Uncertainty, silicone, nylon, raw) -> UncertaintySpec:
                            tuple(params))
 
 
+def cube_bytes(axes: dict, curves: dict) -> int:
+    """Bytes of a cube's variables before compression, from the registry's dims and dtypes."""
+    from .variables import CURVES, DESIGN
+
+    sizes = {k: len(v) for k, v in {**axes, **curves}.items()}
+    return sum(int(np.prod([sizes[d] for d in v.dims], dtype=float)) *
+               np.dtype(v.dtype).itemsize for v in (*DESIGN.values(), *CURVES.values()))
+
+
+def _check_budget(limits: Limits, axes: dict, curves: dict):
+    """Refuse a design space over the budget, before anything is computed or written."""
+    for key in ("designs", "gigabytes"):
+        value = getattr(limits, key)
+        if not (math.isfinite(value) and value > 0):
+            raise range_error(f"limits.{key}", 0, None, "1", value, lo_open=True)
+    n = math.prod(len(v) for v in axes.values())
+    size = cube_bytes(axes, curves) / 1e9
+    if n > limits.designs or size > limits.gigabytes:
+        raise InputError(
+            f"grid: {n:,} designs, a cube of {size:,.3g} GB before compression, is over the "
+            f"budget of {limits.designs:,.0f} designs and {limits.gigabytes:g} GB; shrink the "
+            "grid, or raise the budget with the config key 'limits: {designs: N, gigabytes: "
+            "G}' (or --set limits.designs=N --set limits.gigabytes=G)")
+
+
 def apply_overrides(raw: dict, overrides) -> dict:
     """Apply ``KEY=VALUE`` strings (dotted keys, YAML values) to a copy of ``raw``."""
     out = copy.deepcopy(raw)
     for item in overrides or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise InputError(f"--set {item!r}: expected KEY=VALUE, e.g. grid.radius.num=81")
+            raise InputError(f"--set {short(item)}: expected KEY=VALUE, e.g. "
+                             "grid.radius.num=81")
         parts = key.strip().split(".")
+        if len(parts) > YAML_MAX_DEPTH:
+            raise InputError(f"--set {short(key)}: nested deeper than {YAML_MAX_DEPTH} levels")
         node = out
         for i, part in enumerate(parts[:-1]):
             nxt = node.get(part) if isinstance(node, dict) else None
             if nxt is None:
                 nxt = node[part] = {}
             if not isinstance(nxt, dict):
-                raise InputError(f"--set {key}: {'.'.join(parts[:i + 1])} is not a mapping")
+                raise InputError(f"--set {short(key)}: {short('.'.join(parts[:i + 1]))} is "
+                                 "not a mapping")
             node = nxt
         try:
-            parsed = yaml.safe_load(value)
-        except yaml.YAMLError:
+            parsed = load_yaml(value, f"--set {short(key)}")
+        except InputError as err:
+            if "not valid YAML" not in str(err):
+                raise
             parsed = value
         node[parts[-1]] = parsed
         # switching an axis between forms: drop the other form
@@ -675,20 +732,6 @@ def apply_overrides(raw: dict, overrides) -> dict:
                 for k in ("start", "stop", "num"):
                     node.pop(k, None)
     return out
-
-
-def read_yaml(path) -> dict:
-    """Read a YAML file; a missing file or bad YAML is an InputError naming it."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such config file")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark else ""
-        raise InputError(f"{path}: not valid YAML{where}") from None
-    return data
 
 
 def load_config(path, overrides=()) -> ResolvedConfig:

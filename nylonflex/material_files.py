@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from .safe_yaml import read_yaml
 from .units import InputError
 
 __all__ = ["anchor_material_files", "material_document", "read_material_set",
@@ -105,10 +106,7 @@ def read_material_file(path) -> dict:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such material file")
-    try:
-        doc = yaml.safe_load(p.read_text())
-    except yaml.YAMLError:
-        raise InputError(f"{path}: not valid YAML") from None
+    doc = read_yaml(p)
     if not isinstance(doc, dict) or doc.get("kind") not in ("silicone", "nylon"):
         raise InputError(f"{path}: not a nylonflex material file (needs 'kind: silicone' or "
                          "'kind: nylon')")

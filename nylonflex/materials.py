@@ -20,6 +20,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .units import short
+
 ZERO_CELSIUS = 273.15  # [K]
 
 __all__ = [
@@ -186,7 +188,7 @@ def check_shear_modulus(mu0, field="silicone.mu"):
     if np.any(bad):
         got = float(arr[bad].flat[0])
         msg = (f"{field}: initial shear modulus 1/2 sum mu_i alpha_i = {got:g} Pa is "
-               f"implausible for a silicone; accepted {lo:g} Pa to {hi:g} Pa")
+               f"implausible for a silicone; must be in [{lo:g}, {hi:g}] Pa")
         for factor, unit in ((1e3, "kPa"), (1e6, "MPa")):
             if got < lo and lo <= got * factor <= hi:
                 msg += (f"; the mu values look like {unit}: the code takes Pa "
@@ -339,6 +341,26 @@ def _resolve(kind, table, value, overrides):
     return name, params
 
 
+def _terms(key, value) -> tuple[float, ...]:
+    """A list of 1 to 6 Ogden constants as floats (bounded: never a huge array)."""
+    if isinstance(value, (list, tuple)) and not 1 <= len(value) <= 6 or \
+            isinstance(value, np.ndarray) and not 1 <= value.size <= 6:
+        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
+    items = value if isinstance(value, (list, tuple, np.ndarray)) else [value]
+    if any(isinstance(x, bool) for x in items):
+        raise ValueError(f"silicone.{key}: must be numbers, got a boolean")
+    if not all(isinstance(x, (int, float, np.number)) or
+               isinstance(x, str) and len(x) < 64 for x in items):
+        raise ValueError("silicone.mu/alpha: must be lists of numbers [Pa] and [-]")
+    try:
+        out = tuple(float(x) for x in items)
+    except (TypeError, ValueError):
+        raise ValueError("silicone.mu/alpha: must be lists of numbers [Pa] and [-]") from None
+    if not 1 <= len(out) <= 6:
+        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
+    return out
+
+
 def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
     """The named Ogden set, with fields overridden.
 
@@ -359,15 +381,16 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
     if isinstance(resolved, Silicone):
         return resolved
     name, p = resolved
-    try:
-        mu = tuple(float(x) for x in np.atleast_1d(p["mu"]))
-        alpha = tuple(float(x) for x in np.atleast_1d(p["alpha"]))
-    except (TypeError, ValueError):
-        raise ValueError("silicone.mu/alpha: must be lists of numbers [Pa] and [-]") from None
-    if len(mu) != len(alpha) or not 1 <= len(mu) <= 6:
+    mu, alpha = _terms("mu", p["mu"]), _terms("alpha", p["alpha"])
+    if len(mu) != len(alpha):
         raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
-    if not all(np.isfinite(mu + alpha)) or any(a == 0 for a in alpha):
-        raise ValueError("silicone.alpha: must be finite and non-zero")
+    if not all(np.isfinite(mu)) or any(abs(m) > SILICONE_RANGES["mu"] for m in mu):
+        raise ValueError(f"silicone.mu: each term must be finite and in "
+                         f"[-{SILICONE_RANGES['mu']:g}, {SILICONE_RANGES['mu']:g}] Pa")
+    if not all(np.isfinite(alpha)) or any(not 0 < abs(a) <= SILICONE_RANGES["alpha"]
+                                          for a in alpha):
+        raise ValueError(f"silicone.alpha: each term must be finite, non-zero and in "
+                         f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
     mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
     check_shear_modulus(mu0)
     stretch_range = p.get("stretch_range", (0.0, float("inf")))
@@ -386,6 +409,44 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         sources=dict(p.get("sources", {})),
         stretch_range=(lo, hi),
     )
+
+
+#: Physically plausible range of every nylon field, SI (lo, hi, unit for messages); a value
+#: outside it (or not finite) is refused: tiny or huge values make the model's arithmetic
+#: overflow or give NaN (a 1e-300 m fibre, a 1 Pa strength).
+NYLON_RANGES = {
+    "fibre_diameter": (1e-6, 0.01, "m"),
+    "stroke_reference": (1e-4, 0.9, ""),
+    "alpha": (-100.0, 100.0, ""),
+    "gamma": (-1.0, 1.0, "1/K"),
+    "beta": (-100.0, 100.0, ""),
+    "t_g": (150.0, 700.0, "K"),
+    "sigma_g": (0.01, 500.0, "K"),
+    "t_amb": (150.0, 500.0, "K"),
+    "t_max": (150.0, 800.0, "K"),
+    "resistance_per_length": (1e-6, 1e9, "ohm/m"),
+    "heat_capacity_per_length": (1e-9, 1e6, "J/(K m)"),
+    "heat_loss_per_length": (1e-9, 1e6, "W/(K m)"),
+    "stiffness": (1e-6, 1e9, "N/m"),
+    "damping": (0.0, 1e9, "N s/m"),
+    "thermal_force_coefficient": (-1e6, 1e6, "N/K"),
+    "coil_index_table": (1.0, 50.0, ""),
+    "stroke_max_table": (1e-4, 0.9, ""),
+    "tensile_strength_table": (1e6, 1e10, "Pa"),
+}
+#: Accepted Ogden constants: each |mu_i| [Pa], each |alpha_i| [-] (non-zero), and the
+#: initial shear modulus 1/2 sum mu_i alpha_i [Pa].
+SILICONE_RANGES = {"mu": 1e9, "alpha": 50.0, "mu0": SHEAR_MODULUS_RANGE}
+
+
+def _check_nylon_ranges(kwargs):
+    for key, (lo, hi, unit) in NYLON_RANGES.items():
+        values = kwargs[key] if key.endswith("_table") else (kwargs[key],)
+        for v in values:
+            if not (np.isfinite(v) and lo <= v <= hi):
+                u = f" {unit}" if unit else ""
+                raise ValueError(f"nylon.{key}: must be finite and in [{lo:g}, {hi:g}]{u}, "
+                                 f"got {v:g}")
 
 
 def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
@@ -419,7 +480,10 @@ def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
             else:
                 kwargs[f.name] = float(v)
         except (TypeError, ValueError):
-            raise ValueError(f"nylon.{f.name}: must be a number, got {v!r}") from None
+            raise ValueError(f"nylon.{f.name}: must be a number, got {short(v)}") from None
+        if isinstance(v, bool) or (f.name.endswith("_table") and
+                                   any(isinstance(x, bool) for x in v)):
+            raise ValueError(f"nylon.{f.name}: must be a number, got {str(v).lower()}")
     for key in (
         "fibre_diameter",
         "stroke_reference",
@@ -429,7 +493,8 @@ def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
         "heat_loss_per_length",
     ):
         if not (np.isfinite(kwargs[key]) and kwargs[key] > 0):
-            raise ValueError(f"nylon.{key}: must be > 0, got {kwargs[key]!r}")
+            raise ValueError(f"nylon.{key}: must be > 0, got {short(kwargs[key])}")
+    _check_nylon_ranges(kwargs)
     if not kwargs["t_max"] > kwargs["t_amb"]:
         raise ValueError("nylon.t_max: must be above nylon.t_amb")
     c, smax, su = (kwargs[k] for k in ("coil_index_table", "stroke_max_table",

@@ -321,11 +321,43 @@ def run_simulation(cfg: SimConfig):
 
 
 def write_simulation(ds, path) -> Path:
-    """Write a simulation Dataset to NetCDF4/HDF5 (h5netcdf engine) at ``path``."""
+    """Write a simulation Dataset to NetCDF4/HDF5 (h5netcdf engine) at ``path``.
+
+    Atomic: written to a temporary file beside it, fsynced, then renamed. Only an earlier
+    simulation is replaced; anything else at ``path`` (a cube, a config, a special file) is
+    refused with an InputError.
+    """
+    import os
+
+    from .files import publish, refuse_special
+    from .units import InputError
+
     path = Path(path)
+    refuse_special(path, "--out")
+    if path.exists() and not _is_simulation(path):
+        raise InputError(f"--out: {path} exists and is not a nylonflex simulation; it is not "
+                         "replaced: choose another --out or move it")
     path.parent.mkdir(parents=True, exist_ok=True)
-    ds.to_netcdf(path, engine="h5netcdf")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+        publish(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
     return path
+
+
+def _is_simulation(path) -> bool:
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            title = f.attrs.get("title", b"")
+    except (OSError, ValueError):
+        return False
+    title = title.decode() if isinstance(title, bytes) else str(title)
+    return title.startswith("nylonflex closed-loop simulation")
 
 
 # ---------------------------------------------------------------------------------------

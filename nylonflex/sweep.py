@@ -20,7 +20,7 @@ def default_output(cfg: ResolvedConfig) -> Path:
 
 
 def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=None,
-              scheduler=None, progress=None, log=None):
+              scheduler=None, progress=None, log=None, overwrite: bool = False):
     """Evaluate the config's design space.
 
     Parameters
@@ -31,6 +31,10 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
         Cube file to write. Without it the cube is built in memory (mind its size).
     resume : bool
         Finish an interrupted run of the same config at ``out``; refuse a changed config.
+    overwrite : bool
+        Replace a cube already at ``out`` (atomically: until the new one is complete, the
+        old one stays). Without it an existing cube of the same config is up to date and
+        left alone, and anything else at ``out`` is refused.
     workers : int, optional
         Local threads (default: all cores).
     scheduler : str or dask cluster, optional
@@ -63,7 +67,7 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     from .storage import open_cube, sweep_to_file
 
     sweep_to_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
-                  progress=progress, log=log)
+                  progress=progress, log=log, overwrite=overwrite)
     return open_cube(out)
 
 

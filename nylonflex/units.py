@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import re
 
-__all__ = ["UNITS", "InputError", "parse_quantity", "to_si", "from_si", "unit_kind"]
+__all__ = ["UNITS", "InputError", "parse_quantity", "short", "to_si", "from_si", "unit_kind"]
 
 
 class InputError(ValueError):
@@ -99,6 +99,21 @@ def _units_of(kind):
     return [u for u, (k, _, _) in UNITS.items() if k == kind]
 
 
+def short(value, limit: int = 60) -> str:
+    """The repr of ``value`` for a message, cut to about ``limit`` characters.
+
+    Built with :mod:`reprlib`, so a huge or deeply shared value (a YAML alias bomb) is never
+    expanded to be cut afterwards.
+    """
+    import reprlib
+
+    r = reprlib.Repr()
+    r.maxlevel, r.maxlist, r.maxtuple, r.maxdict, r.maxset = 2, 4, 4, 4, 4
+    r.maxstring = r.maxother = r.maxlong = limit
+    text = r.repr(value)
+    return text if len(text) <= limit + 5 else text[:limit] + "..."
+
+
 def parse_quantity(text, field: str, kind: str, default_unit: str):
     """Parse ``"7.5mm"``, ``"8 deg"`` or a bare ``"7.5"`` (in ``default_unit``) to SI.
 
@@ -109,9 +124,9 @@ def parse_quantity(text, field: str, kind: str, default_unit: str):
     """
     if isinstance(text, (int, float)) and not isinstance(text, bool):
         return to_si(float(text), default_unit, field, kind)
-    m = _NUMBER.match(str(text))
+    m = _NUMBER.match(text) if isinstance(text, str) and len(text) < 200 else None
     if not m:
         raise InputError(f"{field}: expected a number with an optional unit "
-                         f"({', '.join(_units_of(kind))}), got {text!r}")
+                         f"({', '.join(_units_of(kind))}), got {short(text)}")
     number, unit = m.groups()
     return to_si(float(number), unit or default_unit, field, kind)

@@ -53,7 +53,7 @@ def test_silicone_stiffness_in_kpa_is_caught_as_a_unit_slip():
     # the README's old table listed mu in kPa; a config or a call that copies 56.19, 10.49
     # gives mu_0 = 22.9 Pa, a thousand times softer than any silicone
     with pytest.raises(ValueError, match=r"silicone.mu: .* 22.88.. Pa is implausible .*"
-                                         r"accepted 100 Pa to 1e\+08 Pa.* look like kPa"):
+                                         r"must be in \[100, 1e\+08\] Pa.* look like kPa"):
         silicone_parameters("tc5005", mu=[56.19, 10.49])
     import nylonflex as nf
     from conftest import EXAMPLE_2

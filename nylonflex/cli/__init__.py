@@ -73,6 +73,14 @@ def _join_negative_values(argv):
 
 def main(argv=None) -> int:
     """Entry point of the ``nylonflex`` console script."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # Ctrl-C while the parser's modules are imported
+        print("nylonflex: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv=None) -> int:
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(_join_negative_values(argv))

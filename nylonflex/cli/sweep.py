@@ -14,6 +14,9 @@ def add_arguments(s):
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a config key, e.g. grid.radius.num=81 (repeatable)")
     s.add_argument("--resume", action="store_true", help="finish an interrupted run")
+    s.add_argument("--overwrite", action="store_true",
+                   help="replace a cube already at --out (the old one stays until the new "
+                        "one is complete)")
     s.add_argument("--workers", type=int, help="local threads (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a Dask distributed cluster, e.g. tcp://host:8786")
@@ -35,12 +38,11 @@ def _progress(total, quiet):
 def run(args) -> int:
     from ..config import load_config
     from ..sweep import default_output, run_sweep
-    from ..units import InputError
+    from ..files import refuse_special
 
     cfg = load_config(args.config, args.set)
     out = Path(args.out) if args.out else default_output(cfg)
-    if out.exists() and out.is_dir():
-        raise InputError(f"--out: {out} is a folder; give a file path such as {out}/cube.h5")
+    refuse_special(out, "--out")
 
     def log(msg):
         if not args.quiet:
@@ -51,7 +53,8 @@ def run(args) -> int:
 
     with _progress(cfg.n_designs, args.quiet) as bar:
         ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
-                       scheduler=args.scheduler, progress=bar.update, log=log)
+                       scheduler=args.scheduler, progress=bar.update, log=log,
+                       overwrite=args.overwrite)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if cfg.charts and not args.no_charts:
         from ..charts import draw_charts

@@ -30,12 +30,16 @@ from concurrent.futures import ThreadPoolExecutor
 
 from ..units import InputError
 
-__all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "WORKER_WAIT", "DaskRunner"]
+__all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "STALL_TIMEOUT", "WORKER_WAIT",
+           "DaskExecutor"]
 
 #: Seconds to wait for the scheduler to answer before refusing the address.
 CONNECT_TIMEOUT = 5.0
 #: Seconds to wait for the first worker to join a scheduler that has none.
 WORKER_WAIT = 60.0
+#: Seconds without a finished slab, while no worker is alive, before a run gives up
+#: (``DaskExecutor(stall=...)``); the journal keeps what was done for --resume.
+STALL_TIMEOUT = 60.0
 #: Slabs submitted per worker thread at a time: one computing, one queued behind it.
 IN_FLIGHT_PER_THREAD = 2
 
@@ -76,6 +80,33 @@ def _mismatch(expected: dict, got: dict) -> str:
                      if got.get(k) != v)
 
 
+def _connect(client_class, address, timeout):
+    """A Client of ``address`` within ``timeout`` seconds, whatever listens there.
+
+    Dask's own connect timeout does not cover a listener that accepts and never answers
+    (a web server, the dashboard port typed for the scheduler's): its handshake waits
+    forever. The client is made in a daemon thread, which is abandoned after the deadline.
+    """
+    import threading
+
+    box: dict = {}
+
+    def connect():
+        try:
+            box["client"] = client_class(address, timeout=timeout, set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller's thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=connect, name="nylonflex-connect", daemon=True)
+    thread.start()
+    thread.join(timeout + 1.0)
+    if thread.is_alive():
+        raise TimeoutError("no answer")
+    if "error" in box:
+        raise box["error"]
+    return box["client"]
+
+
 def _slab_task(cfg, i0: int, i1: int, expected: dict) -> dict:
     """Runs on a worker: one slab with the serial kernel (one level of parallelism)."""
     bad = _mismatch(expected, _versions())
@@ -99,6 +130,9 @@ class DaskExecutor:
         Seconds to wait for the scheduler to answer [s].
     worker_wait : float
         Seconds to wait for at least one worker to join [s].
+    stall : float
+        Seconds without a finished slab while no worker is alive before the run stops with
+        a RuntimeError (resumable) [s].
 
     Raises
     ------
@@ -110,19 +144,21 @@ class DaskExecutor:
     """
 
     def __init__(self, address, *, timeout: float = CONNECT_TIMEOUT,
-                 worker_wait: float = WORKER_WAIT):
+                 worker_wait: float = WORKER_WAIT, stall: float = STALL_TIMEOUT):
         self.address = _normalise_address(address)
+        self.stall = stall
         try:
             from distributed import Client
         except ImportError:
             raise InputError("--scheduler: needs dask.distributed; install it with "
                              "pip install 'nylonflex[dask]'") from None
         try:
-            self.client = Client(self.address, timeout=timeout, set_as_default=False)
+            self.client = _connect(Client, self.address, timeout)
         except (OSError, TimeoutError) as exc:
             raise InputError(f"--scheduler: no Dask scheduler answers at {self.address} "
                              f"within {timeout:g} s ({type(exc).__name__}); start one with "
-                             "'dask scheduler'") from None
+                             "'dask scheduler' (its default port is 8786; 8787 is the "
+                             "dashboard)") from None
         self._pending: set = set()
         self._used: set[str] = set()
         self._fetcher = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-fetch")
@@ -212,11 +248,32 @@ class DaskExecutor:
                 yield finish(*fetching)  # nothing else finished: don't wait for it
                 fetching = None
                 continue
+            self._wait_ready(done)
             fut = next(done)
             started = (fut, self._fetcher.submit(fut.result))
             if fetching is not None:
                 yield finish(*fetching)
             fetching = started
+
+    def _wait_ready(self, done):
+        """Wait for a finished slab; give up after ``stall`` seconds with no live worker
+        (every worker died, or the scheduler is gone)."""
+        import time
+
+        last_alive = time.monotonic()
+        while not done.has_ready():
+            time.sleep(0.2)
+            try:
+                alive = bool(self.client.scheduler_info().get("workers"))
+            except Exception:  # noqa: BLE001 - a lost scheduler counts as no workers
+                alive = False
+            if alive and self.client.status == "running":
+                last_alive = time.monotonic()
+            elif time.monotonic() - last_alive > self.stall:
+                raise RuntimeError(
+                    f"no slab finished for {self.stall:g} s and no Dask worker is alive at "
+                    f"{self.address}; the finished slabs are journaled: start workers (or "
+                    "the scheduler) and run again with --resume")
 
     def _who_ran(self, fut) -> set[str]:
         # the worker that holds the result ran the task (results are not replicated)

@@ -189,8 +189,9 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 # --------------------------------------------------------------------------- materials
 
 def _short(value, n=40):
-    text = repr(value)
-    return text if len(text) <= n else text[:n] + "..."
+    from ..units import short
+
+    return short(value, n)
 
 
 def _split(kind, value, table, fields):
@@ -229,6 +230,14 @@ def _silicone_arrays(silicone):
                          f"last axis, got shapes {mu.shape} and {alpha.shape}")
     if np.any(alpha == 0):
         raise ValueError("silicone.alpha: must be finite and non-zero")
+    from ..materials import SILICONE_RANGES
+
+    if np.any(np.abs(mu) > SILICONE_RANGES["mu"]):
+        raise ValueError(f"silicone.mu: each term must be in [-{SILICONE_RANGES['mu']:g}, "
+                         f"{SILICONE_RANGES['mu']:g}] Pa")
+    if np.any(np.abs(alpha) > SILICONE_RANGES["alpha"]):
+        raise ValueError(f"silicone.alpha: each term must be in "
+                         f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
     check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1))
     return mu, alpha
 
@@ -257,6 +266,13 @@ def _nylon_arrays(nylon) -> dict:
     for key in _NYLON_POSITIVE:
         if np.any(out[key] <= 0):
             raise ValueError(f"nylon.{key}: must be > 0, got {out[key][out[key] <= 0].flat[0]:g}")
+    from ..materials import NYLON_RANGES
+
+    for key, (lo, hi, unit) in NYLON_RANGES.items():
+        bad = ~((out[key] >= lo) & (out[key] <= hi))
+        if np.any(bad):
+            raise ValueError(f"nylon.{key}: must be finite and in [{lo:g}, {hi:g}]"
+                             f"{' ' + unit if unit else ''}, got {out[key][bad].flat[0]:g}")
     if np.any(out["t_max"] <= out["t_amb"]):
         raise ValueError("nylon.t_max: must be above nylon.t_amb")
     c, smax, su = (out[k] for k in _NYLON_TABLES)

@@ -10,11 +10,15 @@
   and writes the HDF5 cube.
 
 Ctrl-C or SIGTERM stops the loop after the slab being stored; what was stored stays, so an
-interrupted run loses at most the slabs in flight.
+interrupted run loses at most the slabs in flight. The handlers only record the signal (a
+raise from a handler can land anywhere, even in a weakref callback that swallows it, or in
+cleanup code where it prints a traceback); the loop checks the record after each slab. A
+second signal while a slab is still computing stops at once.
 """
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import threading
 import time
@@ -27,7 +31,8 @@ from ..config import ResolvedConfig
 from ..units import InputError
 from .grid import compute_slab, coords, cube_variables, global_arrays
 
-__all__ = ["LocalExecutor", "MemorySink", "RunStats", "run_slabs", "set_workers"]
+__all__ = ["LocalExecutor", "MemorySink", "RunStats", "deferred_signals", "run_slabs",
+           "set_workers"]
 
 
 @dataclass
@@ -42,6 +47,31 @@ class RunStats:
 
 class _Stop(Exception):
     """Raised by the SIGTERM handler to stop a sweep like Ctrl-C does."""
+
+
+@contextlib.contextmanager
+def deferred_signals(on_second=None):
+    """Record SIGINT and SIGTERM instead of acting on them; yields the list of signals seen.
+
+    ``on_second`` (a callable) runs on the second signal (e.g. raise to stop at once);
+    without it every signal is only recorded. Outside the main thread it does nothing.
+    """
+    seen: list = []
+    if threading.current_thread() is not threading.main_thread():
+        yield seen
+        return
+
+    def handler(signum, frame):
+        seen.append(signum)
+        if len(seen) > 1 and on_second is not None:
+            on_second()
+
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield seen
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
 
 
 def set_workers(workers=None) -> int:
@@ -110,30 +140,25 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
     """
     per_radius = cfg.n_designs // cfg.shape[0]
     stats = RunStats(done=set(), computed=0, seconds=0.0, stopped=False)
-    term = []
 
-    def on_term(signum, frame):
-        term.append(signum)  # a raise that lands in a weakref callback is swallowed;
-        raise _Stop()        # the loop below then stops after the slab it is storing
+    def stop_now():
+        raise _Stop()
 
-    in_main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, on_term) if in_main else None
     t0 = time.perf_counter()
     try:
-        for k, arrays in executor.map_slabs(cfg, slabs, todo):
-            i0, i1 = slabs[k]
-            sink.put(k, i0, i1, arrays)
-            stats.done.add(k)
-            stats.computed += (i1 - i0) * per_radius
-            if progress is not None:
-                progress((i1 - i0) * per_radius)
-            if term:
-                raise _Stop()
+        with deferred_signals(on_second=stop_now) as seen:
+            for k, arrays in executor.map_slabs(cfg, slabs, todo):
+                i0, i1 = slabs[k]
+                sink.put(k, i0, i1, arrays)
+                stats.done.add(k)
+                stats.computed += (i1 - i0) * per_radius
+                if progress is not None:
+                    progress((i1 - i0) * per_radius)
+                if seen:
+                    raise _Stop()
     except (KeyboardInterrupt, _Stop):
         stats.stopped = True
     finally:
-        if in_main:
-            signal.signal(signal.SIGTERM, previous)
         stats.seconds = time.perf_counter() - t0
     return stats
 

@@ -92,7 +92,9 @@ class CubeFile:
             raise RuntimeError(f"compression: {codec} needs the hdf5plugin package "
                                "(pip install hdf5plugin), or choose gzip")
         self.path = Path(path)
-        self.f = h5netcdf.File(self.path, "w")
+        # the caller holds the writer's lock on this file (storage.journal.exclusive), so
+        # HDF5's own lock, which would conflict with it, is off
+        self.f = h5netcdf.File(self.path, "w", locking=False)
         sizes = {name: len(values) for name, values in coords.items()}
         if len(models) > 1:
             sizes["model"] = len(models)
@@ -184,6 +186,19 @@ class CubeFile:
             block = data[tuple(slice(c, c + n) for c, n in zip(corner, chunks))]
             offset = (i0 + corner[0], *corner[1:])
             yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec)
+
+    def abandon(self):
+        """Close after a failure (a full disk, an error) without raising, and without
+        leaving h5netcdf a second close to try (and print) at garbage collection."""
+        import contextlib
+
+        self._pool.shutdown(cancel_futures=True)
+        with contextlib.suppress(Exception):
+            self.f.close()
+        if not self.f._closed:
+            with contextlib.suppress(Exception):
+                self.f._h5file.close()
+            self.f._closed = True
 
     def close(self, attrs: dict | None = None):
         self._pool.shutdown()

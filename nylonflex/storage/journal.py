@@ -1,8 +1,23 @@
-"""The journal of a sweep (``<cube>.parts/``) and the lock that makes one writer."""
+"""The journal of a sweep (``<cube>.parts/``) and the lock that makes one writer.
+
+One writer, provably: :func:`exclusive` holds an ``flock`` on ``<cube>.lock`` (a releasing
+writer unlinks it while still holding it, and a taker checks that the file it locked is
+still the one at that path, so the unlink-then-unlock race cannot admit two writers) *and*
+on ``<cube>.building`` itself, opened without truncation. Deleting a "stale" lock file
+therefore does not let a second writer in: the building file's lock refuses it before it
+touches any file. The cube writer opens the building file with HDF5's own locking off,
+since this process already holds the lock on it.
+
+The journal verifies itself: the manifest records its format, the nylonflex version, the
+model digest and a digest of its own content; every slab file records its index, its
+radius range and a digest of its arrays (bound to the config's hash). A slab that fails
+verification is recomputed, never trusted.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import shutil
@@ -10,7 +25,36 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Journal", "exclusive"]
+from ..files import fsync_dir, publish, refuse_special
+from ..units import InputError
+
+__all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "exclusive", "fsync_dir",
+           "publish", "refuse_special"]
+
+#: Version of the journal's layout (manifest keys, slab metadata).
+JOURNAL_FORMAT = 2
+_MANIFEST_KEYS = ("format", "name", "config_sha256", "slabs", "radius_chunk",
+                  "nylonflex_version", "model_digest", "replaces")
+_LOCK_TEXT = b"nylonflex sweep lock\n"
+
+
+class SlabInvalid(Exception):
+    """A journaled slab that fails verification (its message says why)."""
+
+
+def _digest(config_sha, k, i0, i1, arrays: dict) -> str:
+    h = hashlib.sha256(f"{config_sha}:{k}:{i0}:{i1}".encode())
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"|{name}|{a.dtype.str}|{a.shape}|".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def manifest_digest(manifest: dict) -> str:
+    """The digest of a manifest's content (every key but ``digest``)."""
+    body = {k: v for k, v in manifest.items() if k != "digest"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
 
 class Journal:
@@ -25,15 +69,39 @@ class Journal:
 
     def read_manifest(self) -> dict:
         try:
-            return json.loads(self.manifest.read_text())
+            data = json.loads(self.manifest.read_text())
         except (OSError, ValueError):
             return {}
+        return data if isinstance(data, dict) else {}
+
+    def foreign(self) -> bool:
+        """True when ``<cube>.parts`` exists but is not a journal nylonflex wrote: a
+        non-folder, or a folder with anything but a manifest, slab files and their
+        temporaries in it."""
+        if not os.path.lexists(self.dir):
+            return False
+        if self.dir.is_symlink() or not self.dir.is_dir():
+            return True
+        for p in self.dir.iterdir():
+            if p.name in ("manifest.json", "manifest.json.tmp"):
+                continue
+            if p.name.startswith("slab-") and p.suffix in (".npz", ".tmp") and p.is_file():
+                continue
+            return True
+        return False
 
     def start(self, manifest: dict):
+        """Begin a journal (the folder must be absent, empty or a nylonflex journal)."""
+        if self.foreign():
+            raise InputError(f"{self.dir} exists and was not written by nylonflex; it is "
+                             "not deleted: move it or choose another --out")
         if self.dir.exists():
             shutil.rmtree(self.dir)
         self.dir.mkdir(parents=True)
+        manifest = {"format": JOURNAL_FORMAT, **manifest}
+        manifest["digest"] = manifest_digest(manifest)
         _atomic_write(self.manifest, json.dumps(manifest, indent=1).encode())
+        fsync_dir(self.dir.parent)
 
     def _slab_path(self, k):
         return self.dir / f"slab-{k:06d}.npz"
@@ -45,44 +113,158 @@ class Journal:
                 out.add(int(p.stem.split("-")[1]))
         return out
 
-    def save(self, k: int, arrays: dict):
+    def save(self, k: int, arrays: dict, *, slab=(0, 0), config_sha: str = ""):
+        """Journal slab ``k`` (radii ``slab``) with its index, range and digest."""
+        i0, i1 = (int(x) for x in slab)
+        meta = {"index": int(k), "slab": [i0, i1], "config_sha256": config_sha,
+                "digest": _digest(config_sha, k, i0, i1, arrays)}
         tmp = self._slab_path(k).with_suffix(".tmp")
         with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+            np.savez(fh, **arrays, __meta__=np.frombuffer(json.dumps(meta).encode(),
+                                                          np.uint8))
+            fh.flush()
+            os.fsync(fh.fileno())
         os.replace(tmp, self._slab_path(k))
+        fsync_dir(self.dir)
 
-    def load(self, k: int) -> dict:
-        with np.load(self._slab_path(k)) as z:
-            return {name: z[name] for name in z.files}
+    def load(self, k: int, *, slab=None, config_sha: str | None = None) -> dict:
+        """Slab ``k``'s arrays, verified against its index, radius range ``slab`` and
+        digest; :class:`SlabInvalid` when anything does not match or cannot be read."""
+        path = self._slab_path(k)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                arrays = {name: z[name] for name in z.files}
+        except Exception as exc:  # noqa: BLE001 - zip, zlib, format: all mean "unreadable"
+            raise SlabInvalid(f"{path.name} is unreadable ({type(exc).__name__})") from None
+        raw = arrays.pop("__meta__", None)
+        if raw is None:
+            raise SlabInvalid(f"{path.name} has no index, range or digest")
+        try:
+            meta = json.loads(raw.tobytes().decode())
+            index, (i0, i1), digest = meta["index"], meta["slab"], meta["digest"]
+        except Exception:  # noqa: BLE001
+            raise SlabInvalid(f"{path.name} has damaged metadata") from None
+        if index != k:
+            raise SlabInvalid(f"{path.name} holds slab {index}, not {k}")
+        if slab is not None and [i0, i1] != [int(x) for x in slab]:
+            raise SlabInvalid(f"{path.name} holds radii {i0}..{i1}, not "
+                              f"{slab[0]}..{slab[1]}")
+        sha = meta.get("config_sha256", "") if config_sha is None else config_sha
+        if _digest(sha, k, i0, i1, arrays) != digest:
+            raise SlabInvalid(f"{path.name} fails its digest")
+        return arrays
+
+    def discard(self, k: int):
+        """Remove slab ``k``'s file (it failed verification and will be recomputed)."""
+        with contextlib.suppress(OSError):
+            self._slab_path(k).unlink()
 
     def remove(self):
         shutil.rmtree(self.dir, ignore_errors=True)
+        fsync_dir(self.dir.parent)
 
 
 def _atomic_write(path: Path, data: bytes):
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(data)
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
     os.replace(tmp, path)
+    fsync_dir(path.parent)
+
+
+def _busy(cube_path, what) -> RuntimeError:
+    return RuntimeError(f"another sweep is writing {cube_path} ({what} is locked); wait "
+                        "for it or stop it first")
+
+
+def _lock_file(lock: Path):
+    """An fd of ``lock`` holding its flock: the file at that path when the lock was won."""
+    import fcntl
+
+    refuse_special(lock, "--out")
+    if lock.is_file() and lock.stat().st_size and \
+            not lock.read_bytes()[:64].startswith(_LOCK_TEXT.strip()):
+        raise InputError(f"{lock} exists and is not a nylonflex lock; it is not replaced: "
+                         "move it or choose another --out")
+    while True:
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            return None
+        try:
+            same = os.stat(lock).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            os.ftruncate(fd, 0)
+            os.write(fd, _LOCK_TEXT + f"pid {os.getpid()}\n".encode())
+            return fd
+        os.close(fd)  # a releasing writer unlinked it after we opened it: take the new one
+
+
+def building_path(cube_path) -> Path:
+    cube_path = Path(cube_path)
+    return cube_path.with_name(cube_path.name + ".building")
+
+
+def building_is_ours(building: Path, journal: Journal) -> bool:
+    """Whether an existing ``<cube>.building`` may be rewritten: empty, an HDF5 file (a
+    building cube), or accompanied by this output's journal."""
+    import h5py
+
+    if not building.exists():
+        return True
+    if building.stat().st_size == 0 or journal.exists():
+        return True
+    try:
+        return h5py.is_hdf5(building)
+    except OSError:
+        return False
 
 
 @contextlib.contextmanager
 def exclusive(cube_path):
-    """Hold ``<cube>.lock`` for a run; a second run on the same output is refused."""
+    """Hold the writer's locks on ``<cube>.lock`` and ``<cube>.building`` for a run.
+
+    A second run on the same output is refused (RuntimeError) before it changes any file,
+    even when the first run's lock file was deleted. Yields the path of the building file,
+    which the holder may then open for writing (with HDF5 file locking off).
+    """
     import fcntl
 
+    cube_path = Path(cube_path)
     lock = Path(str(cube_path) + ".lock")
+    building = building_path(cube_path)
     lock.parent.mkdir(parents=True, exist_ok=True)
-    fh = open(lock, "a+")
+    refuse_special(building, "--out")
+    fd = _lock_file(lock)
+    if fd is None:
+        raise _busy(cube_path, lock.name)
+    bfd, created = None, False
     try:
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        fh.close()
-        raise RuntimeError(f"another sweep is writing {cube_path} (lock {lock}); "
-                           "wait for it or stop it first") from None
-    try:
-        yield
+        if not building_is_ours(building, Journal(cube_path)):
+            raise InputError(f"{building} exists and was not written by nylonflex; it is "
+                             "not replaced: move it or choose another --out")
+        created = not building.exists()
+        bfd = os.open(building, os.O_RDWR | os.O_CREAT, 0o644)  # never truncating
+        try:
+            fcntl.flock(bfd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise _busy(cube_path, building.name) from None
+        yield building
     finally:
+        if bfd is not None:
+            # an unused building file this run created is not left behind
+            with contextlib.suppress(OSError):
+                st = os.stat(building)
+                if created and st.st_ino == os.fstat(bfd).st_ino and st.st_size == 0:
+                    building.unlink()
+            os.close(bfd)
         with contextlib.suppress(OSError):
-            lock.unlink()
-        fcntl.flock(fh, fcntl.LOCK_UN)
-        fh.close()
+            lock.unlink()  # while still held: a waiting taker re-checks the inode
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)

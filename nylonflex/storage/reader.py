@@ -68,10 +68,9 @@ def open_cube(path, *, quiet: bool = False):
         if not quiet:
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
                           "computed; the rest is masked", stacklevel=2)
-        mask = xr.DataArray(done, dims=("radius",), coords={"radius": ds["radius"]})
         for name in [n for n in ds.data_vars if n in {**DESIGN, **CURVES, **UNCERTAIN}]:
             if "radius" in ds[name].dims:
-                ds[name] = ds[name].where(mask)
+                ds[name] = _masked(ds[name].variable, done)
     return ds
 
 
@@ -89,6 +88,57 @@ def _validity_lines(ds) -> list[str]:
     per = " (counted over every model)" if "model" in ds.dims else ""
     return [f"flagged   {flagged:,} of {v.size:,} design values ({100 * flagged / n:.1f} %)"
             f"{per}: " + ", ".join(parts)]
+
+
+def _masked(var, done):
+    """``var`` with the radii not ``done`` read as NaN, lazily: nothing is loaded until
+    indexed, and then only the part indexed (``where`` would load the whole variable)."""
+    import xarray as xr
+    from xarray.core import indexing
+
+    dtype = np.result_type(var.dtype, np.float32)
+    array = indexing.LazilyIndexedArray(_masked_array_class()(var, done, dtype))
+    return xr.Variable(var.dims, array, var.attrs, var.encoding)
+
+
+_MASKED = []
+
+
+def _masked_array_class():
+    """The lazy masked backend array class (made on first use: xarray is imported lazily)."""
+    if _MASKED:
+        return _MASKED[0]
+    from xarray.backends import BackendArray
+    from xarray.core import indexing
+
+    class MaskedArray(BackendArray):
+        """Reads through the lazily opened variable; masks the radii that are not done
+        (the first axis)."""
+
+        def __init__(self, var, done, dtype):
+            self.var, self.done = var, done
+            self.shape, self.dtype = var.shape, np.dtype(dtype)
+
+        def __getitem__(self, key):
+            return indexing.explicit_indexing_adapter(
+                key, self.shape, indexing.IndexingSupport.OUTER, self._get)
+
+        _get = _masked_get
+
+    _MASKED.append(MaskedArray)
+    return MaskedArray
+
+
+def _masked_get(self, key):
+        data = np.asarray(self.var[key].values, dtype=self.dtype)
+        keep = self.done[key[0]]
+        if np.ndim(keep) == 0:
+            return data if keep else np.full_like(data, np.nan)
+        index = [slice(None)] * data.ndim
+        index[0] = ~np.asarray(keep, bool)
+        data = np.array(data, copy=True) if not data.flags.writeable else data
+        data[tuple(index)] = np.nan
+        return data
 
 
 def cube_summary(path) -> list[str]:

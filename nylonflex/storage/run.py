@@ -5,15 +5,16 @@ Durability: every finished slab of radii is journaled as its own ``.npz`` file i
 absent; it holds the slab's compressed chunks, see :meth:`CubeFile.encode`) and written
 into ``<cube>.building``. Only a finished run renames the building file to ``<cube>``: a
 killed run never leaves a file that reads as complete. ``--resume`` keeps the journal's
-slabs (if the config hash matches) and computes the rest. A run stopped by Ctrl-C or SIGTERM
-also leaves ``<cube>`` with ``complete = "false"`` and a ``slab_done`` mask, so the part
+slabs (if the config hash, the nylonflex version and the model digest match, and each slab
+passes its own verification; a slab that fails is recomputed) and computes the rest. A run
+stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete = "false"`` and a ``slab_done`` mask, so the part
 already done can be queried.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
-import os
+import errno
 import platform
 from pathlib import Path
 
@@ -21,95 +22,172 @@ from .. import __version__
 from ..config import ResolvedConfig
 from ..engine.grid import coords, cube_variables, global_arrays, plan_slabs
 from ..engine.provenance import provenance
-from ..engine.slabs import LocalExecutor, run_slabs
+from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
 from ..units import InputError
 from .cube import CubeFile
-from .journal import Journal, exclusive
+from .journal import JOURNAL_FORMAT, Journal, SlabInvalid, exclusive, manifest_digest, \
+    publish, refuse_special
 from .reader import cube_attrs
 
-__all__ = ["CubeSink", "Interrupted", "sweep_to_file"]
+__all__ = ["CubeSink", "DiskFull", "Interrupted", "sweep_to_file"]
 
 
 class Interrupted(KeyboardInterrupt):
     """A sweep stopped early (Ctrl-C or SIGTERM); its slabs are journaled for --resume."""
 
 
+class DiskFull(RuntimeError):
+    """The disk filled up during a sweep; the journal keeps what was done for --resume."""
+
+
 class CubeSink:
     """Journals each slab, then writes it into the building cube file."""
 
-    def __init__(self, cube: CubeFile, journal: Journal):
+    def __init__(self, cube: CubeFile, journal: Journal, config_sha: str = ""):
         self.cube = cube
         self.journal = journal
+        self.config_sha = config_sha
 
     def put(self, k, i0, i1, arrays):
         encoded = self.cube.encode(i0, arrays)
-        self.journal.save(k, encoded)
+        self.journal.save(k, encoded, slab=(i0, i1), config_sha=self.config_sha)
         self.cube.write_encoded(i0, i1, encoded)
 
 
-def _check_resume(cfg, out, journal, resume, log):
+def _versions() -> dict:
+    from ..kernels._compile import source_digest
+
+    return {"format": JOURNAL_FORMAT, "nylonflex_version": __version__,
+            "model_digest": source_digest()}
+
+
+def _check_existing(cfg, out, attrs, resume, overwrite, log):
+    """What an existing cube at ``out`` allows: None (nothing to do) or whether this run
+    replaces a finished cube (only with --overwrite)."""
+    if attrs is None:
+        return False
+    same = attrs.get("config_sha256") == cfg.sha256
+    complete = attrs.get("complete") == "true"
+    if resume and not same and not overwrite:
+        raise InputError(f"--resume: {out} was made from another config "
+                         f"(sha256 {str(attrs.get('config_sha256', '?'))[:12]} vs "
+                         f"{cfg.sha256[:12]}); add --overwrite (without --resume) to "
+                         "replace it")
+    if complete and same and not overwrite:
+        log(f"{out} is already complete and up to date (same config); nothing to do")
+        return None
+    if not overwrite and not (resume and same):
+        state = "finished" if complete else "incomplete"
+        whose = "this" if same else "another"
+        raise InputError(f"--out: {out} holds a {state} cube of {whose} config "
+                         f"('{_short(attrs.get('name'))}'); it is not replaced: add "
+                         "--overwrite to replace it, or choose another --out")
+    return complete
+
+
+def _short(value, n=40) -> str:
+    text = str(value)
+    return text if len(text) <= n else text[:n] + "..."
+
+
+def _check_resume(cfg, out, journal, resume, log, overwrite=False):
     """Decide what to keep: ``None`` (nothing to do), or the journal's slab plan, its chunk
     length along radius, the indices of its finished slabs (an empty plan: start afresh)
-    and the codec of the journaled chunks."""
+    whether the run replaces a finished cube at ``out`` and the codec of the journaled
+    chunks."""
+    refuse_special(out, "--out")
+    attrs = cube_attrs(out) if out.exists() else None
+    if out.exists() and attrs is None:
+        raise InputError(f"--out: {out} exists and is not a nylonflex cube; it is not "
+                         "replaced: choose another --out or move it")
+    if journal.foreign():
+        raise InputError(f"{journal.dir} exists and was not written by nylonflex; it is "
+                         "not deleted: move it or choose another --out")
     manifest = journal.read_manifest() if journal.exists() else None
-    if manifest is not None and not resume:
-        raise InputError(f"{out}: an interrupted run of '{manifest.get('name')}' is in "
-                         f"{journal.dir}; add --resume to finish it, or delete that folder")
-    if not resume:
-        return [], None, set(), cfg.compression
-    if manifest is None:
-        attrs = cube_attrs(out)
-        if attrs and attrs.get("config_sha256") != cfg.sha256:
-            raise InputError(f"--resume: {out} was made from another config "
-                             f"(sha256 {attrs.get('config_sha256', '?')[:12]} vs "
-                             f"{cfg.sha256[:12]}); drop --resume to overwrite it")
-        if attrs and attrs.get("complete") == "true":
-            log(f"{out} is already complete; nothing to resume")
+    if manifest is not None and not resume and not overwrite:
+        raise InputError(f"{out}: an interrupted run of '{_short(manifest.get('name'))}' is "
+                         f"in {journal.dir}; add --resume to finish it, --overwrite to start "
+                         "afresh, or delete that folder")
+    if manifest is None or not resume:
+        replaces = _check_existing(cfg, out, attrs, resume, overwrite, log)
+        if replaces is None:
             return None
-        log("nothing to resume; starting the sweep")
-        return [], None, set(), cfg.compression
+        if resume:
+            log("nothing to resume; starting the sweep")
+        return [], None, set(), replaces, cfg.compression
     if manifest.get("config_sha256") != cfg.sha256:
         raise InputError(f"--resume: the config changed since the interrupted run "
-                         f"(sha256 {manifest.get('config_sha256', '?')[:12]} vs "
+                         f"(sha256 {str(manifest.get('config_sha256', '?'))[:12]} vs "
                          f"{cfg.sha256[:12]}); delete {journal.dir} to start over")
     # the journal's own slab plan and chunking: slab_megabytes may differ now (it is not in
     # the hash), and journaled slabs hold compressed chunks of the recorded shape
-    slabs = [tuple(int(i) for i in s) for s in manifest.get("slabs", [])]
+    try:
+        slabs = [tuple(int(i) for i in s) for s in manifest.get("slabs", [])]
+    except (TypeError, ValueError):
+        slabs = []
     edges = [i for s in slabs for i in s]
     chunk = manifest.get("radius_chunk")
-    if not slabs or edges[0] != 0 or edges[-1] != cfg.shape[0] or \
+    if not slabs or any(len(s) != 2 for s in slabs) or edges[0] != 0 or \
+            edges[-1] != cfg.shape[0] or \
             any(a != b for a, b in zip(edges[1:-1:2], edges[2::2])) or \
-            not isinstance(chunk, int) or chunk < 1:
-        raise InputError(f"--resume: {journal.manifest} is damaged; delete {journal.dir} "
-                         "to start over")
+            any(a >= b for a, b in slabs) or not isinstance(chunk, int) or chunk < 1 or \
+            manifest.get("digest") != manifest_digest(manifest):
+        raise InputError(f"--resume: {journal.manifest} is damaged or was edited; delete "
+                         f"{journal.dir} to start over")
+    now = _versions()
+    differs = [f"{key} {_short(manifest.get(key))} (now {value})" for key, value in now.items()
+               if manifest.get(key) != value]
+    if differs:
+        raise InputError(f"--resume: the journal in {journal.dir} was written with "
+                         f"{'; '.join(differs)}; its slabs would mix two models: delete "
+                         f"{journal.dir} and run again without --resume")
+    replaces = bool(manifest.get("replaces")) and attrs is not None
     codec = manifest.get("compression", "gzip")  # journaled chunks are in this codec
     if codec != cfg.compression:
         log(f"resuming with the journal's compression, {codec} (the config now says "
             f"{cfg.compression})")
-    return slabs, chunk, journal.done() & set(range(len(slabs))), codec
+    return slabs, chunk, journal.done() & set(range(len(slabs))), replaces, codec
+
+
+def _needed_gigabytes(cfg) -> float:
+    from ..engine.grid import _bytes_per_radius
+
+    return 2 * _bytes_per_radius(cfg) * cfg.shape[0] / 1e9
+
+
+def _disk_full(exc) -> bool:
+    return getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT) or \
+        "No space left" in str(exc) or "errno = 28" in str(exc)
 
 
 def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, scheduler=None,
-                  progress=None, log=None) -> Path:
+                  progress=None, log=None, overwrite=False) -> Path:
     """Sweep ``cfg`` into the cube file ``out`` (one writer: a second run is refused).
 
     Parameters are those of :func:`nylonflex.run_sweep`; ``progress`` receives the designs
-    each stored slab adds, ``log`` one-line messages.
+    each stored slab adds, ``log`` one-line messages. A finished cube at ``out`` is
+    replaced only with ``overwrite`` (atomically: an interrupted replacement leaves it in
+    place); with the same config it is up to date and left alone. Anything at ``out`` that
+    is not a nylonflex cube is refused, never replaced.
 
     Raises
     ------
     Interrupted
-        Ctrl-C or SIGTERM stopped the run; ``out`` is marked incomplete and the journal
-        keeps every finished slab for ``--resume``.
+        Ctrl-C or SIGTERM stopped the run; ``out`` is marked incomplete (or, when it held a
+        finished cube, left as it was) and the journal keeps every finished slab for
+        ``--resume``.
+    DiskFull
+        The disk filled up; the journal keeps what was done for ``--resume``.
     """
     log = log or (lambda msg: None)
     out = Path(out)
-    with exclusive(out):
+    refuse_special(out, "--out")
+    with exclusive(out) as building:
         journal = Journal(out)
-        decision = _check_resume(cfg, out, journal, resume, log)
+        decision = _check_resume(cfg, out, journal, resume, log, overwrite)
         if decision is None:
             return out
-        slabs, chunk, keep, codec = decision
+        slabs, chunk, keep, replaces, codec = decision
         if slabs:
             log(f"resuming: {len(keep)} of {len(slabs)} slabs already done")
         else:
@@ -125,27 +203,56 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
             if not keep:
                 journal.start({"name": cfg.name, "config_sha256": cfg.sha256,
                                "slabs": [list(s) for s in slabs], "radius_chunk": chunk,
-                               "compression": codec, "nylonflex_version": __version__})
-            _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log)
+                               "compression": codec, **_versions(),
+                               "replaces": bool(replaces)})
+            _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor,
+                   progress, log, replaces)
+        except OSError as exc:
+            if not _disk_full(exc):
+                raise
+            raise DiskFull(f"the disk of {out.parent} is full; this run needs up to "
+                           f"{_needed_gigabytes(cfg):.3g} GB (cube and journal, before "
+                           f"compression); the finished slabs are kept in {journal.dir}: "
+                           "free some space and run again with --resume") from None
         finally:
             executor.close()
     return out
 
 
-def _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log):
+def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log,
+           replaces=False):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
-    building = out.with_name(out.name + ".building")
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
                     cfg.models)
+    try:
+        _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
+              replaces)
+    except BaseException:
+        cube.abandon()
+        raise
+
+
+def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
+          replaces):
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
+    kept = set()
     for k in sorted(keep):
         i0, i1 = slabs[k]
-        cube.write_encoded(i0, i1, journal.load(k))
+        try:
+            arrays = journal.load(k, slab=(i0, i1), config_sha=cfg.sha256)
+        except SlabInvalid as why:
+            log(f"journal: {why}; recomputing that slab")
+            journal.discard(k)
+            continue
+        cube.write_encoded(i0, i1, arrays)
+        kept.add(k)
         if progress is not None:
             progress((i1 - i0) * per_radius)
+    keep = kept
     todo = [k for k in range(len(slabs)) if k not in keep]
-    stats = run_slabs(cfg, slabs, todo, executor, CubeSink(cube, journal), progress)
+    stats = run_slabs(cfg, slabs, todo, executor, CubeSink(cube, journal, cfg.sha256),
+                      progress)
     done = len(keep) + len(stats.done)
     complete = not stats.stopped and done == len(slabs)
     seconds = stats.seconds
@@ -159,13 +266,18 @@ def _write(cfg, out, journal, slabs, keep, chunk, codec, executor, progress, log
         "python_version": platform.python_version(),
         "hostname": platform.node(),
     }
-    cube.close(final)
-    os.replace(building, out)
+    with deferred_signals():  # the publishing steps run to their end
+        cube.close(final)
+        if complete or not replaces:
+            publish(building, out)
+        if complete:
+            journal.remove()
     if complete:
-        journal.remove()
         log(f"wrote {out}: {cfg.n_designs:,} designs in {seconds:.2f} s "
             f"({final['designs_per_second']} designs/s computed)")
         return
-    log(f"stopped: {done} of {len(slabs)} slabs saved in {journal.dir}; "
-        f"{out} is marked incomplete. Finish with --resume.")
+    where = (f"{out} (the finished cube) is kept until this run completes"
+             if replaces else f"{out} is marked incomplete")
+    log(f"stopped: {done} of {len(slabs)} slabs saved in {journal.dir}; {where}. "
+        "Finish with --resume.")
     raise Interrupted

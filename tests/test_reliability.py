@@ -1,0 +1,631 @@
+"""Reliability: nothing lost, nothing corrupted, nothing hangs (issue 16).
+
+Each test keeps one finding of the attack on the tool as a regression: the writer's lock,
+the journal's verification, the output path, hostile input (alias bombs, deep nesting,
+huge grids, implausible materials), Dask listeners that never answer, signals and a full
+disk. The fast ones run in-process on small grids; the kill-and-resume loops are slow.
+"""
+
+import errno
+import fcntl
+import os
+import random
+import resource
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import h5py
+import json
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+import nylonflex.storage.journal as journal_mod
+import nylonflex.storage.run as run_mod
+from nylonflex.cli import main
+from nylonflex.config import parse_config
+from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
+from nylonflex.sweep import run_sweep
+from nylonflex.units import InputError
+
+#: 6 slabs of 3 radii (slab_megabytes 1), about a second to sweep.
+MULTI = {
+    "name": "multi",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 18, "units": "mm"},
+        "wall_thickness": {"start": 1, "stop": 6, "num": 30, "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"start": 3, "stop": 30, "num": 30, "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 40, "num": 5, "units": "kPa"}},
+    "slab_megabytes": 1,
+}
+
+
+def stable(ds):
+    ds = ds.copy()
+    ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS}
+    return ds
+
+
+def write_config(folder, raw, name="cfg.yaml"):
+    path = folder / name
+    path.write_text(yaml.safe_dump(raw))
+    return path
+
+
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory):
+    """The reference cube of MULTI, swept without interruption."""
+    return run_sweep(parse_config(MULTI), tmp_path_factory.mktemp("whole") / "cube.h5")
+
+
+def interrupted(out, k=3, raw=MULTI, **kwargs):
+    """Sweep ``raw`` into ``out``, stopping it (SIGTERM to itself) after ``k`` slabs."""
+    original = run_mod.run_slabs
+
+    def run_slabs(cfg, plan, todo, executor, sink, progress=None):
+        class Stopping:
+            stored = 0
+
+            def put(self, *args):
+                sink.put(*args)
+                Stopping.stored += 1
+                if Stopping.stored == k:
+                    os.kill(os.getpid(), signal.SIGTERM)
+
+        return original(cfg, plan, todo, executor, Stopping(), progress)
+
+    run_mod.run_slabs = run_slabs
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_sweep(parse_config(raw), out, **kwargs)
+    finally:
+        run_mod.run_slabs = original
+
+
+def resume(out, raw=MULTI, log=None):
+    return run_sweep(parse_config(raw), out, resume=True, log=log)
+
+
+# --------------------------------------------------------------------------- 1. two writers
+
+def test_lock_race_unlink_before_release_admits_one_writer(tmp_path, monkeypatch):
+    # writer A holds the lock; writer B opened the lock file just before A released it
+    # (the injected delay): B's flock then succeeds on the unlinked file. B must notice
+    # and lock the file now at the path, so that a third writer C is refused.
+    out = tmp_path / "cube.h5"
+    a = exclusive(out)
+    a.__enter__()
+    real_flock = fcntl.flock
+    released = []
+
+    def delayed_flock(fd, op):
+        if not released and op & fcntl.LOCK_NB and op & fcntl.LOCK_EX:
+            released.append(True)
+            a.__exit__(None, None, None)  # A releases between B's open and B's flock
+        return real_flock(fd, op)
+
+    monkeypatch.setattr(fcntl, "flock", delayed_flock)
+    with exclusive(out):
+        monkeypatch.setattr(fcntl, "flock", real_flock)
+        lock = out.with_name(out.name + ".lock")
+        assert lock.exists()
+        with pytest.raises(RuntimeError, match="another sweep is writing"):
+            with exclusive(out):
+                pass
+
+
+_HOLD = """
+import sys, time
+import h5py
+from nylonflex.storage import exclusive
+with exclusive(sys.argv[1]) as building:
+    with h5py.File(building, "w", locking=False) as f:
+        f["x"] = list(range(1000))
+    print("held", flush=True)
+    time.sleep(60)
+"""
+
+
+def test_deleting_the_lock_file_does_not_let_a_second_writer_in(tmp_path, capsys):
+    out = tmp_path / "cube.h5"
+    cfg = write_config(tmp_path, MULTI)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    first = subprocess.Popen([sys.executable, "-c", _HOLD, str(out)], stdout=subprocess.PIPE,
+                             env=env)
+    try:
+        assert first.stdout.readline().strip() == b"held"
+        out.with_name("cube.h5.lock").unlink()  # "a stale lock"
+        rc = main(["sweep", str(cfg), "--out", str(out), "--resume", "--quiet",
+                   "--no-charts"])
+        assert rc == 1
+        assert "another sweep is writing" in capsys.readouterr().err
+        # the first writer's file is untouched, and nothing was published
+        with h5py.File(out.with_name("cube.h5.building"), "r", locking=False) as f:
+            assert f["x"][-1] == 999
+        assert not out.exists()
+    finally:
+        first.kill()
+        first.wait()
+
+
+# --------------------------------------------------------------------------- 3. the journal
+
+def _tamper_swap(parts):
+    a, b = parts / "slab-000000.npz", parts / "slab-000001.npz"
+    tmp = parts / "x"
+    a.rename(tmp), b.rename(a), tmp.rename(b)
+
+
+def _tamper_empty(parts):
+    (parts / "slab-000001.npz").write_bytes(b"")
+
+
+def _tamper_deflate(parts):
+    p = parts / "slab-000002.npz"
+    data = bytearray(p.read_bytes())
+    for i in range(len(data) // 3, len(data) // 3 + 64):
+        data[i] ^= 0x5A
+    p.write_bytes(bytes(data))
+
+
+def _tamper_arrays(parts):
+    # a well-formed slab file whose arrays were changed: only the digest can tell
+    p = parts / "slab-000000.npz"
+    with np.load(p) as z:
+        arrays = {k: z[k] for k in z.files}
+    key = next(k for k in arrays if k.endswith(":bytes"))
+    arrays[key] = arrays[key].copy()
+    arrays[key][:8] = 0
+    with open(p, "wb") as fh:
+        np.savez(fh, **arrays)
+
+
+@pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_deflate,
+                                    pytest.param(_tamper_empty, marks=pytest.mark.slow),
+                                    pytest.param(_tamper_arrays, marks=pytest.mark.slow)])
+def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    tamper(Journal(out).dir)
+    messages = []
+    ds = resume(out, log=messages.append)
+    assert any("recomputing" in m for m in messages), messages
+    assert ds.attrs["complete"] == "true"
+    xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
+
+
+def test_an_edited_manifest_is_refused(tmp_path):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    manifest = Journal(out).manifest
+    doc = json.loads(manifest.read_text())
+    doc["radius_chunk"] += 1  # any edit the digest does not cover
+    manifest.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="damaged or was edited"):
+        resume(out)
+
+
+@pytest.mark.parametrize("key,value", [("nylonflex_version", "0.0.1"),
+                                       ("model_digest", "0123456789abcdef"),
+                                       ("format", 1)])
+def test_a_journal_of_another_version_or_model_is_refused(tmp_path, capsys, key, value):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=2)
+    journal = Journal(out)
+    doc = journal.read_manifest()
+    doc.pop("digest"), doc.pop("format")
+    doc[key] = value
+    slabs = {p.name: p.read_bytes() for p in journal.dir.glob("slab-*.npz")}
+    journal.start(doc)
+    if key == "format":  # start() writes the current format: edit it, then re-digest
+        raw = journal.read_manifest()
+        raw["format"] = value
+        raw["digest"] = journal_mod.manifest_digest(raw)
+        journal.manifest.write_text(json.dumps(raw))
+    for name, data in slabs.items():
+        (journal.dir / name).write_bytes(data)
+    cfg = write_config(tmp_path, MULTI)
+    assert main(["sweep", str(cfg), "--out", str(out), "--resume", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err and "delete" in err
+
+
+def test_crash_safety_kill_at_random_points_resumes_identical(tmp_path, whole):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=1)
+    interrupted(out, k=2, resume=True)  # a resume stopped in its turn
+    ds = resume(out)
+    assert ds.attrs["resumed_slabs"] == "3"
+    xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
+
+
+# --------------------------------------------------------------------------- 4. output path
+
+@pytest.fixture
+def small_cfg(tmp_path):
+    raw = {**MULTI, "name": "tiny", "grid": {**MULTI["grid"],
+                                             "radius": {"values": [5, 10], "units": "mm"},
+                                             "wall_thickness": {"values": [1, 2],
+                                                                "units": "mm"}}}
+    return raw, write_config(tmp_path, raw, "tiny.yaml")
+
+
+def sweep(cfg_path, out, *extra):
+    return main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--no-charts",
+                 *extra])
+
+
+def test_out_onto_the_config_itself_is_refused(small_cfg, capsys):
+    raw, cfg = small_cfg
+    before = cfg.read_bytes()
+    assert sweep(cfg, cfg) == 2
+    assert "not a nylonflex cube" in capsys.readouterr().err
+    assert cfg.read_bytes() == before
+
+
+def test_unrelated_parts_lock_and_building_are_left_alone(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    for suffix, make in [(".parts", "folder"), (".lock", "text"), (".building", "text")]:
+        out = tmp_path / f"c{suffix[1:]}.h5"
+        other = out.with_name(out.name + suffix)
+        if make == "folder":
+            other.mkdir()
+            (other / "thesis.tex").write_text("precious")
+        else:
+            other.write_text("precious")
+        assert sweep(cfg, out) == 2, suffix
+        err = capsys.readouterr().err
+        assert "not written by nylonflex" in err or "not a nylonflex lock" in err
+        kept = other / "thesis.tex" if make == "folder" else other
+        assert kept.read_text() == "precious"
+        assert not out.exists()
+
+
+def test_a_finished_cube_is_replaced_only_with_overwrite(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    out = tmp_path / "cube.h5"
+    assert sweep(cfg, out) == 0
+    first = out.stat().st_mtime_ns
+    capsys.readouterr()
+    # identical config: up to date, left alone
+    assert main(["sweep", str(cfg), "--out", str(out), "--no-charts"]) == 0
+    assert "up to date" in capsys.readouterr().err
+    assert out.stat().st_mtime_ns == first
+    other = write_config(tmp_path, {**raw, "name": "other"}, "other.yaml")
+    assert sweep(other, out) == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert open_cube(out).attrs["name"] == "tiny"
+    assert sweep(other, out, "--overwrite") == 0
+    assert open_cube(out).attrs["name"] == "other"
+
+
+@pytest.mark.slow
+def test_an_interrupted_overwrite_keeps_the_old_cube(tmp_path, whole):
+    out = tmp_path / "cube.h5"
+    raw = {**MULTI, "name": "old", "grid": {**MULTI["grid"],
+                                           "radius": {"values": [5, 10], "units": "mm"}}}
+    run_sweep(parse_config(raw), out).close()
+    interrupted(out, k=3, overwrite=True)
+    old = open_cube(out)
+    assert old.attrs["name"] == "old" and old.attrs["complete"] == "true"
+    old.close()
+    ds = resume(out)  # the replacement, once complete, is published
+    xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
+
+
+def test_special_files_are_refused(small_cfg, capsys):
+    raw, cfg = small_cfg
+    assert sweep(cfg, "/dev/null") == 2
+    assert "special file" in capsys.readouterr().err
+
+
+def test_simulate_never_writes_over_a_cube(tmp_path, small_cfg):
+    from nylonflex.simulate import write_simulation
+
+    raw, cfg = small_cfg
+    out = tmp_path / "cube.h5"
+    assert sweep(cfg, out) == 0
+    before = out.read_bytes()
+    with pytest.raises(InputError, match="not a nylonflex simulation"):
+        write_simulation(xr.Dataset({"x": ("t", [1.0])}), out)
+    assert out.read_bytes() == before
+
+
+# --------------------------------------------------------------------------- 2, 10. input
+
+def _bomb(levels=9):
+    lines = ['a0: &a0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    for i in range(1, levels):
+        refs = ", ".join([f"*a{i - 1}"] * 9)
+        lines.append(f"a{i}: &a{i} [{refs}]")
+    return "\n".join(lines) + f"\nname: bomb\nsilicone: {{set: tc5005, mu: *a{levels - 1}}}\n"
+
+
+_MEASURE = """
+import resource, sys, time
+resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))
+t = time.perf_counter()
+from nylonflex.cli import main
+rc = main(["sweep", sys.argv[1], "--out", sys.argv[2], "--quiet"])
+# VmHWM: this process's peak resident memory (ru_maxrss may carry the forking parent's)
+hwm = [line for line in open("/proc/self/status") if line.startswith("VmHWM")]
+peak = int(hwm[0].split()[1]) / 1024 if hwm else 0.0
+print(rc, time.perf_counter() - t, peak, flush=True)
+"""
+
+
+def test_an_alias_bomb_is_refused_quickly_in_little_memory(tmp_path):
+    cfg = tmp_path / "bomb.yaml"
+    cfg.write_text(_bomb())
+    assert len(cfg.read_bytes()) < 800
+    proc = subprocess.run([sys.executable, "-c", _MEASURE, str(cfg), str(tmp_path / "c.h5")],
+                          capture_output=True, text=True, timeout=120)
+    rc, seconds, megabytes = proc.stdout.split()
+    assert rc == "2", proc.stderr
+    assert "aliases expand" in proc.stderr and proc.stderr.count("\n") == 1
+    assert float(megabytes) < 200  # peak memory of the whole process, imports included
+    assert not (tmp_path / "c.h5").exists()
+
+
+@pytest.mark.parametrize("text,match", [
+    ("a: " + "[" * 200 + "]" * 200 + "\n", "nested deeper"),
+    ("name: x\nname: y\n", "appears twice"),
+    ("a: &x [*x]\n", "not valid YAML|refers to itself"),
+])
+def test_hostile_yaml_is_one_line_exit_2(tmp_path, capsys, text, match):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(text)
+    assert main(["sweep", str(cfg), "--out", str(tmp_path / "c.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert __import__("re").search(match, err), err
+
+
+def test_deep_set_and_non_utf8_config(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    assert main(["sweep", str(cfg), "--set", ".".join(["a"] * 5000) + "=1"]) == 2
+    assert "nested deeper" in capsys.readouterr().err
+    assert main(["sweep", str(cfg), "--set", "name=" + "[" * 2000 + "]" * 2000]) == 2
+    capsys.readouterr()
+    bad = tmp_path / "latin1.yaml"
+    bad.write_bytes("name: caf\xe9\n".encode("latin-1"))
+    assert main(["sweep", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert str(bad) in err and "UTF-8" in err
+
+
+@pytest.mark.parametrize("path,value", [
+    (("grid", "radius"), {"values": [True], "units": "mm"}),
+    (("grid", "radius"), {"start": 5, "stop": 10, "num": True}),
+])
+def test_booleans_are_not_numbers(path, value):
+    raw = yaml.safe_load(yaml.safe_dump(MULTI))
+    raw[path[0]][path[1]] = value
+    with pytest.raises(InputError, match="must be a number|true"):
+        parse_config(raw)
+
+
+def test_messages_print_only_a_prefix_of_a_huge_value():
+    raw = yaml.safe_load(yaml.safe_dump(MULTI))
+    raw["grid"]["radius"] = {"start": "x" * 10**7, "stop": 10, "num": 3}
+    with pytest.raises(InputError) as info:
+        parse_config(raw)
+    assert len(str(info.value)) < 300
+
+
+# --------------------------------------------------------------------------- 6. budget
+
+def test_a_huge_grid_is_refused_before_any_file(tmp_path, capsys):
+    raw = {**MULTI, "grid": {**MULTI["grid"],
+                             "radius": {"start": 1, "stop": 50, "num": 100_000},
+                             "wall_thickness": {"start": 1, "stop": 6, "num": 100_000},
+                             "length": {"start": 20, "stop": 200, "num": 100}}}
+    cfg = write_config(tmp_path, raw)
+    out = tmp_path / "run" / "cube.h5"
+    assert main(["sweep", str(cfg), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "designs" in err and "GB" in err and "limits" in err
+    assert not (tmp_path / "run").exists()
+    raw["grid"]["radius"]["num"] = 10
+    raw["grid"]["wall_thickness"]["num"] = 10
+    raw["limits"] = {"designs": 1000}
+    with pytest.raises(InputError, match="budget of 1,000 designs"):
+        parse_config(raw)
+
+
+def test_long_value_lists_are_capped():
+    raw = yaml.safe_load(yaml.safe_dump(MULTI))
+    raw["curves"]["stroke"] = {"values": [0.01] * 200_001}
+    with pytest.raises(InputError, match="at most"):
+        parse_config(raw)
+
+
+# --------------------------------------------------------------------------- 9. materials
+
+@pytest.mark.parametrize("override,match", [
+    ({"silicone": {"set": "tc5005", "mu": [1e-300, 1e-300]}}, "silicone.mu"),
+    ({"nylon": {"set": "silver_nylon66", "fibre_diameter": 1e-300}}, "nylon.fibre_diameter"),
+    ({"nylon": {"set": "silver_nylon66", "tensile_strength_table": [1, 1, 1, 1]}},
+     "nylon.tensile_strength_table"),
+    ({"nylon": {"set": "silver_nylon66", "gamma": float("nan")}}, "nylon.gamma"),
+    ({"nylon": {"set": "silver_nylon66", "stiffness": float("nan")}}, "nylon.stiffness"),
+    ({"nylon": {"set": "silver_nylon66", "damping": float("inf")}}, "nylon.damping"),
+])
+def test_implausible_materials_are_refused_with_their_range(override, match):
+    with pytest.raises(InputError, match=match + r".*(\[|must be)"):
+        parse_config({**MULTI, **override})
+
+
+def test_array_material_fields_are_range_checked():
+    import nylonflex as nf
+
+    with pytest.raises(ValueError, match=r"nylon.gamma: must be finite"):
+        nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.7, 0.14,
+                    nylon={"set": "silver_nylon66", "gamma": np.array([[1e-4], [np.nan]])})
+    with pytest.raises(ValueError, match=r"nylon.tensile_strength_table: must be finite and in"):
+        nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.7, 0.14,
+                    nylon={"set": "silver_nylon66",
+                           "tensile_strength_table": np.array([[1.0, 1, 1, 1], [1e8] * 4])})
+
+
+def test_accepted_input_gives_no_nan_and_use_at_most_one(whole):
+    ds = whole
+    for name in ("nylon_use", "tip_force_max", "pressure_max"):
+        values = ds[name].values
+        assert np.all(np.isfinite(values)), name
+    assert float(ds["nylon_use"].max()) <= 1 + 1e-9
+
+
+# --------------------------------------------------------------------------- 5. reading
+
+def test_an_incomplete_cube_is_masked_lazily(tmp_path, whole):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = open_cube(out)
+    var = ds["tip_force_max"].variable
+    assert not isinstance(var._data, np.ndarray)  # nothing loaded by opening
+    done = ds["slab_done"].values.astype(bool)
+    part = ds["tip_force_max"].isel(radius=slice(0, 20)).values
+    assert np.isnan(part[~done[:20]]).all()
+    np.testing.assert_array_equal(part[done[:20]],
+                                  whole["tip_force_max"].values[:20][done[:20]])
+
+
+# --------------------------------------------------------------------------- 7. Dask
+
+def test_a_silent_listener_as_scheduler_times_out(tmp_path):
+    pytest.importorskip("distributed")
+    from nylonflex.engine.cluster import DaskExecutor
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(4)
+    srv.settimeout(20)  # bounded: closes itself
+    accepted = []
+
+    def accept():
+        try:
+            while True:
+                accepted.append(srv.accept()[0])
+        except OSError:
+            pass
+
+    threading.Thread(target=accept, daemon=True).start()
+    try:
+        with pytest.raises(InputError, match="no Dask scheduler answers"):
+            DaskExecutor(f"tcp://127.0.0.1:{srv.getsockname()[1]}", timeout=1.0)
+    finally:
+        srv.close()
+        for c in accepted:
+            c.close()
+
+
+# --------------------------------------------------------------------------- 8. signals, disk
+
+def test_a_full_disk_is_one_line_with_the_size_and_resume(tmp_path, small_cfg, capsys,
+                                                           monkeypatch):
+    raw, cfg = small_cfg
+    out = tmp_path / "cube.h5"
+    real = Journal.save
+
+    def full(self, k, arrays, **kw):
+        if k >= 0:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, k, arrays, **kw)
+
+    monkeypatch.setattr(Journal, "save", full)
+    assert sweep(cfg, out) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "GB" in err and "--resume" in err and "full" in err
+    monkeypatch.setattr(Journal, "save", real)
+    assert sweep(cfg, out, "--resume") == 0
+
+
+def test_a_signal_while_a_slab_computes_stops_after_it(tmp_path):
+    # the handler only records: a raise that lands in a weakref callback is swallowed
+    from nylonflex.engine.slabs import run_slabs
+
+    class Executor:
+        def map_slabs(self, cfg, slabs, todo):
+            for k in todo:
+                if k == 1:
+                    os.kill(os.getpid(), signal.SIGINT)
+                yield k, {}
+
+    class Sink:
+        stored = []
+
+        def put(self, k, *args):
+            Sink.stored.append(k)
+
+    cfg = parse_config(MULTI)
+    stats = run_slabs(cfg, [(0, 4), (4, 8), (8, 12)], [0, 1, 2], Executor(), Sink())
+    assert stats.stopped and Sink.stored == [0, 1]
+
+
+_SIGNAL_AT = """
+import os, random, signal, sys, threading, time
+delay, sig = float(sys.argv[1]), int(sys.argv[2])
+from nylonflex.cli import main  # a signal during Python's own start-up is not covered
+timer = threading.Timer(delay, lambda: os.kill(os.getpid(), sig))
+timer.daemon = True  # a run that finishes first exits without waiting for it
+timer.start()
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.slow
+def test_signals_at_random_points_stop_cleanly_and_resume_identical(tmp_path, whole):
+    cfg = write_config(tmp_path, MULTI)
+    rng = random.Random(16)
+    for trial in range(8):
+        out = tmp_path / f"t{trial}" / "cube.h5"
+        sig = rng.choice([signal.SIGINT, signal.SIGTERM])
+        delay = rng.uniform(0.0, 6.0)
+        proc = subprocess.run([sys.executable, "-c", _SIGNAL_AT, str(delay), str(int(sig)),
+                               "sweep", str(cfg), "--out", str(out), "--quiet",
+                               "--no-charts"], capture_output=True, text=True, timeout=300)
+        assert "Traceback" not in proc.stderr, proc.stderr
+        assert proc.returncode in (0, 130, -signal.SIGTERM), (proc.returncode, proc.stderr)
+        if proc.returncode == 0:
+            continue  # finished before the signal
+        assert sweep(cfg, out, "--resume") == 0
+        ds = open_cube(out)
+        xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
+        ds.close()
+        shutil.rmtree(out.parent)
+
+
+@pytest.mark.slow
+def test_a_tiny_filesystem(tmp_path, small_cfg):
+    # a 1 MB tmpfs in a user namespace, where the platform allows it
+    raw, cfg = small_cfg
+    probe = subprocess.run(["unshare", "-rm", "sh", "-c",
+                            f"mount -t tmpfs -o size=1m tmpfs {tmp_path} && echo ok"],
+                           capture_output=True, text=True)
+    if probe.stdout.strip() != "ok":
+        pytest.skip("no unprivileged tmpfs mount here")
+    big = {**MULTI, "name": "big"}
+    cfgp = write_config(tmp_path.parent, big, "big.yaml")
+    script = (f"mount -t tmpfs -o size=1m tmpfs {tmp_path} && cd {tmp_path} && "
+              f"{sys.executable} -m nylonflex sweep {cfgp} --out {tmp_path}/cube.h5 --quiet "
+              "--no-charts")
+    proc = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True,
+                          text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert proc.returncode == 1, proc.stderr
+    assert "Traceback" not in proc.stderr and "--resume" in proc.stderr
