@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import html
 import math
+import re
 
 import numpy as np
 
@@ -46,10 +47,13 @@ def _subset(ds) -> dict:
         keep[a] = max(2, keep[a] // 2) if keep[a] > 2 else 1
     out = {}
     for a in AXES:
-        idx = set(np.round(np.linspace(0, sizes[a] - 1, keep[a])).astype(int).tolist())
-        if keep[a] >= 3:
-            idx.add(snap(ds, a, _DEFAULT[a]).index)
-        out[a] = sorted(idx)
+        idx = sorted(set(np.round(np.linspace(0, sizes[a] - 1, keep[a])).astype(int)
+                         .tolist()))
+        d = snap(ds, a, _DEFAULT[a]).index
+        if len(idx) >= 3 and d not in idx:  # swap the nearest inner value for the default
+            j = 1 + int(np.argmin([abs(i - d) for i in idx[1:-1]]))
+            idx = sorted(idx[:j] + idx[j + 1:] + [d])
+        out[a] = idx
     return out
 
 
@@ -167,7 +171,7 @@ def build_html(ds, *, source: str = "") -> str:
                               Div, LinearColorMapper, RadioButtonGroup, Select, Slider,
                               Span, TapTool)
     from bokeh.plotting import figure
-    from bokeh.resources import INLINE
+    from bokeh.resources import Resources
 
     keep = _subset(ds)
     part = ds.isel(keep)
@@ -336,4 +340,9 @@ def build_html(ds, *, source: str = "") -> str:
     doc = Document()
     doc.add_root(layout)
     doc.js_on_event("document_ready", update)
-    return file_html(doc, INLINE, title=f"nylonflex explorer: {ds.attrs.get('name', '')}")
+    text = file_html(doc, Resources(mode="inline"),
+                     title=f"nylonflex explorer: {ds.attrs.get('name', '')}")
+    # Where Panel is imported in the same process, bokeh bundles its extensions' script
+    # tags (relative URLs this page never uses and that could not load offline): drop them.
+    return re.sub(r'<script[^>]*\bsrc="[^"]*"[^>]*>\s*</script>\s*', "", text)
+

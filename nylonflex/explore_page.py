@@ -200,13 +200,13 @@ def build_page(ds, *, static: bool = False, source: str = ""):
     variables = design_variables(ds)
     var_options = {label(ds, n): n for n in variables}
     default_var = "tip_force_max" if "tip_force_max" in variables else variables[0]
-    w_var = pn.widgets.Select(name="variable (map, lines and read-out)", options=var_options,
+    w_var = pn.widgets.Select(label="variable (map, lines and read-out)", options=var_options,
                               value=default_var, width=300)
     widgets = [w_var]
     w_model = None
     if "model" in ds.dims:
         models = [str(m) for m in ds["model"].values]
-        w_model = pn.widgets.Select(name="model variant", options=models, value=models[0],
+        w_model = pn.widgets.Select(label="model variant", options=models, value=models[0],
                                     width=300)
         widgets.append(w_model)
 
@@ -218,7 +218,7 @@ def build_page(ds, *, static: bool = False, source: str = ""):
         opts = _slider_options(ds, axis, limits.get(axis))
         default = snap(ds, axis, DEFAULT_DESIGN[axis]).value
         value = min(opts.values(), key=lambda v: abs(v - default))
-        sliders[axis] = pn.widgets.DiscreteSlider(name=label(ds, axis), options=opts,
+        sliders[axis] = pn.widgets.DiscreteSlider(label=label(ds, axis), options=opts,
                                                   value=value, width=300)
         if static:
             embed_states[sliders[axis]] = list(opts.values())
@@ -232,9 +232,9 @@ def build_page(ds, *, static: bool = False, source: str = ""):
         w_x = w_y = None
         x_axis, y_axis = "radius", "wall_thickness"
     else:
-        w_x = pn.widgets.Select(name="map across", options={label(ds, a): a for a in AXES},
+        w_x = pn.widgets.Select(label="map across", options={label(ds, a): a for a in AXES},
                                 value="radius", width=145)
-        w_y = pn.widgets.Select(name="map up", options={label(ds, a): a for a in AXES},
+        w_y = pn.widgets.Select(label="map up", options={label(ds, a): a for a in AXES},
                                 value="wall_thickness", width=145)
     notes = pn.widgets.StaticText(value="", visible=False)  # the last click's snap note
 

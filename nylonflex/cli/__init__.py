@@ -26,6 +26,7 @@ COMMANDS = {
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",
+    "explore": "explore",
 }
 
 
