@@ -94,9 +94,9 @@ mapper.low = lo; mapper.high = hi;
 map_src.change.emit();
 const sel = flat(ix.radius, ix.wall_thickness, ix.length, ix.coil_index, ix.wrap_angle) + off;
 star.data = {x: [gx.radius[ix.radius]], y: [gx.wall_thickness[ix.wall_thickness]]};
-const held = (ks) => ks.map(k => names[k] + " " + labels[k][ix[k]]).join(", ");
+const held = (ks) => ks.map(k => names[k] + " = " + labels[k][ix[k]]).join(", ");
 const mname = model ? ", model " + model.labels[im] : "";
-map_fig.title.text = vlabels[iv] + " at " + held(["length", "coil_index", "wrap_angle"]) + mname;
+map_fig.title.text = vshort[iv] + " at " + held(["length", "coil_index", "wrap_angle"]) + mname;
 // figure 12 style lines: var against radius, one per coil index
 for (let c = 0; c < N[3]; c++) {
   const all = [], solid = [];
@@ -106,7 +106,7 @@ for (let c = 0; c < N[3]; c++) {
   }
   line_srcs[c].data = {x: gx.radius, y: all}; solid_srcs[c].data = {x: gx.radius, y: solid};
 }
-lines_fig.title.text = vlabels[iv] + " against radius at " +
+lines_fig.title.text = "Figure 12 style at " +
   held(["wall_thickness", "length", "wrap_angle"]) + mname;
 lines_yaxis.axis_label = vlabels[iv];
 // curves of the selected design
@@ -126,7 +126,7 @@ let text = '<div id="nf-readout" class="nf-readout" data-variable="' + vnames[iv
   '" data-value="' + v + '" data-unit="' + vunits[iv] + '" style="font-size:15px">' +
   vshort[iv] + ' of the selected design: <b>' + fmt(v) +
   (vunits[iv] == "1" ? "" : " " + vunits[iv]) + '</b><br><span style="color:#555">design: ' +
-  held(AXES) + mname + '</span>';
+  AXES.map(k => k + " " + labels[k][ix[k]]).join(", ") + mname + '</span>';
 if (note.tags.length) text += '<br><span class="nf-snap" style="color:#a0522d">' + note.tags[0] + '</span>';
 readout.text = text + '</div>';
 let rows = '';
@@ -169,7 +169,7 @@ def build_html(ds, *, source: str = "") -> str:
     from bokeh.layouts import column, row
     from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter,
                               Div, LinearColorMapper, RadioButtonGroup, Select, Slider,
-                              Span, TapTool)
+                              Span, TapTool, Title)
     from bokeh.plotting import figure
     from bokeh.resources import Resources
 
@@ -270,6 +270,8 @@ def build_html(ds, *, source: str = "") -> str:
                        legend_label=f"C = {c:.3g}")
         lines_fig.line("x", "y", source=solid_srcs[-1], color=colour, line_width=3)
     lines_fig.legend.location = "top_left"
+    lines_fig.add_layout(Title(text="solid: full range of motion; dashed: strength-limited",
+                               text_font_style="italic", text_font_size="11px"), "above")
     # ---- curves of the selected design
     def curve_fig(title, x, y, colour):
         f = figure(width=400, height=280, title=title, x_axis_label=label(ds, x),
@@ -277,7 +279,7 @@ def build_html(ds, *, source: str = "") -> str:
         src = ColumnDataSource({"x": [], "y": []})
         f.line("x", "y", source=src, color=colour, line_width=2)
         return f, src
-    nf_fig, nf_src = curve_fig("nylon force against muscle stroke (dashed: strength limit)",
+    nf_fig, nf_src = curve_fig("nylon force vs stroke (dashed: its limit)",
                                "stroke", "nylon_force", _COLOURS[0])
     flim_span = Span(location=0, dimension="width", line_dash="dashed", line_color="black")
     nf_fig.add_layout(flim_span)
@@ -311,7 +313,8 @@ def build_html(ds, *, source: str = "") -> str:
 
     args = dict(variable=variable, model=model, sliders=sliders, data=data, limit=limit,
                 validity=validity, sizes=sizes, AXES=list(AXES), map_src=map_src,
-                mapper=mapper, star=star, gx=gx, names={a: a for a in AXES}, labels=labels,
+                mapper=mapper, star=star, gx=gx, names={"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
+                       "wrap_angle": "\u03c8"}, labels=labels,
                 map_fig=map_fig, lines_fig=lines_fig, lines_yaxis=lines_fig.yaxis[0], line_srcs=line_srcs,
                 solid_srcs=solid_srcs, curves=curves, nf_src=nf_src, ba_src=ba_src,
                 tf_src=tf_src, flim=flim, flim_span=flim_span, readout=readout, table=table,

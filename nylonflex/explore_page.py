@@ -40,6 +40,16 @@ _FLAG_MARKERS = ("circle", "square", "triangle", "diamond", "inverted_triangle",
 _PLOT = {"width": 460, "height": 330}
 
 
+_SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
+           "wrap_angle": "\u03c8"}
+
+
+def _held(ds, at, axes) -> str:
+    """``"t 2 mm, L 90 mm, psi 8 deg"``: the held axes of a view, for its title."""
+    text = ", ".join(f"{_SYMBOL[k]} = {axis_text(ds, k, at[k])}" for k in axes)
+    return text + (f", model {at['model']}" if "model" in at else "")
+
+
 def _fmt(value: float) -> str:
     return "nan" if not np.isfinite(value) else f"{value:.4g}"
 
@@ -71,15 +81,12 @@ def _static_limits(ds) -> dict:
 
 def _map_plot(ds, var, x, y, at, hv):
     m = map_slice(ds, var, x, y, at)
-    ttl = ", ".join(f"{k} {axis_text(ds, k, v)}" for k, v in at.items()
-                    if k in AXES and k not in (x, y))
-    if "model" in at:
-        ttl += f", model {at['model']}"
+    ttl = _held(ds, at, [k for k in AXES if k not in (x, y)])
     xs, ys = np.meshgrid(m["x"], m["y"])
     qm = hv.QuadMesh((m["x"], m["y"], m["z"]), kdims=[label(ds, x), label(ds, y)],
-                     vdims=[label(ds, var)]).opts(
+                     vdims=["value"]).opts(
         cmap="viridis", colorbar=True, tools=["hover", "tap"], title=f"{label(ds, var)}\n"
-        f"at {ttl}", **_PLOT, toolbar="above")
+        f"at {ttl}", framewise=True, **_PLOT, toolbar="above")
     layers = [qm]
     if m["limit"] is not None:
         strong = m["limit"] == 1
@@ -114,12 +121,10 @@ def _lines_plot(ds, var, at, hv):
                                                         line_width=1))
         curves.append(hv.Curve((x, solid), label(ds, "radius"), label(ds, var)).opts(
             color=colour, line_width=3))
-    held = ", ".join(f"{k} {axis_text(ds, k, at[k])}" for k in AXES
-                     if k not in ("radius", "coil_index"))
+    held = _held(ds, at, [k for k in AXES if k not in ("radius", "coil_index")])
     return hv.Overlay(curves).opts(
-        title=f"Figure 12 style: {label(ds, var)} against radius\nat {held}; solid: full "
-              "range of motion, dashed: strength-limited", legend_position="right",
-        **_PLOT)
+        title=f"Figure 12 style at {held}\nsolid: full range of motion; dashed: "
+              "strength-limited", legend_position="top_left", framewise=True, **_PLOT)
 
 
 def _curves_plot(ds, at, hv):
@@ -132,8 +137,7 @@ def _curves_plot(ds, at, hv):
         if "nylon_force_limit" in c:
             p = p * hv.HLine(c["nylon_force_limit"], label="strength limit").opts(
                 color="black", line_dash="dashed")
-        plots.append(p.opts(title="nylon force against muscle stroke (dashed: its "
-                                  "strength limit)", width=400, height=280))
+        plots.append(p.opts(title="nylon force vs stroke (dashed: its limit)", width=400, height=280))
     for name in ("bend_angle", "tip_force"):
         if name in c:
             x, y = c[name]
