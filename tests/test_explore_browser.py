@@ -143,3 +143,26 @@ def test_exported_file_works_offline(cube, browser, tmp_path):
     page.screenshot(path=str(tmp_path / "exported.png"), full_page=True)
     assert [u for u in requests if not u.startswith(("file:", "data:", "blob:"))] == []
     context.close()
+
+
+def test_exported_map_click_picks_the_nearest_grid_point(cube, browser, tmp_path):
+    import re
+
+    out = tmp_path / "fig12.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out)], env=env, check=True, capture_output=True)
+    page = browser.new_page(viewport={"width": 1300, "height": 1000})
+    page.goto(out.as_uri())
+    page.wait_for_selector("#nf-readout")
+    box = page.locator("canvas").first.bounding_box()  # the design map comes first
+    page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.45 * box["height"])
+    page.wait_for_selector(".nf-snap", timeout=20_000)
+    text = page.locator("#nf-readout").inner_text()
+    assert "picked on the map" in text and "no values between grid points" in text
+    m = re.search(r"design: radius ([\d.]+) mm, wall_thickness ([\d.]+) mm", text)
+    at = {**DESIGN, "length": 90e-3, "radius": float(m[1]) * 1e-3,
+          "wall_thickness": float(m[2]) * 1e-3}
+    assert (float(m[1]), float(m[2])) != (15.0, 2.0)
+    assert _readout(page)[1] == pytest.approx(_expected(cube, "tip_force_max", at), rel=5e-4)

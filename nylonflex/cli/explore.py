@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 HELP = "explore a cube in a local web page (or write one offline HTML file)"
 DESCRIPTION = """\
 Serve a page on http://127.0.0.1:PORT with a variable selector, a slider per axis, a design
@@ -63,9 +65,16 @@ def run(args) -> int:
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
 
-    import panel as pn
+    try:
+        import panel as pn
+    except ModuleNotFoundError:
+        print("nylonflex explore: failed: the explorer needs Panel and HoloViews: "
+              "pip install 'nylonflex[explore]'", file=sys.stderr)
+        return 1
 
     from ..explore_page import build_page
+
+    build_page(ds)  # warm up: load the first views' blocks before the first visitor
 
     def page():
         return build_page(ds, source=str(args.cube))[0]
