@@ -85,7 +85,7 @@ def _map_plot(ds, var, x, y, at, hv):
     xs, ys = np.meshgrid(m["x"], m["y"])
     qm = hv.QuadMesh((m["x"], m["y"], m["z"]), kdims=[label(ds, x), label(ds, y)],
                      vdims=["value"]).opts(
-        cmap="viridis", colorbar=True, tools=["hover", "tap"], title=f"{label(ds, var)}\n"
+        cmap="viridis", colorbar=True, tools=["hover"], title=f"{label(ds, var)}\n"
         f"at {ttl}", framewise=True, **_PLOT, toolbar="above")
     layers = [qm]
     if m["limit"] is not None:
@@ -280,8 +280,20 @@ def build_page(ds, *, static: bool = False, source: str = ""):
         map_pane = pn.panel(pn.bind(map_view, w_var, x_axis, y_axis, *slider_list,
                                     **model_arg))
     else:
-        dmap = hv.DynamicMap(pn.bind(map_view, w_var, w_x, w_y, *slider_list, **model_arg))
-        tap = hv.streams.Tap(source=dmap)
+        # The Tap stream sits in the DynamicMap's own streams and the widgets redraw it
+        # through event(): a Tap whose source is a DynamicMap of pn.bind never reaches
+        # Python when served (holoviz/holoviews#5788, #4955). transient: a redraw for a
+        # widget does not replay the last click.
+        tap = hv.streams.Tap(x=None, y=None, transient=True)
+
+        def map_now(x=None, y=None):
+            return map_view(w_var.value, w_x.value, w_y.value,
+                            *(s.value for s in slider_list),
+                            model=w_model.value if w_model is not None else None)
+
+        dmap = hv.DynamicMap(map_now, streams=[tap])
+        for w in [w_var, w_x, w_y, *slider_list] + ([w_model] if w_model else []):
+            w.param.watch(lambda _event: dmap.event(), "value")
 
         def on_tap(x=None, y=None):
             if x is None or y is None:
@@ -297,9 +309,21 @@ def build_page(ds, *, static: bool = False, source: str = ""):
                                  f"between grid points: showing the nearest grid point "
                                  f"{axis_text(ds, axis, grid[i])} (the cube holds no values "
                                  "between grid points)")
-                sliders[axis].value = float(grid[i])
+                tapping[0] = True
+                try:
+                    sliders[axis].value = float(grid[i])
+                finally:
+                    tapping[0] = False
             notes.value = "; ".join(texts)
 
+        tapping = [False]
+
+        def clear_note(_event):  # a slider moved by hand: the click's note is stale
+            if not tapping[0]:
+                notes.value = ""
+
+        for w in slider_list:
+            w.param.watch(clear_note, "value")
         tap.add_subscriber(on_tap)
         map_pane = pn.pane.HoloViews(dmap)
     lines_pane = pn.panel(pn.bind(lines_view, w_var, *slider_list, **model_arg))

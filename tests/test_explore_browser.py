@@ -6,6 +6,7 @@ Playwright; Playwright never downloads a browser. The value the page shows (``#n
 significant figures.
 """
 
+import contextlib
 import math
 import os
 import socket
@@ -103,7 +104,9 @@ def _drive(page, cube, select_label):
     assert "length 70 mm" in page.locator("#nf-readout").inner_text()
 
 
-def test_served_page_follows_slider_and_variable(cube, browser, tmp_path):
+@contextlib.contextmanager
+def _serve_page(cube, browser):
+    """Serve the cube on a free loopback port; yield a page showing it."""
     port = _free_port()
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
                                                                                ""))
@@ -121,11 +124,37 @@ def test_served_page_follows_slider_and_variable(cube, browser, tmp_path):
                 if proc.poll() is not None or time.monotonic() > end:
                     raise AssertionError(proc.stdout.read())
                 time.sleep(0.3)
-        _drive(page, cube, "maximum bend angle [deg]")
-        page.screenshot(path=str(tmp_path / "served.png"), full_page=True)
+        yield page
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def test_served_page_follows_slider_and_variable(cube, browser, tmp_path):
+    with _serve_page(cube, browser) as page:
+        _drive(page, cube, "maximum bend angle [deg]")
+        page.screenshot(path=str(tmp_path / "served.png"), full_page=True)
+
+
+def test_served_map_click_picks_the_nearest_grid_point(cube, browser):
+    with _serve_page(cube, browser) as page:
+        page.wait_for_selector("#nf-readout", timeout=60_000)
+        _click_map_and_check(page, cube)
+
+
+def _click_map_and_check(page, cube):
+    import re
+
+    box = page.locator("canvas").first.bounding_box()  # the design map comes first
+    page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.45 * box["height"])
+    page.wait_for_selector(".nf-snap", timeout=20_000)
+    text = page.locator("#nf-readout").inner_text()
+    assert "between grid points" in text and "no values between grid points" in text
+    m = re.search(r"design: radius ([\d.]+) mm, wall_thickness ([\d.]+) mm", text)
+    at = {**DESIGN, "length": 90e-3, "radius": float(m[1]) * 1e-3,
+          "wall_thickness": float(m[2]) * 1e-3}
+    assert (float(m[1]), float(m[2])) != (15.0, 2.0)
+    assert _readout(page)[1] == pytest.approx(_expected(cube, "tip_force_max", at), rel=5e-4)
 
 
 def test_exported_file_works_offline(cube, browser, tmp_path):
@@ -146,8 +175,6 @@ def test_exported_file_works_offline(cube, browser, tmp_path):
 
 
 def test_exported_map_click_picks_the_nearest_grid_point(cube, browser, tmp_path):
-    import re
-
     out = tmp_path / "fig12.html"
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
                                                                                ""))
@@ -156,13 +183,4 @@ def test_exported_map_click_picks_the_nearest_grid_point(cube, browser, tmp_path
     page = browser.new_page(viewport={"width": 1300, "height": 1000})
     page.goto(out.as_uri())
     page.wait_for_selector("#nf-readout")
-    box = page.locator("canvas").first.bounding_box()  # the design map comes first
-    page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.45 * box["height"])
-    page.wait_for_selector(".nf-snap", timeout=20_000)
-    text = page.locator("#nf-readout").inner_text()
-    assert "picked on the map" in text and "no values between grid points" in text
-    m = re.search(r"design: radius ([\d.]+) mm, wall_thickness ([\d.]+) mm", text)
-    at = {**DESIGN, "length": 90e-3, "radius": float(m[1]) * 1e-3,
-          "wall_thickness": float(m[2]) * 1e-3}
-    assert (float(m[1]), float(m[2])) != (15.0, 2.0)
-    assert _readout(page)[1] == pytest.approx(_expected(cube, "tip_force_max", at), rel=5e-4)
+    _click_map_and_check(page, cube)
