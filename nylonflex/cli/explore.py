@@ -74,8 +74,6 @@ def run(args) -> int:
 
     from ..explore_page import build_page
 
-    build_page(ds)  # warm up: load the first views' blocks before the first visitor
-
     def page():
         return build_page(ds, source=str(args.cube))[0]
 
