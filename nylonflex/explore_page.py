@@ -92,7 +92,8 @@ def _map_plot(ds, var, x, y, at, hv):
         strong = m["limit"] == 1
         layers.append(hv.Points((xs[strong], ys[strong]), kdims=[label(ds, x), label(ds, y)],
                                 label="strength-limited (x): the nylon breaks first").opts(
-            marker="x", color="white", size=7, line_width=1.5))
+            marker="x", color="white", line_width=1 if len(m["x"]) > 60 else 1.5,
+            size=int(np.clip(300 / max(len(m["x"]), len(m["y"]), 1), 2, 7))))
     if m["validity"] is not None:
         bits = np.nan_to_num(m["validity"].astype(float)).astype(np.int64)
         for k, (mask, meaning) in enumerate(flag_meanings(ds)):
@@ -280,20 +281,17 @@ def build_page(ds, *, static: bool = False, source: str = ""):
         map_pane = pn.panel(pn.bind(map_view, w_var, x_axis, y_axis, *slider_list,
                                     **model_arg))
     else:
-        # The Tap stream sits in the DynamicMap's own streams and the widgets redraw it
-        # through event(): a Tap whose source is a DynamicMap of pn.bind never reaches
-        # Python when served (holoviz/holoviews#5788, #4955). transient: a redraw for a
-        # widget does not replay the last click.
+        # The Tap stream sits in the DynamicMap's own streams, beside the ones pn.bind
+        # makes for the widgets: a Tap whose *source* is a DynamicMap of pn.bind never
+        # reaches Python when served (holoviz/holoviews#5788, #4955). transient: a redraw
+        # for a widget does not replay the last click.
         tap = hv.streams.Tap(x=None, y=None, transient=True)
 
-        def map_now(x=None, y=None):
-            return map_view(w_var.value, w_x.value, w_y.value,
-                            *(s.value for s in slider_list),
-                            model=w_model.value if w_model is not None else None)
+        def map_with_tap(*args, x=None, y=None, **kwargs):  # the click is for on_tap
+            return map_view(*args, **kwargs)
 
-        dmap = hv.DynamicMap(map_now, streams=[tap])
-        for w in [w_var, w_x, w_y, *slider_list] + ([w_model] if w_model else []):
-            w.param.watch(lambda _event: dmap.event(), "value")
+        dmap = hv.DynamicMap(pn.bind(map_with_tap, w_var, w_x, w_y, *slider_list,
+                                     **model_arg), streams=[tap])
 
         def on_tap(x=None, y=None):
             if x is None or y is None:
