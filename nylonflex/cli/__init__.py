@@ -32,6 +32,7 @@ COMMANDS = {
     "init": "init",
     "list": "listing",
     "sensitivity": "sensitivity",
+    "explore": "explore",
 }
 
 

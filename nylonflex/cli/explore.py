@@ -1,0 +1,86 @@
+"""``nylonflex explore CUBE``: a local web page with sliders over a cube (INTERFACE.md)."""
+
+from __future__ import annotations
+
+import sys
+
+HELP = "explore a cube in a local web page (or write one offline HTML file)"
+DESCRIPTION = """\
+Serve a page on http://127.0.0.1:PORT with a variable selector, a slider per axis, a design
+map (strength-limited and flagged designs marked), figure 12 style lines and, for the picked
+design, every design variable and its curves. Sliders snap to grid values; nothing is
+interpolated. With --html, write one self-contained file that works offline instead.
+
+  nylonflex explore sweeps/fig12/cube.h5
+  nylonflex explore sweeps/fig12/cube.h5 --html fig12.html
+"""
+
+
+def add_arguments(p):
+    p.add_argument("cube")
+    p.add_argument("--port", type=int, default=5006, help="local port (default 5006)")
+    p.add_argument("--html", metavar="OUT.html", help="write one offline HTML file and exit")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --html file")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+
+
+def port_free(port: int, host: str = "127.0.0.1") -> bool:
+    """Whether ``host:port`` can be bound now."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        try:
+            s.bind((host, port))
+        except OSError:
+            return False
+    return True
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from ..units import InputError
+    from ._common import open_cube_for
+
+    if args.html:
+        out = Path(args.html)
+        if out.exists() and not args.overwrite:
+            raise InputError(f"--html {out}: the file exists; pass --overwrite to replace it")
+        if not out.parent.is_dir():
+            raise InputError(f"--html {out}: no such folder {out.parent}")
+    elif not 1 <= args.port <= 65535:
+        raise InputError(f"--port {args.port}: expected a port number 1..65535")
+    elif not port_free(args.port):
+        raise InputError(f"--port {args.port}: already in use on 127.0.0.1; choose another "
+                         "with --port N")
+
+    ds = open_cube_for("explore", args.cube)
+    if args.html:
+        from ..explore_html import build_html
+
+        text = build_html(ds, source=str(args.cube))
+        tmp = out.with_name(out.name + ".part")
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(out)
+        print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
+        return 0
+
+    try:
+        import panel as pn
+    except ModuleNotFoundError:
+        print("nylonflex explore: failed: the explorer needs Panel and HoloViews: "
+              "pip install 'nylonflex[explore]'", file=sys.stderr)
+        return 1
+
+    from ..explore_page import build_page
+
+    def page():
+        return build_page(ds, source=str(args.cube))[0]
+
+    url = f"http://127.0.0.1:{args.port}/"
+    print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
+    pn.serve({"/": page}, port=args.port, address="127.0.0.1", show=not args.no_browser,
+             websocket_origin=[f"127.0.0.1:{args.port}", f"localhost:{args.port}"],
+             title=f"nylonflex explorer: {ds.attrs.get('name', '')}", print_url=False)
+    return 0
+

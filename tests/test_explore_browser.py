@@ -1,0 +1,189 @@
+"""``nylonflex explore`` in a real headless browser: the served page and the offline file.
+
+Chromium comes from the system's packages (``.ci/run`` installs it) and is driven through
+Playwright; Playwright never downloads a browser. The value the page shows (``#nf-readout``'s
+``data-value``, display units) is compared with ``ds.sel`` of the fig12 cube to 3
+significant figures.
+"""
+
+import contextlib
+import math
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+CHROMIUM = "/usr/bin/chromium"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run"]
+ROOT = Path(__file__).resolve().parents[1]
+
+if not os.path.exists(CHROMIUM):
+    pytest.skip(f"no Chromium at {CHROMIUM} (.ci/run installs it with apt-get)",
+                allow_module_level=True)
+# a real browser and a server: about a minute, run with the slow checks (.ci/run)
+pytestmark = pytest.mark.slow
+
+sync_api = pytest.importorskip("playwright.sync_api")
+pytest.importorskip("panel")
+
+# The page's default design: radius 15 mm, wall 2 mm, length 90 mm, C 1.7, psi 8 deg; the
+# tests move the length slider one grid step down (90 -> 70 mm) and pick bend_angle_max.
+DESIGN = {"radius": 15e-3, "wall_thickness": 2e-3, "length": 70e-3, "coil_index": 1.7,
+          "wrap_angle": math.radians(8.0)}
+
+
+@pytest.fixture(scope="module")
+def cube(tmp_path_factory):
+    import nylonflex as nf
+
+    path = tmp_path_factory.mktemp("explore_browser") / "cube.h5"
+    nf.run_sweep(nf.load_config(ROOT / "configs" / "fig12.yaml"), out=path).close()
+    return path
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _expected(cube, name, at):
+    from nylonflex.storage import open_cube
+    from nylonflex.variables import to_display
+
+    with open_cube(cube) as ds:
+        return float(to_display(name, ds[name].sel(at, method="nearest").values))
+
+
+def _readout(page):
+    el = page.locator("#nf-readout")
+    return el.get_attribute("data-variable"), float(el.get_attribute("data-value"))
+
+
+def _wait_for(page, variable, timeout=20.0):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if _readout(page)[0] == variable:
+            return _readout(page)
+        page.wait_for_timeout(200)
+    raise AssertionError(f"the page never showed {variable}: {_readout(page)}")
+
+
+def _move_length_down(page):
+    """Focus the length slider's handle (the third slider) and step it down once."""
+    handle = page.locator(".noUi-handle").nth(2)
+    handle.focus()
+    page.keyboard.press("ArrowLeft")
+    end = time.monotonic() + 20
+    while time.monotonic() < end and "length 70 mm" not in page.locator(
+            "#nf-readout").inner_text():
+        page.wait_for_timeout(200)
+
+
+def _drive(page, cube, select_label):
+    page.wait_for_selector("#nf-readout", timeout=60_000)
+    var, value = _wait_for(page, "tip_force_max")
+    at90 = {**DESIGN, "length": 90e-3}
+    assert value == pytest.approx(_expected(cube, "tip_force_max", at90), rel=5e-4)
+    _move_length_down(page)
+    var, value = _readout(page)
+    assert value == pytest.approx(_expected(cube, "tip_force_max", DESIGN), rel=5e-4)
+    page.locator("select").first.select_option(label=select_label)
+    var, value = _wait_for(page, "bend_angle_max")
+    assert value == pytest.approx(_expected(cube, "bend_angle_max", DESIGN), rel=5e-4)
+    assert "length 70 mm" in page.locator("#nf-readout").inner_text()
+
+
+@contextlib.contextmanager
+def _serve_page(cube, browser):
+    """Serve the cube on a free loopback port; yield a page showing it."""
+    port = _free_port()
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    proc = subprocess.Popen([sys.executable, "-m", "nylonflex", "explore", str(cube),
+                             "--port", str(port), "--no-browser"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        page = browser.new_page(viewport={"width": 1300, "height": 1000})
+        end = time.monotonic() + 60
+        while True:
+            try:
+                page.goto(f"http://127.0.0.1:{port}/")
+                break
+            except sync_api.Error:
+                if proc.poll() is not None or time.monotonic() > end:
+                    raise AssertionError(proc.stdout.read())
+                time.sleep(0.3)
+        yield page
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def test_served_page_follows_slider_and_variable(cube, browser, tmp_path):
+    with _serve_page(cube, browser) as page:
+        _drive(page, cube, "maximum bend angle [deg]")
+        page.screenshot(path=str(tmp_path / "served.png"), full_page=True)
+
+
+def test_served_map_click_picks_the_nearest_grid_point(cube, browser):
+    with _serve_page(cube, browser) as page:
+        page.wait_for_selector("#nf-readout", timeout=60_000)
+        _click_map_and_check(page, cube)
+
+
+def _click_map_and_check(page, cube):
+    import re
+
+    box = page.locator("canvas").first.bounding_box()  # the design map comes first
+    page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.45 * box["height"])
+    page.wait_for_selector(".nf-snap", timeout=20_000)
+    text = page.locator("#nf-readout").inner_text()
+    assert "between grid points" in text and "no values between grid points" in text
+    m = re.search(r"design: radius ([\d.]+) mm, wall_thickness ([\d.]+) mm", text)
+    at = {**DESIGN, "length": 90e-3, "radius": float(m[1]) * 1e-3,
+          "wall_thickness": float(m[2]) * 1e-3}
+    assert (float(m[1]), float(m[2])) != (15.0, 2.0)
+    assert _readout(page)[1] == pytest.approx(_expected(cube, "tip_force_max", at), rel=5e-4)
+
+
+def test_exported_file_works_offline(cube, browser, tmp_path):
+    out = tmp_path / "fig12.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out)], env=env, check=True, capture_output=True)
+    context = browser.new_context(offline=True, viewport={"width": 1300, "height": 1000})
+    page = context.new_page()
+    requests = []
+    page.on("request", lambda r: requests.append(r.url))
+    page.goto(out.as_uri())
+    _drive(page, cube, "maximum bend angle [deg]")
+    page.screenshot(path=str(tmp_path / "exported.png"), full_page=True)
+    assert [u for u in requests if not u.startswith(("file:", "data:", "blob:"))] == []
+    context.close()
+
+
+def test_exported_map_click_picks_the_nearest_grid_point(cube, browser, tmp_path):
+    out = tmp_path / "fig12.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out)], env=env, check=True, capture_output=True)
+    page = browser.new_page(viewport={"width": 1300, "height": 1000})
+    page.goto(out.as_uri())
+    page.wait_for_selector("#nf-readout")
+    _click_map_and_check(page, cube)
