@@ -1,0 +1,229 @@
+"""The config machinery every config shares: strict pydantic models, one range-error
+formatter, and pydantic's errors as one line naming the dotted field.
+
+Sweep configs (:mod:`.sweep`) and simulate configs (:mod:`nylonflex.simconfig`) both use it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal, Union, get_args, get_origin
+
+import numpy as np
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Tag, ValidationError
+
+from ..units import InputError, from_si, parse_quantity, short
+
+__all__ = ["Count", "Number", "check_range", "check_run_name", "range_error", "valid_name"]
+
+
+def _no_bool(value):
+    if isinstance(value, bool):  # YAML's true/false/yes/no are not numbers
+        raise ValueError(f"must be a number, got {str(value).lower()}")
+    return value
+
+
+Number = Annotated[Union[float, str], BeforeValidator(_no_bool)]
+Count = Annotated[int, BeforeValidator(_no_bool)]
+
+Number = Annotated[Union[float, str], BeforeValidator(_no_bool)]
+Count = Annotated[int, BeforeValidator(_no_bool)]
+
+
+def valid_name(name) -> bool:
+    """A run name usable as a folder under sweeps/: letters, digits, '-', '_', '.'."""
+    return isinstance(name, str) and bool(name) and not name.startswith(".") and \
+        all(ch.isalnum() or ch in "-_." for ch in name)
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def check_run_name(name):
+    """A run name (pydantic validator body): refused unless :func:`valid_name`."""
+    if not valid_name(name):
+        raise ValueError("letters, digits, '-', '_' and '.' only")
+    return name
+
+
+def range_error(field: str, lo, hi, display_unit: str, got, lo_open: bool = False,
+                hi_open: bool = False) -> InputError:
+    """The one-line refusal of a value outside its range, shown in display units.
+
+    Parameters
+    ----------
+    field : str
+        The dotted field, e.g. ``grid.radius.stop``.
+    lo, hi : float or int or None
+        Accepted range, SI [unit of the quantity]; None: unbounded on that side.
+    display_unit : str
+        Unit to show the range and the value in (``"1"``: none shown).
+    got : float or int
+        The refused value, SI [unit of the quantity].
+    lo_open, hi_open : bool
+        Whether the bound itself is refused.
+
+    Returns
+    -------
+    InputError
+        ``grid.radius.stop: must be in [0.5, 200] mm, got 900 mm``.
+    """
+    def show(x):
+        if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
+            return str(int(x))  # counts and seeds: every digit
+        return f"{from_si(x, display_unit):g}"
+
+    unit = "" if display_unit in ("1", "", None) else f" {display_unit}"
+    if lo is not None and hi is not None:
+        rng = f"in {'(' if lo_open else '['}{show(lo)}, {show(hi)}{')' if hi_open else ']'}"
+    elif lo is not None:
+        rng = f"{'>' if lo_open else '>='} {show(lo)}"
+    elif hi is not None:
+        rng = f"{'<' if hi_open else '<='} {show(hi)}"
+    else:
+        return InputError(f"{field}: must be finite, got {show(got)}{unit}")
+    return InputError(f"{field}: must be {rng}{unit}, got {show(got)}{unit}")
+
+
+def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
+                display_unit: str | None = None, *, lo_open: bool = False,
+                hi_open: bool = False, slack: float = 0.0) -> float:
+    """Parse a quantity (``"7.5 mm"`` or a bare number in ``unit``) to SI and check its range.
+
+    Parameters
+    ----------
+    raw : str or float
+        The value as the user typed it [``unit`` when bare].
+    field : str
+        The dotted field, for messages.
+    kind : str
+        The quantity's kind (``"length"``, ``"angle"``, ...).
+    unit : str
+        Unit of a bare number.
+    lo, hi : float or None
+        Accepted range, SI [unit of the quantity]; None: unbounded on that side.
+    display_unit : str or None
+        Unit of the message; ``unit`` when None.
+    lo_open, hi_open : bool
+        Whether the bound itself is refused.
+    slack : float
+        Tolerance on a closed bound, SI; a value within it is clamped onto the bound.
+
+    Returns
+    -------
+    float
+        The value in SI, within [lo, hi].
+
+    Raises
+    ------
+    InputError
+        Not a number, a unit of another kind, or out of range: one line naming ``field``.
+    """
+    value = float(parse_quantity(raw, field, kind, unit))
+    ok = math.isfinite(value)
+    if lo is not None:
+        ok = ok and (value > lo if lo_open else value >= lo - slack)
+    if hi is not None:
+        ok = ok and (value < hi if hi_open else value <= hi + slack)
+    if not ok:
+        raise range_error(field, lo, hi, display_unit or unit, value, lo_open, hi_open)
+    if lo is not None and not lo_open:
+        value = max(value, lo)
+    if hi is not None and not hi_open:
+        value = min(value, hi)
+    return value
+
+
+def _strip(tp):
+    """A type without its Annotated metadata and without None in a union."""
+    while get_origin(tp) is Annotated:
+        tp = get_args(tp)[0]
+    if get_origin(tp) in (Union, type(int | None)):
+        args = [a for a in get_args(tp) if a is not type(None)]
+        if len(args) == 1:
+            return _strip(args[0])
+    return tp
+
+
+def _union_member(tp, tag):
+    """The member of a union that pydantic's location ``tag`` names, or None."""
+    for member in get_args(tp):
+        meta = get_args(member)[1:] if get_origin(member) is Annotated else ()
+        base = _strip(member)
+        tags = {m.tag for m in meta if isinstance(m, Tag)}
+        if isinstance(base, type) and issubclass(base, BaseModel):
+            tags.add(base.__name__)
+            kind = base.model_fields.get("kind")
+            if kind is not None and get_origin(kind.annotation) is Literal:
+                tags.update(get_args(kind.annotation))
+        if tag in tags:
+            return base
+    return None
+
+
+def _walk(model, loc):
+    """The dotted path (``actuators[0].design.radius``) of a pydantic location, and the
+    type it ends at (None when unknown); union members' tags are not part of the path."""
+    path, tp = "", model
+    for part in loc:
+        tp = _strip(tp)
+        if get_origin(tp) in (Union, type(int | None)):
+            tp = _union_member(tp, part)  # a union's tag: not a key the user typed
+            continue
+        if isinstance(part, int):
+            path += f"[{part}]"
+            args = get_args(tp)
+            tp = args[0] if get_origin(tp) in (list, tuple) and args else None
+            continue
+        path += f".{part}" if path else str(part)
+        if isinstance(tp, type) and issubclass(tp, BaseModel) and part in tp.model_fields:
+            tp = tp.model_fields[part].annotation
+        elif get_origin(tp) is dict:
+            tp = get_args(tp)[1]
+        else:
+            tp = None
+    return path, _strip(tp) if tp is not None else None
+
+
+_TYPE_MESSAGES = {
+    "model_type": "must be a mapping of keys",
+    "model_attributes_type": "must be a mapping of keys",
+    "dict_type": "must be a mapping of keys",
+    "list_type": "must be a list",
+    "int_type": "must be an integer",
+    "int_from_float": "must be an integer",
+    "string_type": "must be a string",
+}
+
+
+def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
+    """One line for the first error of a validation against ``model``: the dotted field and
+    what it accepts."""
+    e = err.errors()[0]
+    path, tp = _walk(model, e["loc"])
+    msg = e["msg"].removeprefix("Value error, ")
+    got = e.get("input")
+    tail = "" if isinstance(got, dict) else f", got {short(got)}"
+    kind = e["type"]
+    if kind == "extra_forbidden":
+        parent = _walk(model, e["loc"][:-1])[1]
+        keys = sorted(parent.model_fields) if isinstance(parent, type) and \
+            issubclass(parent, BaseModel) else []
+        msg, tail = "unknown key" + (f"; accepted: {', '.join(keys)}" if keys else ""), ""
+    elif kind == "missing":
+        msg, tail = "missing key", ""
+    elif kind == "literal_error":
+        msg = msg.replace("Input should be", "must be one of")
+    elif kind in ("union_tag_invalid", "union_tag_not_found"):
+        key = e["ctx"]["discriminator"].strip("'")
+        path = f"{path}.{key}" if path else key
+        tags = [t for m in get_args(tp) for t in get_args(_strip(m).model_fields[key].annotation)]
+        msg = f"must be one of {', '.join(tags)}"
+        tail = f", got {short(e['ctx']['tag'])}" if kind == "union_tag_invalid" else ""
+        msg = msg if tail else f"missing key; accepted: {', '.join(tags)}"
+    else:
+        msg = _TYPE_MESSAGES.get(kind, msg)
+    return f"{path or 'config'}: {msg}{tail}"
+
+

@@ -1,0 +1,370 @@
+"""YAML sweep configs: schema, units and ranges, validated before any work.
+
+(The shared machinery is in :mod:`.base`, the ``uncertainty:`` section in
+:mod:`.uncertainty`.)
+
+The schema is a set of pydantic models (structure, types, unknown and missing keys);
+:func:`resolve` then turns the typed config into SI arrays and checks every range. Every
+error is an :class:`~nylonflex.units.InputError` of one line that names the field (as a
+dotted path) and what it accepts.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union
+
+import numpy as np
+import yaml
+from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
+
+from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
+from ..requirements import parse_requirements
+from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
+from ..units import InputError, short, to_si
+from ..variables import INPUTS, VARIABLES
+from .base import (
+    Count,
+    Number,
+    _no_bool,
+    _pydantic_message,
+    _Strict,
+    check_range,
+    check_run_name,
+    range_error,
+)
+from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
+
+__all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", "cube_bytes",
+           "load_config", "load_yaml", "parse_config", "range_error"]
+
+#: Figures a sweep config may name under ``charts``.
+CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
+          "feasibility_map", "compare")
+
+
+
+#: Default budget of one sweep (config key ``limits``): designs in the grid, and gigabytes
+#: of the cube before compression. Checked before any file is created.
+LIMITS = {"designs": 1_000_000_000, "gigabytes": 200.0}
+
+#: quantity -> (kind, default unit, accepted SI range lo, hi, display unit for messages),
+#: read off the registry (nylonflex.variables), for sweeps and simulations alike; the coil
+#: index's range is the muscle table's
+DESIGN_RANGES = {
+    name: (v.kind, v.display, v.lo, v.hi, v.display)
+    for name, v in {**VARIABLES, **INPUTS}.items()
+    if name in ("radius", "wall_thickness", "length", "coil_index", "wrap_angle", "stroke",
+                "pressure", "base_thickness")
+}
+_MAX_POINTS = 100_000
+
+
+class Axis(_Strict):
+    """One grid axis: ``start``/``stop``/``num`` (linear) or ``values``, with ``units``."""
+
+    start: Number | None = None
+    stop: Number | None = None
+    num: Count | None = None
+    values: list[Number] | None = None
+    units: str | None = None
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        linear = (self.start, self.stop, self.num)
+        if self.values is not None and any(x is not None for x in linear):
+            raise ValueError("give start/stop/num or values, not both")
+        if self.values is None and any(x is None for x in linear):
+            raise ValueError("needs start, stop and num, or values")
+        return self
+
+
+class Grid(_Strict):
+    radius: Axis
+    wall_thickness: Axis
+    length: Axis
+    coil_index: Axis
+    wrap_angle: Axis
+
+
+class Curves(_Strict):
+    stroke: Axis
+    pressure: Axis
+
+
+class FixedThickness(_Strict):
+    value: Number
+    units: str | None = "mm"
+
+
+class Supply(_Strict):
+    """A steady supply across the muscle: ``voltage`` with ``units`` (V by default)."""
+
+    voltage: Number
+    units: str | None = "V"
+
+
+class Limits(_Strict):
+    """The budget of one sweep: at most ``designs`` designs and a cube of ``gigabytes``."""
+
+    designs: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["designs"]
+    gigabytes: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["gigabytes"]
+
+
+class SweepConfig(_Strict):
+    """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
+
+    name: str
+    silicone: Union[str, dict[str, Any]] = "tc5005"
+    nylon: Union[str, dict[str, Any]] = "silver_nylon66"
+    grid: Grid
+    base_thickness: Union[Literal["wall"], FixedThickness] = "wall"
+    curves: Curves
+    charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
+    slab_megabytes: Annotated[float, BeforeValidator(_no_bool)] = 16.0
+    limits: Limits = Limits()
+    compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
+    uncertainty: Uncertainty | None = None
+    requirements: list[str] = []
+    model: Union[str, list[str]] = "paper"
+    supply: Supply | None = None
+
+    _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
+
+
+@dataclass(frozen=True)
+class ResolvedConfig:
+    """A validated config in SI: axes as float64 arrays, materials as objects.
+
+    ``text`` is the canonical YAML of everything that determines the cube, and ``sha256``
+    its hash: two configs that resolve to the same design space hash the same.
+    """
+
+    name: str
+    axes: dict[str, np.ndarray]
+    curves: dict[str, np.ndarray]
+    base_thickness: float | None
+    silicone: Silicone
+    nylon: Nylon
+    charts: tuple[str, ...]
+    slab_megabytes: float
+    raw: dict = field(compare=False, repr=False)
+    compression: str = "gzip"  # the cube's codec: not part of the design space or its hash
+    uncertainty: "UncertaintySpec | None" = None
+    requirements: tuple[str, ...] = ()
+    models: tuple[str, ...] = ("paper",)
+    supply_voltage: float | None = None
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for v in self.axes.values())
+
+    @property
+    def n_designs(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def text(self) -> str:
+        return canonical_yaml(self)
+
+    @property
+    def sha256(self) -> str:
+        return hashlib.sha256(self.text.encode()).hexdigest()
+
+
+def canonical_yaml(cfg: ResolvedConfig) -> str:
+    """YAML of the resolved config: SI values, materials in full, sorted keys."""
+    doc = {
+        "name": cfg.name,
+        "grid": {k: [float(x) for x in v] for k, v in cfg.axes.items()},
+        "curves": {k: [float(x) for x in v] for k, v in cfg.curves.items()},
+        "base_thickness": "wall" if cfg.base_thickness is None else cfg.base_thickness,
+        "silicone": cfg.silicone.to_dict(),
+        "nylon": cfg.nylon.to_dict(),
+        "units": "SI (m, rad, Pa; stroke and coil_index dimensionless)",
+    }
+    if cfg.uncertainty is not None:  # only then: plain sweeps keep their hash
+        doc["uncertainty"] = cfg.uncertainty.to_dict()
+    if cfg.requirements:
+        doc["requirements"] = list(cfg.requirements)
+    # only when asked for: the default config hashes as it always did
+    if cfg.models != ("paper",):
+        doc["model"] = list(cfg.models)
+    if cfg.supply_voltage is not None:
+        doc["supply_voltage"] = cfg.supply_voltage
+    return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
+
+
+def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
+    kind, unit, lo, hi, shown = DESIGN_RANGES[name]
+    units = axis.units or unit
+    to_si(1.0, units, f"{path}.units", kind)
+    if name == "coil_index":
+        lo, hi = nylon.coil_index_range
+
+    def value(text, field):
+        return check_range(text, field, kind, units, lo, hi, shown, slack=1e-12)
+
+    if axis.values is not None:
+        if len(axis.values) == 0:
+            raise InputError(f"{path}.values: needs at least one value")
+        if len(axis.values) > _MAX_POINTS:
+            raise InputError(f"{path}.values: at most {_MAX_POINTS:,} values, got "
+                             f"{len(axis.values):,}")
+        vals = np.array([value(v, f"{path}.values[{i}]") for i, v in enumerate(axis.values)])
+    else:
+        if not 1 <= axis.num <= _MAX_POINTS:
+            raise range_error(f"{path}.num", 1, _MAX_POINTS, "1", axis.num)
+        start, stop = value(axis.start, f"{path}.start"), value(axis.stop, f"{path}.stop")
+        vals = np.linspace(start, stop, axis.num) if axis.num > 1 else np.array([start])
+    if len(vals) > 1 and np.any(np.diff(vals) <= 0):
+        raise InputError(f"{path}: values must be strictly increasing")
+    return vals
+
+
+def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
+    """Validate a config mapping (as read from YAML) and resolve it to SI.
+
+    Raises
+    ------
+    InputError
+        One line: the dotted field, what it accepts, and the bad value.
+    """
+    if not isinstance(raw, dict):
+        raise InputError(f"{source}: must be a YAML mapping of keys (name, grid, curves, ...)")
+    try:
+        cfg = SweepConfig.model_validate(raw)
+    except ValidationError as err:
+        raise InputError(_pydantic_message(err, SweepConfig)) from None
+    if not 1.0 <= cfg.slab_megabytes <= 4096.0:
+        raise range_error("slab_megabytes", 1.0, 4096.0, "1", cfg.slab_megabytes)
+    try:
+        silicone = silicone_parameters(cfg.silicone)
+        nylon = nylon_parameters(cfg.nylon)
+    except InputError:
+        raise
+    except ValueError as err:
+        raise InputError(str(err)) from None
+    axes = {name: _axis_values(name, getattr(cfg.grid, name), f"grid.{name}", nylon)
+            for name in Grid.model_fields}
+    curves = {name: _axis_values(name, getattr(cfg.curves, name), f"curves.{name}", nylon)
+              for name in Curves.model_fields}
+    _check_budget(cfg.limits, axes, curves)
+    if cfg.base_thickness == "wall":
+        base = None
+    else:
+        kind, _, lo, hi, shown = DESIGN_RANGES["base_thickness"]
+        base = check_range(cfg.base_thickness.value, "base_thickness.value", kind,
+                           cfg.base_thickness.units or "mm", lo, hi, shown)
+    requirements = tuple(r.text for r in parse_requirements(cfg.requirements))
+    if (cfg.uncertainty is not None or requirements) and not isinstance(cfg.model, str) \
+            and len(cfg.model) > 1:
+        raise InputError("model: a sweep with uncertainty or requirements takes one model; "
+                         "sweep each variant on its own")
+    uncertainty = None if cfg.uncertainty is None else \
+        resolve_uncertainty(cfg.uncertainty, silicone, nylon, raw)
+    return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
+                          silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
+                          slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
+                          raw=copy.deepcopy(raw), uncertainty=uncertainty,
+                          requirements=requirements, models=_models(cfg.model),
+                          supply_voltage=_supply(cfg.supply))
+
+
+def _models(model) -> tuple[str, ...]:
+    """The model variants of a config's ``model`` (one name or a list), checked."""
+    from ..variables import MODELS
+
+    names = [model] if isinstance(model, str) else list(model)
+    if not names:
+        raise InputError(f"model: needs at least one of {', '.join(MODELS)}")
+    for i, name in enumerate(names):
+        field_name = "model" if isinstance(model, str) else f"model[{i}]"
+        if name not in MODELS:
+            raise InputError(f"{field_name}: must be one of {', '.join(MODELS)}, got {name!r}")
+    if len(set(names)) != len(names):
+        raise InputError(f"model: each variant once, got {', '.join(names)}")
+    return tuple(names)
+
+
+def _supply(supply) -> float | None:
+    """The supply voltage [V] of a config's ``supply``, or None."""
+    if supply is None:
+        return None
+    v = INPUTS["supply_voltage"]
+    return check_range(supply.voltage, "supply.voltage", v.kind, supply.units or "V", v.lo,
+                       v.hi, "V", lo_open=v.lo_open)
+
+
+def cube_bytes(axes: dict, curves: dict) -> int:
+    """Bytes of a cube's variables before compression, from the registry's dims and dtypes."""
+    from ..variables import CURVES, DESIGN
+
+    sizes = {k: len(v) for k, v in {**axes, **curves}.items()}
+    return sum(int(np.prod([sizes[d] for d in v.dims], dtype=float)) *
+               np.dtype(v.dtype).itemsize for v in (*DESIGN.values(), *CURVES.values()))
+
+
+def _check_budget(limits: Limits, axes: dict, curves: dict):
+    """Refuse a design space over the budget, before anything is computed or written."""
+    for key in ("designs", "gigabytes"):
+        value = getattr(limits, key)
+        if not (math.isfinite(value) and value > 0):
+            raise range_error(f"limits.{key}", 0, None, "1", value, lo_open=True)
+    n = math.prod(len(v) for v in axes.values())
+    size = cube_bytes(axes, curves) / 1e9
+    if n > limits.designs or size > limits.gigabytes:
+        raise InputError(
+            f"grid: {n:,} designs, a cube of {size:,.3g} GB before compression, is over the "
+            f"budget of {limits.designs:,.0f} designs and {limits.gigabytes:g} GB; shrink the "
+            "grid, or raise the budget with the config key 'limits: {designs: N, gigabytes: "
+            "G}' (or --set limits.designs=N --set limits.gigabytes=G)")
+
+
+def apply_overrides(raw: dict, overrides) -> dict:
+    """Apply ``KEY=VALUE`` strings (dotted keys, YAML values) to a copy of ``raw``."""
+    out = copy.deepcopy(raw)
+    for item in overrides or ():
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise InputError(f"--set {short(item)}: expected KEY=VALUE, e.g. "
+                             "grid.radius.num=81")
+        parts = key.strip().split(".")
+        if len(parts) > YAML_MAX_DEPTH:
+            raise InputError(f"--set {short(key)}: nested deeper than {YAML_MAX_DEPTH} levels")
+        node = out
+        for i, part in enumerate(parts[:-1]):
+            nxt = node.get(part) if isinstance(node, dict) else None
+            if nxt is None:
+                nxt = node[part] = {}
+            if not isinstance(nxt, dict):
+                raise InputError(f"--set {short(key)}: {short('.'.join(parts[:i + 1]))} is "
+                                 "not a mapping")
+            node = nxt
+        try:
+            parsed = load_yaml(value, f"--set {short(key)}")
+        except InputError as err:
+            if "not valid YAML" not in str(err):
+                raise
+            parsed = value
+        node[parts[-1]] = parsed
+        # switching an axis between forms: drop the other form
+        if len(parts) >= 3 and parts[0] in ("grid", "curves"):
+            if parts[-1] in ("start", "stop", "num"):
+                node.pop("values", None)
+            elif parts[-1] == "values":
+                for k in ("start", "stop", "num"):
+                    node.pop(k, None)
+    return out
+
+
+def load_config(path, overrides=()) -> ResolvedConfig:
+    """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
+    from ..material_files import anchor_material_files
+
+    raw = anchor_material_files(read_yaml(path), Path(path).parent)
+    return parse_config(apply_overrides(raw, overrides), str(path))
