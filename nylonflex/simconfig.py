@@ -33,8 +33,8 @@ from pydantic import (
     field_validator,
 )
 
-from .config import DESIGN_RANGES, check_run_name, _pydantic_message, _Strict, check_range, range_error, \
-    read_yaml
+from .config import (DESIGN_RANGES, _pydantic_message, _Strict, check_range, check_run_name,
+                     range_error, read_yaml)
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.nylon import stroke
 from .physics.thermal import muscle_resistance, steady_temperature
