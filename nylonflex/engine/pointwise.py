@@ -22,11 +22,10 @@ from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
 from ..physics._formula import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
+from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
-
-from ..physics.limits import MODELS  # noqa: E402  (docs/model.md s. 16)
 
 #: Designs below which the serial loop is used (threads cost more than they save).
 _PARALLEL_FROM = 64
