@@ -56,6 +56,10 @@ def _unmet(ds, name):
             "has 1") if short else None
 
 
+#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
+ALL_MODELS = ("fig12b", "fig12c", "compare")
+
+
 #: Axes a chart slice (``--at``) may fix.
 SLICE_AXES = ("radius", "wall_thickness", "length", "wrap_angle")
 
@@ -170,7 +174,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     models = [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
-    jobs = [(name, m) for name in names for m in (models if name != "compare" else [None])]
+    jobs = [(name, m) for name in names
+            for m in (models if name not in ALL_MODELS else [None])]
     for done, (name, model) in enumerate(jobs, 1):
         if progress is not None and done > 1:
             progress(done - 1, len(jobs))

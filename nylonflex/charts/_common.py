@@ -16,6 +16,9 @@ FORMATS = ("png", "pdf", "svg")
 # Colours of the Okabe-Ito palette (readable for colour-blind readers and in greyscale).
 _COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
             "#000000")
+# Flagged designs (``validity`` != 0): greyed or hatched in this grey.
+_FLAG_GREY = "0.55"
+_FLAG_FILL = (0.55, 0.55, 0.55, 0.7)
 # Dash patterns of the strength limits, one per wrap angle; all black as in the paper.
 _DASHES = ((0, (6, 2)), (0, (3, 1.5)), (0, (1, 1.2)), (0, (6, 1.5, 1, 1.5)),
            (0, (10, 3)), (0, (2, 3)))
@@ -196,3 +199,25 @@ def _stroke_max(ds):
     dims = [d for d in s.dims if d != "coil_index"]
     return s.max(dims).values
 
+
+
+def _models(ds):
+    """The models of a cube, or ``[None]`` for a cube without a ``model`` dimension."""
+    return [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
+
+
+def _one_model(ds, model):
+    """The cube of one model (``model`` None: the cube as it is)."""
+    return ds if model is None else ds.sel(model=model, drop=True)
+
+
+def _flag_text(ds, bits) -> str:
+    """``"1 self_contact, 4 under_one_turn"``: the validity flags set in ``bits``, named
+    from the cube's CF ``flag_masks``/``flag_meanings`` ("" for none)."""
+    if not bits or "validity" not in ds:
+        return ""
+    attrs = ds["validity"].attrs
+    masks = [int(m) for m in np.atleast_1d(attrs.get("flag_masks", []))]
+    meanings = str(attrs.get("flag_meanings", "")).split()
+    named = [f"{m} {n}" for m, n in zip(masks, meanings) if bits & m]
+    return ", ".join(named) if named else f"validity {bits}"

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..variables import VARIABLES, quantile_name, to_display
-from ._common import (_COLOURS, _DASHES, _EXAMPLES, _LENGTH_DEFAULT, _WRAP_DEFAULT,
+from ._common import (_COLOURS, _DASHES, _EXAMPLES, _FLAG_GREY, _LENGTH_DEFAULT,
+                      _WRAP_DEFAULT, _flag_text, _models, _one_model,
                       _coils, _eq, _example_point, _figure, _footer, _label,
                       _labelled_psis, _nearest, _pick_few, _psi_colour, _stroke_max,
                       _suptitle, _text)
@@ -118,29 +119,59 @@ def _cut_ins(ds, var, sel, coils, psis):
             cut = ds[[var, "limit"]].sel(coil_index=c, wrap_angle=w, **sel)
             lim = cut["limit"].values
             value = to_display(var, cut[var].values)
-            hits = np.flatnonzero((lim[:-1] == 0) & (lim[1:] == 1))
+            # the last design the strength does not bind (full, supply's or load's stroke)
+            hits = np.flatnonzero((lim[:-1] != 1) & (lim[1:] == 1))
             if hits.size:
                 points.append((x[hits[0]], value[hits[0]]))
         out[w] = points
     return out
 
 
-def _limit_lines(ax, ds, var, sel, coils, psis):
+def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
     """Fig. 12(b,c) panel: ``var`` against radius per coil index (solid while
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
-    designs with a full range of motion."""
+    designs with a full range of motion.
+
+    Load-limited designs (``coupled_muscle``) depend on the wrap angle: drawn thinner,
+    dashed, at ``psi_ref`` [rad]. Designs flagged by ``validity`` at ``psi_ref`` get a grey
+    underlay. Returns ``(load_drawn, flag_bits)``: whether a load-limited line was drawn
+    and the OR of the flags under the curves.
+    """
     x = to_display("radius", ds["radius"].values)
+    flagged = "validity" in ds
     # read the panel's slice once (a large cube's chunks span every coil and wrap angle)
-    ds = ds[[var, "limit"]].sel(**sel).load()
+    ds = ds[[var, "limit", *(["validity"] if flagged else [])]].sel(**sel).load()
     sel = {}
+    j_ref = None if psi_ref is None else \
+        int(np.argmin(np.abs(ds["wrap_angle"].values - psi_ref)))
+    load_drawn, bits = False, 0
     for k, c in enumerate(coils):
-        cut = ds[[var, "limit"]].sel(coil_index=c, **sel)
+        cut = ds.sel(coil_index=c)
         value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
-        stroke_limited = cut["limit"].transpose("wrap_angle", "radius").values == 0
-        # stroke-limited values are the same for every wrap angle (s* = s_max(C))
+        lim = cut["limit"].transpose("wrap_angle", "radius").values
+        # the whole stroke, or the supply's: the same for every wrap angle (s* = s_max(C)
+        # or s(T_reach), docs/model.md s. 15)
+        stroke_limited = (lim == 0) | (lim == 2)
         solid = np.where(stroke_limited.any(axis=0), np.nanmax(
             np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
         ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
+        if j_ref is None:
+            continue
+        # where the muscle settles against its load, the value depends on the wrap angle
+        load = np.where(lim[j_ref] == 3, value[j_ref], np.nan)
+        if np.isfinite(load).any():
+            load_drawn = True
+            ax.plot(x, load, color=_COLOURS[k % len(_COLOURS)], lw=1.5, ls=(0, (4, 1.5)),
+                    zorder=3)
+        if flagged:
+            drawn = np.where(np.isfinite(solid), solid, load)
+            v = cut["validity"].transpose("wrap_angle", "radius").values[j_ref]
+            bad = (v != 0) & np.isfinite(drawn)
+            if bad.any():
+                bits |= int(np.bitwise_or.reduce(v[bad].astype(int)))
+                ax.plot(x, np.where(bad, drawn, np.nan), color=_FLAG_GREY, lw=7,
+                        alpha=0.55, marker="o", ms=8, mew=0, solid_capstyle="round",
+                        zorder=2.5)
     shown = _labelled_psis(psis)
     annotate = len(shown) <= 4  # more labels than that overprint: the legend names them
     for w, points in _cut_ins(ds, var, sel, coils, psis).items():
@@ -162,9 +193,12 @@ def _limit_lines(ax, ds, var, sel, coils, psis):
                         bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
                               "alpha": 0.8})
     ax.set_xlabel(_label("radius"))
+    return load_drawn, bits
 
 
-def _legend_12bc(fig, coils, psis):
+def _legend_12bc(fig, coils, psis, load_psi=None, flags=""):
+    """The fig. 12(b,c) legend; ``load_psi`` [rad]: a load-limited line was drawn at that
+    wrap angle; ``flags``: the names of the validity flags under the curves ("" none)."""
     from matplotlib.lines import Line2D
 
     shown = _labelled_psis(psis)
@@ -180,6 +214,13 @@ def _legend_12bc(fig, coils, psis):
         handles.append(Line2D([], [], color="0.75", lw=0.7,
                               label=f"the other {len(psis) - len(shown)} wrap angles"))
         note = f" ({len(shown)} of {len(psis)} labelled)"
+    if load_psi is not None:
+        handles.append(Line2D([], [], color="0.3", lw=1.5, ls=(0, (4, 1.5)),
+                              label=f"load-limited (muscle stops short), at "
+                                    f"{_eq('wrap_angle', load_psi)}"))
+    if flags:
+        handles.append(Line2D([], [], color=_FLAG_GREY, lw=7, alpha=0.55,
+                              label=f"flagged design: {flags}"))
     fig.legend(handles=handles, loc="outside lower center",
                ncol=min(6, max(len(coils), len(shown) + (len(shown) < len(psis)))),
                title="coil index C: solid while the design has its full range of motion "
@@ -188,7 +229,7 @@ def _legend_12bc(fig, coils, psis):
                      "limits")
 
 
-def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None):
+def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None, brief=False):
     """Mark the paper's worked examples (section 4) on a fig. 12(b,c) panel of wall ``t``.
 
     An example is marked only where the cube holds its design exactly (every value a grid
@@ -207,6 +248,11 @@ def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None):
             continue
         ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
         unit = VARIABLES[var].display
+        if brief:  # a narrow panel of a model comparison: the value beside the star
+            ax.annotate(f"{y:.3g} {unit}", (x, y), xytext=(6, 4), textcoords="offset points",
+                        fontsize=7.5, zorder=7, bbox={"boxstyle": "round,pad=0.15",
+                                                      "fc": "white", "ec": "0.6"})
+            continue
         text = f"paper example: {_eq('radius', at['radius'])}, " \
                f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}" \
                f"\n{VARIABLES[var].long_name} {y:.3g} {unit}"
@@ -228,6 +274,22 @@ def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None):
                     arrowprops={"arrowstyle": "->", "color": "0.3", "lw": 0.8,
                                 "shrinkB": 6},
                     bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.6"})
+
+
+def _row_limits(rows):
+    """From zero to the largest value drawn in each row of panels (one shared scale; set
+    after every model is drawn, since matplotlib freezes a shared scale at its first
+    ``set_ylim``)."""
+    for row in rows:
+        tops = [ax.dataLim.y1 for ax in row if ax.has_data() and np.isfinite(ax.dataLim.y1)]
+        row[0].set_ylim(0, 1.05 * max(tops) if tops and max(tops) > 0 else 1.0)
+
+
+def _ref_psi(ds, wrap_angle=None):
+    """The wrap angle at which load-limited lines and flags are drawn [rad]: the first
+    one asked for, or the grid value nearest 8 deg."""
+    first = _WRAP_DEFAULT if wrap_angle is None else float(np.atleast_1d(wrap_angle)[0])
+    return _nearest(ds, "wrap_angle", first)
 
 
 def _psis(ds, wrap_angle=None):
@@ -272,19 +334,39 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     coils = _coils(ds, coil_index)
     psis = _psis(ds, wrap_angle)
-    fig, axes = _figure(1, len(walls), size=(4.4 * len(walls) + 0.4, 5.4))
-    for ax, t in zip(axes[0], walls):
-        _limit_lines(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
-                     coils, psis)
-        _quantile_bands(ax, ds, "torque_max", {"wall_thickness": t, "length": length},
-                        coils)
-        _examples(ax, ds, "torque_max", t, coils=coils)
-        ax.set_title(f"wall thickness {_eq('wall_thickness', t)}")
-        ax.set_ylabel(_label("torque_max"))
-        ax.set_ylim(bottom=0)
-    _legend_12bc(fig, coils, psis)
+    psi_ref = _ref_psi(ds, wrap_angle)
+    models = _models(ds)
+    many = len(models) > 1
+    if many:  # a column per model, a row per wall; one scale along a row
+        fig, axes = _figure(len(walls), len(models), sharex=True, sharey="row",
+                            size=(3.3 * len(models) + 0.6, 3.9 * len(walls) + 1.9))
+    else:
+        fig, axes = _figure(1, len(walls), size=(4.4 * len(walls) + 0.4, 5.4))
+    load, bits = False, 0
+    for m, model in enumerate(models):
+        one = _one_model(ds, model)
+        for w, t in enumerate(walls):
+            ax = axes[w][m] if many else axes[0][w]
+            sel = {"wall_thickness": t, "length": length}
+            drew, flags = _limit_lines(ax, one, "torque_max", sel, coils, psis, psi_ref)
+            load, bits = load or drew, bits | flags
+            _quantile_bands(ax, one, "torque_max", sel, coils)
+            _examples(ax, one, "torque_max", t, coils=coils, brief=many)
+            ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
+                         f"{model}\n{_eq('wall_thickness', t)}",
+                         weight="bold" if many else None)
+            ax.set_ylabel(_label("torque_max") if m == 0 else "")
+            if many and w < len(walls) - 1:
+                ax.set_xlabel("")
+            if not many:
+                ax.set_ylim(bottom=0)
+    if many:
+        _row_limits(axes)
+    _legend_12bc(fig, coils, psis, psi_ref if load else None, _flag_text(ds, bits))
     _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
-              "any length (M* does not depend on L; tip force = M*/L)")
+              "any length (M* does not depend on L; tip force = M*/L)" +
+              (f"\none column per model ({len(models)}), one scale along each row"
+               if many else ""))
     _footer(fig, ds)
     return fig
 
@@ -320,32 +402,62 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
     coils = _coils(ds, coil_index)
     psis = _psis(ds, wrap_angle)
-    fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
-                        height_ratios=(3, 2))
+    models = _models(ds)
+    many = len(models) > 1
+    if many:  # a column per model; per wall a row of angles and a row of range fractions
+        fig, axes = _figure(2 * len(walls), len(models), sharex=True, sharey="row",
+                            size=(3.3 * len(models) + 0.6, 6.4 * len(walls) + 1.9),
+                            height_ratios=(3, 2) * len(walls))
+    else:
+        fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
+                            height_ratios=(3, 2))
     x = to_display("radius", ds["radius"].values)
-    for col, t in enumerate(walls):
-        sel = {"wall_thickness": t, "length": length}
-        top, bottom = axes[0][col], axes[1][col]
-        _limit_lines(top, ds, "bend_angle_max", sel, coils, psis)
-        _quantile_bands(top, ds, "bend_angle_max", sel, coils, psi, note_at=(0.02, 0.98))
-        _examples(top, ds, "bend_angle_max", t, length, corner="lower right", coils=coils)
-        top.set_title(f"wall thickness {_eq('wall_thickness', t)}")
-        top.set_xlabel("")
-        top.set_ylabel(_label("bend_angle_max"))
-        top.set_ylim(bottom=0)
-        fraction = ds["range_fraction"].sel(wrap_angle=psi, **sel).load()
-        for k, c in enumerate(coils):
-            rf = fraction.sel(coil_index=c).values
-            bottom.plot(x, 100 * rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
-        bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)} "
-                         "(100 % = full range)")
-        bottom.set_xlabel(_label("radius"))
-        bottom.set_ylabel("range of motion [%]")
-        bottom.set_ylim(0, 105)
-    _legend_12bc(fig, coils, psis)
+    load, bits = False, 0
+    for m, model in enumerate(models):
+        one = _one_model(ds, model)
+        for w, t in enumerate(walls):
+            sel = {"wall_thickness": t, "length": length}
+            top, bottom = (axes[2 * w][m], axes[2 * w + 1][m]) if many else \
+                (axes[0][w], axes[1][w])
+            drew, flags = _limit_lines(top, one, "bend_angle_max", sel, coils, psis, psi)
+            load, bits = load or drew, bits | flags
+            _quantile_bands(top, one, "bend_angle_max", sel, coils, psi,
+                            note_at=(0.02, 0.98))
+            _examples(top, one, "bend_angle_max", t, length, corner="lower right",
+                      coils=coils, brief=many)
+            top.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
+                          f"{model}\n{_eq('wall_thickness', t)}",
+                          weight="bold" if many else None)
+            top.set_xlabel("")
+            top.set_ylabel(_label("bend_angle_max") if m == 0 else "")
+            if not many:
+                top.set_ylim(bottom=0)
+            names = ["range_fraction", *(["validity"] if "validity" in one else [])]
+            cut = one[names].sel(wrap_angle=psi, **sel).load()
+            for k, c in enumerate(coils):
+                rf = 100 * cut["range_fraction"].sel(coil_index=c).values
+                bottom.plot(x, rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
+                if "validity" in cut:
+                    bad = cut["validity"].sel(coil_index=c).values != 0
+                    if bad.any():
+                        bits |= int(np.bitwise_or.reduce(
+                            cut["validity"].sel(coil_index=c).values[bad].astype(int)))
+                        bottom.plot(x, np.where(bad, rf, np.nan), color=_FLAG_GREY, lw=7,
+                                    alpha=0.55, marker="o", ms=8, mew=0,
+                                    solid_capstyle="round", zorder=1.5)
+            bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)}" +
+                             ("" if many else " (100 % = full range)"))
+            bottom.set_xlabel(_label("radius") if w == len(walls) - 1 or not many else "")
+            bottom.set_ylabel("range of motion [%]" if m == 0 else "")
+            bottom.set_ylim(0, 105)
+    if many:
+        _row_limits(axes[0::2])
+    _legend_12bc(fig, coils, psis, psi if load else None, _flag_text(ds, bits))
     _suptitle(fig, "Figure 12(c): maximum bend angle (range of motion) against radius",
               f"{_eq('length', length)} (the angle grows in proportion to L; "
-              "the range fraction does not)")
+              "the range fraction does not)" +
+              (f"\none column per model ({len(models)}), one scale along each row"
+               if many else ""))
     _footer(fig, ds)
     return fig
 

@@ -9,8 +9,9 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import to_display
-from ._common import (_EXAMPLES, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _figure,
-                      _footer, _grid_value, _label, _nearest, _pick_few, _plt, _suptitle)
+from ._common import (_EXAMPLES, _FLAG_FILL, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq,
+                      _figure, _flag_text, _footer, _grid_value, _label, _nearest,
+                      _pick_few, _plt, _suptitle)
 
 
 # ---------------------------------------------------------------------------- design map
@@ -42,7 +43,9 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     nrows = math.ceil(len(coils) / ncols)
     fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
                         sharex=True, sharey=True)
-    cut = ds[["tip_force_max", "limit"]].sel(length=length, wrap_angle=psi).load()
+    names = ["tip_force_max", "limit", *(["validity"] if "validity" in ds else [])]
+    cut = ds[names].sel(length=length, wrap_angle=psi).load()
+    bits = 0
     force = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
     top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
     levels = _nice_levels(top)
@@ -66,6 +69,13 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
                 ax.contourf(x, y, strength, levels=[0.5, 1.5], colors="none",
                             hatches=["///"])
             ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
+        if "validity" in cut:  # flagged designs (docs/model.md s. 17): greyed, hatched
+            v = cut["validity"].sel(coil_index=c).transpose("wall_thickness", "radius").values
+            if (v != 0).any():
+                bits |= int(np.bitwise_or.reduce(v[v != 0].astype(int)))
+                with plt.rc_context({"hatch.color": "k", "hatch.linewidth": 0.6}):
+                    ax.contourf(x, y, (v != 0).astype(float), levels=[0.5, 1.5],
+                                colors=[_FLAG_FILL], hatches=["\\\\"])
         for example in _map_examples(ds, length, psi, c):
             ax.plot(to_display("radius", example[0]),
                     to_display("wall_thickness", example[1]), "*", ms=13, mfc="gold",
@@ -80,6 +90,9 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     handles = [Patch(fc="#2a788e", ec="white", hatch="///",
                      label="strength-limited: nylon breaks first, range of motion cut short"),
                Patch(fc="#2a788e", ec="none", label="stroke-limited: full range of motion")]
+    if bits:
+        handles.append(Patch(fc=_FLAG_FILL, ec="k", hatch="\\\\",
+                             label=f"flagged design: {_flag_text(ds, bits)}"))
     if any(_map_examples(ds, length, psi, c) for c in coils):
         from matplotlib.lines import Line2D
 
