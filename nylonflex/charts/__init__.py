@@ -24,7 +24,7 @@ from ..units import InputError
 from ..variables import VARIABLES, to_display
 # _figure, _plt and _RC are shared with the uncertainty and design charts
 from ._common import FORMATS, _RC, _figure, _grid_value, _plt  # noqa: F401
-from .compare import compare
+from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
 from .fig12 import fig12a, fig12b, fig12c
 from .maps import design_map, feasibility_map
@@ -124,7 +124,7 @@ def _slice_kwargs(func, chosen):
 
 
 def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_index=None,
-                progress=None) -> list[Path]:
+                progress=None, variable=None) -> list[Path]:
     """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
 
     Parameters
@@ -147,6 +147,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         Coil indices to draw [-] (grid values); default every one of the cube.
     progress : callable, optional
         Called as ``progress(done, total)`` [charts] after each chart.
+    variable : str, optional
+        The variable ``compare`` draws (default ``tip_force_max``).
 
     Returns
     -------
@@ -169,6 +171,13 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         raise InputError(f"--format: unknown image format {fmt!r}; accepted: "
                          f"{', '.join(FORMATS)}")
     chosen = chart_slice(ds, at, coil_index)
+    if variable is not None:
+        if "compare" not in names:
+            raise InputError("--variable: only --figure compare draws a chosen variable")
+        if variable not in comparable(ds):
+            raise InputError(f"--variable: compare draws one of {', '.join(comparable(ds))}; "
+                             f"got {variable!r}")
+        chosen["variable"] = variable
     plt = _plt()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

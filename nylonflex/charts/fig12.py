@@ -165,7 +165,7 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
                     zorder=3)
         if flagged:
             drawn = np.where(np.isfinite(solid), solid, load)
-            v = cut["validity"].transpose("wrap_angle", "radius").values[j_ref]
+            v = np.nan_to_num(cut["validity"].transpose("wrap_angle", "radius").values[j_ref])
             bad = (v != 0) & np.isfinite(drawn)
             if bad.any():
                 bits |= int(np.bitwise_or.reduce(v[bad].astype(int)))
@@ -438,7 +438,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                 rf = 100 * cut["range_fraction"].sel(coil_index=c).values
                 bottom.plot(x, rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
                 if "validity" in cut:
-                    bad = cut["validity"].sel(coil_index=c).values != 0
+                    bad = np.nan_to_num(cut["validity"].sel(coil_index=c).values) != 0
                     if bad.any():
                         bits |= int(np.bitwise_or.reduce(
                             cut["validity"].sel(coil_index=c).values[bad].astype(int)))

@@ -70,7 +70,8 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
                             hatches=["///"])
             ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
         if "validity" in cut:  # flagged designs (docs/model.md s. 17): greyed, hatched
-            v = cut["validity"].sel(coil_index=c).transpose("wall_thickness", "radius").values
+            v = np.nan_to_num(cut["validity"].sel(coil_index=c)
+                              .transpose("wall_thickness", "radius").values)
             if (v != 0).any():
                 bits |= int(np.bitwise_or.reduce(v[v != 0].astype(int)))
                 with plt.rc_context({"hatch.color": "k", "hatch.linewidth": 0.6}):
