@@ -132,10 +132,10 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
     designs with a full range of motion.
 
-    Load-limited designs (``coupled_muscle``) depend on the wrap angle: drawn thinner,
-    dashed, at ``psi_ref`` [rad]. Designs flagged by ``validity`` at ``psi_ref`` get a grey
-    underlay. Returns ``(load_drawn, flag_bits)``: whether a load-limited line was drawn
-    and the OR of the flags under the curves.
+    Supply- and load-limited designs (``supply``, ``coupled_muscle``) depend on the wrap
+    angle: drawn thinner, dashed, at ``psi_ref`` [rad]. Designs flagged by ``validity`` at
+    ``psi_ref`` get a grey underlay. Returns ``(limits, flag_bits)``: the limit codes of
+    the dashed lines drawn (a set of 2, 3) and the OR of the flags under the curves.
     """
     x = to_display("radius", ds["radius"].values)
     flagged = "validity" in ds
@@ -144,23 +144,24 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
     sel = {}
     j_ref = None if psi_ref is None else \
         int(np.argmin(np.abs(ds["wrap_angle"].values - psi_ref)))
-    load_drawn, bits = False, 0
+    load_drawn, bits = set(), 0
     for k, c in enumerate(coils):
         cut = ds.sel(coil_index=c)
         value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
         lim = cut["limit"].transpose("wrap_angle", "radius").values
-        # the whole stroke, or the supply's: the same for every wrap angle (s* = s_max(C)
-        # or s(T_reach), docs/model.md s. 15)
-        stroke_limited = (lim == 0) | (lim == 2)
+        # the whole stroke: the same for every wrap angle (s* = s_max(C))
+        stroke_limited = lim == 0
         solid = np.where(stroke_limited.any(axis=0), np.nanmax(
             np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
         ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
         if j_ref is None:
             continue
-        # where the muscle settles against its load, the value depends on the wrap angle
-        load = np.where(lim[j_ref] == 3, value[j_ref], np.nan)
-        if np.isfinite(load).any():
-            load_drawn = True
+        # the supply's stroke (the wrap's muscle length sets T_ss) or where the muscle
+        # settles against its load: the value depends on the wrap angle
+        short = (lim[j_ref] == 2) | (lim[j_ref] == 3)
+        load = np.where(short, value[j_ref], np.nan)
+        if short.any():
+            load_drawn |= {int(code) for code in lim[j_ref][short]}
             ax.plot(x, load, color=_COLOURS[k % len(_COLOURS)], lw=1.5, ls=(0, (4, 1.5)),
                     zorder=3)
         if flagged:
@@ -196,9 +197,10 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
     return load_drawn, bits
 
 
-def _legend_12bc(fig, coils, psis, load_psi=None, flags=""):
-    """The fig. 12(b,c) legend; ``load_psi`` [rad]: a load-limited line was drawn at that
-    wrap angle; ``flags``: the names of the validity flags under the curves ("" none)."""
+def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
+    """The fig. 12(b,c) legend; ``load_psi`` [rad]: supply- or load-limited lines (limit
+    codes ``limits``) were drawn at that wrap angle; ``flags``: the names of the validity
+    flags under the curves ("" none)."""
     from matplotlib.lines import Line2D
 
     shown = _labelled_psis(psis)
@@ -215,8 +217,10 @@ def _legend_12bc(fig, coils, psis, load_psi=None, flags=""):
                               label=f"the other {len(psis) - len(shown)} wrap angles"))
         note = f" ({len(shown)} of {len(psis)} labelled)"
     if load_psi is not None:
+        what = " or ".join(w for code, w in ((2, "supply-limited"), (3, "load-limited"))
+                           if code in limits)
         handles.append(Line2D([], [], color="0.3", lw=1.5, ls=(0, (4, 1.5)),
-                              label=f"load-limited (muscle stops short), at "
+                              label=f"{what} (muscle stops short), at "
                                     f"{_eq('wrap_angle', load_psi)}"))
     if flags:
         handles.append(Line2D([], [], color=_FLAG_GREY, lw=7, alpha=0.55,
@@ -342,14 +346,14 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                             size=(3.3 * len(models) + 0.6, 3.9 * len(walls) + 1.9))
     else:
         fig, axes = _figure(1, len(walls), size=(4.4 * len(walls) + 0.4, 5.4))
-    load, bits = False, 0
+    load, bits = set(), 0
     for m, model in enumerate(models):
         one = _one_model(ds, model)
         for w, t in enumerate(walls):
             ax = axes[w][m] if many else axes[0][w]
             sel = {"wall_thickness": t, "length": length}
             drew, flags = _limit_lines(ax, one, "torque_max", sel, coils, psis, psi_ref)
-            load, bits = load or drew, bits | flags
+            load, bits = load | drew, bits | flags
             _quantile_bands(ax, one, "torque_max", sel, coils)
             _examples(ax, one, "torque_max", t, coils=coils, brief=many)
             ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
@@ -362,7 +366,8 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                 ax.set_ylim(bottom=0)
     if many:
         _row_limits(axes)
-    _legend_12bc(fig, coils, psis, psi_ref if load else None, _flag_text(ds, bits))
+    _legend_12bc(fig, coils, psis, psi_ref if load else None, _flag_text(ds, bits),
+                 load)
     _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
               "any length (M* does not depend on L; tip force = M*/L)" +
               (f"\none column per model ({len(models)}), one scale along each row"
@@ -412,7 +417,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
         fig, axes = _figure(2, len(walls), size=(4.4 * len(walls) + 0.4, 7.6), sharex=True,
                             height_ratios=(3, 2))
     x = to_display("radius", ds["radius"].values)
-    load, bits = False, 0
+    load, bits = set(), 0
     for m, model in enumerate(models):
         one = _one_model(ds, model)
         for w, t in enumerate(walls):
@@ -420,7 +425,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             top, bottom = (axes[2 * w][m], axes[2 * w + 1][m]) if many else \
                 (axes[0][w], axes[1][w])
             drew, flags = _limit_lines(top, one, "bend_angle_max", sel, coils, psis, psi)
-            load, bits = load or drew, bits | flags
+            load, bits = load | drew, bits | flags
             _quantile_bands(top, one, "bend_angle_max", sel, coils, psi,
                             note_at=(0.02, 0.98))
             _examples(top, one, "bend_angle_max", t, length, corner="lower right",
@@ -452,7 +457,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             bottom.set_ylim(0, 105)
     if many:
         _row_limits(axes[0::2])
-    _legend_12bc(fig, coils, psis, psi if load else None, _flag_text(ds, bits))
+    _legend_12bc(fig, coils, psis, psi if load else None, _flag_text(ds, bits), load)
     _suptitle(fig, "Figure 12(c): maximum bend angle (range of motion) against radius",
               f"{_eq('length', length)} (the angle grows in proportion to L; "
               "the range fraction does not)" +
