@@ -87,7 +87,8 @@ def compare(ds, *, variable="tip_force_max", wall_thickness=None, length=None,
     ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
     ax.legend(fontsize="small", title="model")
     sub = ", ".join(_eq(n, v) for n, v in at.items())
-    _suptitle(fig, f"Model variants: {VARIABLES[variable].long_name} against radius",
+    _suptitle(fig, f"Figure compare: {VARIABLES[variable].long_name} against radius, "
+              "every model",
               f"at {sub} (the paper's first example's slice)")
     _footer(fig, ds)
     return fig
