@@ -31,7 +31,7 @@ import re
 import numpy as np
 
 from .units import InputError, from_si, parse_quantity
-from .variables import AXES, DESIGN, VARIABLES, to_display
+from .variables import AXES, DESIGN, MODEL, VARIABLES, to_display
 
 __all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_csv", "format_json", "format_table",
            "held_back", "parse_at", "parse_where", "query_cube", "rows_note"]
@@ -240,8 +240,11 @@ def _slab_rows(ds, at_loc, r0, r1):
             sub["bend_angle_max"] = sub["bend_angle_max"] * length
         # a limit between two grid points is known only where both agree
         sub["limit"] = a["limit"].where(~mixed)
-    dims = [d for d in AXES if d in sub.dims]
+    # a cube of several models: the model is the last (fastest) axis of the rows
+    dims = [d for d in (*AXES, "model") if d in sub.dims]
     shape = [sub.sizes[d] for d in dims]
+    if "model" in sub.dims:  # model-free variables: the same value for every model
+        sub = sub.map(lambda v: v if "model" in v.dims else v.expand_dims(model=sub["model"]))
     rows = {}
     for name in AXES:
         if name in sub.dims:
@@ -250,6 +253,10 @@ def _slab_rows(ds, at_loc, r0, r1):
             rows[name] = np.broadcast_to(coord, shape).reshape(-1)
         else:
             rows[name] = np.full(int(np.prod(shape)), at_value(at_loc, name, ds))
+    if "model" in sub.dims:
+        names = sub["model"].values.astype(str).astype(object)
+        rows["model"] = np.broadcast_to(names.reshape([1] * (len(dims) - 1) + [-1]),
+                                        shape).reshape(-1)
     for name in DESIGN:
         rows[name] = sub[name].transpose(*dims).values.reshape(-1) if name in sub else \
             np.full(int(np.prod(shape)), np.nan)  # heating_time: only with a supply
@@ -350,6 +357,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
+    if "model" in ds.dims:  # every model at once: the model names each row
+        columns = ("model", *columns)
     for name in [c.name for c in conditions] + [sort_name]:
         if name in OPTIONAL and name not in ds:
             raise InputError(f"{name}: the cube has no {name}; sweep a config with "
@@ -373,12 +382,14 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         other = 1
         for name in AXES[1:]:
             other *= 2 if name in at_loc else ds.sizes[name]
+        other *= ds.sizes.get("model", 1)
         step = max(1, _SLAB_VALUES // max(other, 1))
         slabs = [(r, min(r + step, ds.sizes["radius"]))
                  for r in range(0, ds.sizes["radius"], step)]
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
-    kept = {name: np.empty(0) for name in columns}
+    kept = {name: np.empty(0, dtype=object if name == "model" else float)
+            for name in columns}
     matched = 0
     for k, (r0, r1) in enumerate(slabs):
         if done is not None and "radius" not in at_loc and not done[r0:r1].any():
@@ -420,8 +431,8 @@ _MODEL_WHERE = re.compile(r"^\s*model\s*(==|=)\s*([A-Za-z0-9_]+)\s*$")
 def _select_model(ds, where):
     """The cube at the model a ``--where "model == NAME"`` names, and the other conditions.
 
-    A cube of several models (docs/model.md s. 16) is queried one model at a time; without
-    such a condition it is refused with the models it has.
+    A cube of several models (docs/model.md s. 16) without such a condition is queried
+    across every model at once (a ``model`` column names each row's).
     """
     where = list(where or ())
     names = [m.group(2) for m in (_MODEL_WHERE.match(str(w)) for w in where) if m]
@@ -433,9 +444,11 @@ def _select_model(ds, where):
             raise InputError(f"--where model: this cube has {', '.join(models)}, got {name!r}")
     if "model" not in ds.dims:
         return ds, rest
+    if not names:
+        return ds, rest
     if len(set(names)) != 1:
-        raise InputError(f"--where: this cube holds the models {', '.join(models)}; pick one "
-                         f"with --where \"model == {models[0]}\"")
+        raise InputError(f"--where: one model at a time ({', '.join(models)}), or none for "
+                         f"every model; got {', '.join(sorted(set(names)))}")
     return ds.sel(model=names[0], drop=True), rest
 
 
@@ -451,8 +464,12 @@ def _sorted(rows, name, descending, limit):
 # ---------------------------------------------------------------------------- output
 
 
+def _var(name):
+    return MODEL if name == "model" else VARIABLES[name]
+
+
 def _unit(name):
-    return VARIABLES[name].display
+    return _var(name).display
 
 
 def _sig3(x) -> str:
@@ -469,6 +486,8 @@ def _sig3(x) -> str:
 
 
 def _cell(name, x) -> str:
+    if name == "model":
+        return str(x)
     if name == "limit":
         return {0.0: "stroke", 1.0: "strength", 2.0: "supply", 3.0: "load"}.get(
             float(x), "boundary") \
@@ -501,7 +520,7 @@ def format_table(res) -> str:
     n = len(res)
     if res.single and n == 1:
         print(f"design at {_describe_at(res)}", file=out)
-        for name in [*DESIGN, *res.columns[len(COLUMNS):]]:
+        for name in [*DESIGN, *(c for c in res.columns if c in OPTIONAL)]:
             x = res.data[name][0]
             unit = _unit(name)
             text = _cell(name, x)
@@ -524,10 +543,12 @@ def format_table(res) -> str:
     widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
               enumerate(zip(heads, units))] if cells else [max(len(h), len(u)) for h, u in
                                                           zip(heads, units)]
-    print("  ".join(h.rjust(w) for h, w in zip(heads, widths)), file=out)
-    print("  ".join(u.rjust(w) for u, w in zip(units, widths)), file=out)
+    # names to the left (the model column), numbers to the right
+    just = [str.ljust if h == "model" else str.rjust for h in heads]
+    print("  ".join(j(h, w) for h, w, j in zip(heads, widths, just)), file=out)
+    print("  ".join(j(u, w) for u, w, j in zip(units, widths, just)), file=out)
     for r in cells:
-        print("  ".join(c.rjust(w) for c, w in zip(r, widths)), file=out)
+        print("  ".join(j(c, w) for c, w, j in zip(r, widths, just)), file=out)
     print(rows_note(res), file=out)
     return out.getvalue()
 
@@ -554,7 +575,7 @@ def _json_value(x):
 
 
 def _records(res):
-    units = {name: VARIABLES[name].units for name in res.columns}
+    units = {name: _var(name).units for name in res.columns}
     records = []
     for i in range(len(res)):
         rec = {}
@@ -562,6 +583,9 @@ def _records(res):
             rec["point"] = res.point
         for name in res.columns:
             x = res.data[name][i]
+            if name == "model":
+                rec[name] = str(x)
+                continue
             rec[name] = (None if not np.isfinite(x) else int(x)) if name == "limit" \
                 else _json_value(x)
         rec["units"] = units
@@ -581,13 +605,15 @@ def format_csv(res) -> str:
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     head = ([] if not res.point else ["point"]) + \
-        [f"{n} [{VARIABLES[n].units}]" for n in res.columns]
+        [n if n == "model" else f"{n} [{VARIABLES[n].units}]" for n in res.columns]
     w.writerow(head)
     for i in range(len(res)):
         row = [] if not res.point else [res.point]
         for name in res.columns:
             x = res.data[name][i]
-            if name == "limit":
+            if name == "model":
+                row.append(str(x))
+            elif name == "limit":
                 row.append("" if not np.isfinite(x) else int(x))
             else:
                 row.append("" if not np.isfinite(x) else repr(float(x)))

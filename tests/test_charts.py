@@ -141,13 +141,15 @@ def test_sweep_draws_the_configs_charts(tmp_path, capsys, monkeypatch):
 
 def test_charts_read_the_dataset_only():
     # layers (STYLE.md): charts never compute physics; matplotlib is imported lazily
-    tree = ast.parse(Path(charts.__file__).read_text())
-    imported = {(n.module or "") for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
-    imported |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
-    assert not any("physics" in m or "kernels" in m or "sweep" in m for m in imported)
-    top = {a.name for n in tree.body if isinstance(n, ast.Import) for a in n.names}
-    top |= {n.module for n in tree.body if isinstance(n, ast.ImportFrom)}
-    assert not any(m and m.startswith("matplotlib") for m in top)
+    for path in sorted(Path(charts.__file__).parent.glob("*.py")):
+        tree = ast.parse(path.read_text())
+        imported = {(n.module or "") for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+        imported |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import)
+                     for a in n.names}
+        assert not any("physics" in m or "kernels" in m or "sweep" in m for m in imported), path
+        top = {a.name for n in tree.body if isinstance(n, ast.Import) for a in n.names}
+        top |= {n.module for n in tree.body if isinstance(n, ast.ImportFrom)}
+        assert not any(m and m.startswith("matplotlib") for m in top), path
 
 
 def test_incomplete_cube_draws_with_a_warning(cube, tmp_path, capsys):

@@ -21,6 +21,9 @@ def add_arguments(c):
                         "chart takes the ones it holds fixed")
     c.add_argument("--coil-index", metavar="C,...",
                    help="coil indices to draw (grid values, e.g. 1.1,1.7); default all")
+    c.add_argument("--variable", metavar="NAME",
+                   help="the design variable --figure compare draws against radius for "
+                        "every model (default tip_force_max)")
     c.add_argument("--out", help="folder for the images (default: beside the cube)")
     c.add_argument("--format", choices=["png", "pdf", "svg"], default="png",
                    help="image format: png, pdf or svg")
@@ -53,7 +56,7 @@ def run(args) -> int:
         skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
         with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
             paths = draw_charts(ds, args.figure, out, args.format, on_skip=skip, at=at,
-                                coil_index=coils, progress=bar)
+                                coil_index=coils, progress=bar, variable=args.variable)
         for path in paths:
             print(path)
     finally:

@@ -1,0 +1,217 @@
+"""Design charts drawn from a saved cube: the paper's figures 4, 6, 7 and 12, and a design map.
+
+Charts read the :class:`xarray.Dataset` only; they never compute physics. Every axis label
+comes from the variable registry (:mod:`nylonflex.variables`) in the unit a designer reads
+(mm, deg, kPa, N), and every title names the slice of the cube it shows. matplotlib is
+imported lazily with the headless Agg backend (after ``xarray/plot/utils.py``).
+
+Each chart is a function ``f(ds, **slice) -> matplotlib.figure.Figure``; the keyword
+arguments choose the slice in SI (default: the grid values nearest the paper's choices), and
+:func:`draw_charts` passes a slice (``at``, ``coil_index``) to every chart that draws along
+it (``nylonflex chart CUBE --at length=70mm,wrap_angle=8deg --coil-index 1.1,1.7``).
+Subtitles are written from the values drawn; the paper's worked examples are marked only
+where the slice holds them exactly, with the cube's values there.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..config import CHARTS as _CHART_NAMES
+from ..units import InputError
+from ..variables import VARIABLES, to_display
+# _figure, _plt and _RC are shared with the uncertainty and design charts
+from ._common import FORMATS, _RC, _figure, _grid_value, _plt  # noqa: F401
+from .compare import comparable, compare
+from .curves import fig4, fig6, fig7
+from .fig12 import fig12a, fig12b, fig12c
+from .maps import design_map, feasibility_map
+
+__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "design_map",
+           "draw_charts", "feasibility_map", "fig4", "fig6", "fig7", "fig12a", "fig12b",
+           "fig12c"]
+
+
+#: Chart name -> function, the names a config's ``charts`` list accepts.
+CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
+          "fig6": fig6, "fig7": fig7, "design_map": design_map,
+          "feasibility_map": feasibility_map, "compare": compare}
+assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
+
+
+#: Axes each chart draws along: a cube with a single value there cannot show it.
+NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
+         "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
+         "design_map": ("radius", "wall_thickness"),
+         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",)}
+
+
+def _unmet(ds, name):
+    if name == "feasibility_map" and "feasibility" not in ds:
+        return "feasibility_map skipped: the cube has no feasibility (no 'requirements')"
+    short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
+    return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
+            "has 1") if short else None
+
+
+#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
+ALL_MODELS = ("fig12b", "fig12c", "compare")
+
+
+#: Axes a chart slice (``--at``) may fix.
+SLICE_AXES = ("radius", "wall_thickness", "length", "wrap_angle")
+
+
+def _on_grid(ds, name, values, field):
+    out = []
+    for value in np.atleast_1d(values):
+        grid = _grid_value(ds, name, float(value))
+        if grid is None:
+            v = VARIABLES[name]
+            unit = "" if v.display == "1" else f" {v.display}"
+            shown = ", ".join(f"{x:g}" for x in to_display(name, ds[name].values[:12]))
+            more = ", ..." if ds.sizes[name] > 12 else ""
+            raise InputError(f"{field}: {name}={float(to_display(name, value)):g}{unit} is "
+                             f"not a grid value of the cube; it has {shown}{more}{unit}")
+        out.append(grid)
+    return out
+
+
+def chart_slice(ds, at=None, coil_index=None) -> dict:
+    """Check a chart slice against the cube: ``{axis: grid value}`` [SI] and coil indices.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    at : dict, optional
+        ``{axis: value}`` [SI] for axes of :data:`SLICE_AXES`.
+    coil_index : float or sequence of float, optional
+        Coil indices to draw [-].
+
+    Returns
+    -------
+    dict
+        The slice with grid values, ``coil_index`` a list.
+
+    Raises
+    ------
+    InputError
+        An axis that charts cannot fix, or a value that is not a grid value.
+    """
+    out = {}
+    for name, value in (at or {}).items():
+        if name not in SLICE_AXES:
+            raise InputError(f"--at: charts take {', '.join(SLICE_AXES)} (coil indices with "
+                             f"--coil-index), got {name!r}")
+        out[name] = _on_grid(ds, name, value, "--at")[0]
+    if coil_index is not None:
+        out["coil_index"] = _on_grid(ds, "coil_index", coil_index, "--coil-index")
+    return out
+
+
+def _slice_kwargs(func, chosen):
+    """The keyword arguments of chart ``func`` that the slice ``chosen`` sets."""
+    import inspect
+
+    params = inspect.signature(func).parameters
+    kw = {name: value for name, value in chosen.items() if name in params}
+    if "wall_thickness" in chosen and "walls" in params:
+        kw["walls"] = [chosen["wall_thickness"]]
+    return kw
+
+
+def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_index=None,
+                progress=None, variable=None) -> list[Path]:
+    """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube (:func:`nylonflex.open_cube`).
+    names : sequence of str or None
+        Chart names (:data:`CHARTS`); None draws all the cube can show.
+    out_dir : path
+        Folder for the images (created if missing).
+    fmt : {"png", "pdf", "svg"}
+        Image format.
+    on_skip : callable, optional
+        Receives a one-line message for each chart the cube cannot show (an axis it plots
+        along has a single value); a warning by default.
+    at : dict, optional
+        The slice, ``{axis: value}`` [SI] for axes of :data:`SLICE_AXES` (grid values):
+        each chart takes the ones it holds fixed.
+    coil_index : float or sequence of float, optional
+        Coil indices to draw [-] (grid values); default every one of the cube.
+    progress : callable, optional
+        Called as ``progress(done, total)`` [charts] after each chart.
+    variable : str, optional
+        The variable ``compare`` draws (default ``tip_force_max``).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in the order of ``names``.
+
+    Raises
+    ------
+    InputError
+        An unknown chart name or format.
+    """
+    if not names:  # every chart the cube can show (feasibility only with requirements)
+        names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
+    names = list(names)
+    unknown = [n for n in names if n not in CHARTS]
+    if unknown:
+        raise InputError(f"--figure: unknown chart {unknown[0]!r}; accepted: "
+                         f"{', '.join(CHARTS)}")
+    if fmt not in FORMATS:
+        raise InputError(f"--format: unknown image format {fmt!r}; accepted: "
+                         f"{', '.join(FORMATS)}")
+    chosen = chart_slice(ds, at, coil_index)
+    if variable is not None:
+        if "compare" not in names:
+            raise InputError("--variable: only --figure compare draws a chosen variable")
+        if variable not in comparable(ds):
+            raise InputError(f"--variable: compare draws one of {', '.join(comparable(ds))}; "
+                             f"got {variable!r}")
+        chosen["variable"] = variable
+    plt = _plt()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
+    jobs = [(name, m) for name in names
+            for m in (models if name not in ALL_MODELS else [None])]
+    for done, (name, model) in enumerate(jobs, 1):
+        if progress is not None and done > 1:
+            progress(done - 1, len(jobs))
+        reason = _unmet(ds, name)
+        if reason:
+            if on_skip is None:
+                import warnings
+
+                warnings.warn(reason, stacklevel=2)
+            else:
+                on_skip(reason)
+            continue
+        with plt.rc_context(_RC):
+            # a cube of several models: each figure once a model, its name in title and file
+            one = ds if model is None else ds.sel(model=model, drop=True)
+            fig = CHARTS[name](one, **_slice_kwargs(CHARTS[name], chosen))
+            if model is not None:
+                fig.text(0.99, 0.995, f"model: {model}", ha="right", va="top",
+                         fontsize="small", weight="bold")
+            path = out_dir / (f"{name}.{fmt}" if model is None else f"{name}_{model}.{fmt}")
+            # fixed metadata so that the same cube gives byte-stable PDF/SVG files
+            meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
+                    "svg": {"Date": None}}[fmt]
+            fig.savefig(path, format=fmt, metadata=meta, bbox_inches="tight",
+                        pad_inches=0.08)
+            plt.close(fig)
+        written.append(path)
+    if progress is not None:
+        progress(len(jobs), len(jobs))
+    return written
