@@ -323,10 +323,15 @@ def test_an_interrupted_overwrite_keeps_the_old_cube(tmp_path, whole):
     xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
 
 
-def test_special_files_are_refused(small_cfg, capsys):
+def test_special_files_are_refused(small_cfg, tmp_path, capsys):
+    # a fifo of the test's own, not /dev/null: code with this bug would replace the
+    # machine's /dev/null with a regular file (it happened once while checking the old code)
     raw, cfg = small_cfg
-    assert sweep(cfg, "/dev/null") == 2
+    fifo = tmp_path / "fifo.h5"
+    os.mkfifo(fifo)
+    assert sweep(cfg, str(fifo)) == 2
     assert "special file" in capsys.readouterr().err
+    assert fifo.is_fifo()
 
 
 def test_simulate_never_writes_over_a_cube(tmp_path, small_cfg):
