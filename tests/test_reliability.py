@@ -720,3 +720,25 @@ def test_info_does_not_call_a_cube_with_a_corrupt_chunk_complete(tmp_path, whole
     assert "Traceback" not in cap.err
     assert main(["info", source, "--check"]) == 0
     assert "every chunk" in capsys.readouterr().out
+
+
+def test_nylon_use_is_at_most_one_by_construction(monkeypatch):
+    """Even for a muscle far weaker than the accepted range (checks bypassed), in the
+    reference loop and in the compiled kernels; it was 1 + 1e-8 (and 1 + 6e-15 on the
+    reference cube's strength-limited designs)."""
+    import nylonflex as nf
+    import nylonflex.materials as materials
+    from nylonflex.physics.limits import design_limits
+
+    monkeypatch.setitem(materials.NYLON_RANGES, "tensile_strength_table",
+                        (1e-300, 1e300, "Pa"))
+    radius = np.linspace(4e-3, 25e-3, 23)
+    for table in ([1.0] * 4, [1e3] * 4, [2e8] * 4):
+        nylon = {"set": "silver_nylon66", "tensile_strength_table": table}
+        slow = design_limits(radius, 2e-3, 70e-3, 1.3, 0.14, nylon=nylon)
+        fast = nf.evaluate(radius, 2e-3, 70e-3, 1.3, 0.14, nylon=nylon)
+        for use in (slow["nylon_use"], fast["nylon_use"]):
+            assert np.all(np.isfinite(use)) and np.max(use) <= 1.0, table
+    ref = run_sweep(parse_config(yaml.safe_load(
+        open(os.path.join(os.path.dirname(__file__), "data", "reference_cube.yaml")))))
+    assert float(ref["nylon_use"].max()) == 1.0
