@@ -742,3 +742,19 @@ def test_nylon_use_is_at_most_one_by_construction(monkeypatch):
     ref = run_sweep(parse_config(yaml.safe_load(
         open(os.path.join(os.path.dirname(__file__), "data", "reference_cube.yaml")))))
     assert float(ref["nylon_use"].max()) == 1.0
+
+
+def test_a_simulation_over_its_budget_says_its_size_and_how_to_raise_it():
+    from nylonflex.simconfig import parse_sim_config
+
+    raw = {"name": "long", "time": {"duration": "1000 s", "step": "0.01 ms"},
+           "reference": {"kind": "step", "initial": 0, "final": 120, "at": "1 s"}}
+    with pytest.raises(InputError) as info:
+        parse_sim_config(raw)
+    msg = str(info.value)
+    assert "100,000,000" in msg and "GB" in msg and "limits: {samples: N}" in msg
+    assert "\n" not in msg
+    parse_sim_config({**raw, "limits": {"samples": 2e8}})  # raised: accepted
+    for bad in (0, True, float("nan")):
+        with pytest.raises(InputError, match="limits.samples"):
+            parse_sim_config({**raw, "limits": {"samples": bad}})
