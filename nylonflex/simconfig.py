@@ -24,6 +24,7 @@ import numpy as np
 import yaml
 from pydantic import (
     AfterValidator,
+    BeforeValidator,
     Discriminator,
     Field,
     PlainValidator,
@@ -33,8 +34,8 @@ from pydantic import (
     field_validator,
 )
 
-from .config import (DESIGN_RANGES, _pydantic_message, _Strict, check_range, check_run_name,
-                     range_error, read_yaml)
+from .config import (DESIGN_RANGES, _no_bool, _pydantic_message, _Strict, check_range,
+                     check_run_name, range_error, read_yaml)
 from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from .physics.nylon import stroke
 from .physics.thermal import muscle_resistance, steady_temperature
@@ -191,6 +192,12 @@ class ActuatorModel(_Loop):
     name: str | None = None
 
 
+class SimLimits(_Strict):
+    """The budget of one simulation: at most ``samples`` time samples x actuators."""
+
+    samples: Annotated[float, BeforeValidator(_no_bool)] = _MAX_SAMPLES
+
+
 class SimConfigModel(_Loop):
     """The simulation config (``configs/control.yaml``), as typed (not yet in SI)."""
 
@@ -199,6 +206,7 @@ class SimConfigModel(_Loop):
     supply: Supply | None = None
     time: Time | None = None
     actuators: list[ActuatorModel] | None = None
+    limits: SimLimits | None = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -503,9 +511,16 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
     cfg = SimConfig(name=top.name, supply_voltage=voltage, internal_resistance=r_int,
                     duration=duration, step=dt, actuators=specs,
                     gripper=top.actuators is not None, raw=copy.deepcopy(raw))
-    if cfg.n_steps * len(specs) > _MAX_SAMPLES:
-        raise InputError(f"time.step: {cfg.n_steps} samples x {len(specs)} actuators is more "
-                         f"than {_MAX_SAMPLES}; use a longer step or a shorter duration")
+    cap = top.limits.samples if top.limits is not None else _MAX_SAMPLES
+    if not 0 < cap < float("inf"):
+        raise range_error("limits.samples", 0, None, "1", cap, lo_open=True)
+    total = cfg.n_steps * len(specs)
+    if total > cap:
+        raise InputError(
+            f"time.step: {cfg.n_steps:,} samples x {len(specs)} actuators = {total:,} "
+            f"(about {total * 64 / 1e9:.3g} GB of series) is more than the budget of "
+            f"{cap:,.0f}; use a longer step or a shorter duration, or raise the budget with "
+            "the config key 'limits: {samples: N}'")
     for a in specs:
         hot = top_temperature(cfg, a)
         s_top = float(stroke(hot, a.coil_index, a.nylon))

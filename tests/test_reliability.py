@@ -634,3 +634,132 @@ def test_a_tiny_filesystem(tmp_path, small_cfg):
                           env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
     assert proc.returncode == 1, proc.stderr
     assert "Traceback" not in proc.stderr and "--resume" in proc.stderr
+
+
+# --------------------------------------------------------------------------- 4/10. charts, info
+
+def _corrupt_chunk(path, name, index):
+    """Overwrite the stored (compressed) bytes of chunk ``index`` of ``name``."""
+    with h5py.File(path, "r") as f:
+        info = f[name].id.get_chunk_info(index)
+        n = f[name].id.get_num_chunks()
+    with open(path, "r+b") as fh:
+        fh.seek(info.byte_offset)
+        fh.write(b"\xff" * info.size)
+    return n
+
+
+def test_charts_replace_only_what_nylonflex_drew_for_that_cube(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    cube, other = tmp_path / "a" / "cube.h5", tmp_path / "b" / "cube.h5"
+    cube.parent.mkdir()
+    assert sweep(cfg, cube) == 0 and sweep(cfg, other) == 0
+    mine = cube.parent / "fig12b.png"
+    mine.write_bytes(b"my own figure")
+    chart = ["chart", "--figure", "fig12b", "--quiet"]
+    capsys.readouterr()
+    # beside the cube: a user's file is refused before anything is drawn
+    assert main([*chart, str(cube)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "did not write it" in err and "--overwrite" in err
+    assert mine.read_bytes() == b"my own figure"
+    # a folder of its own: drawn, then redrawn (its own earlier chart is replaced)
+    out = tmp_path / "figs"
+    assert main([*chart, str(cube), "--out", str(out)]) == 0
+    assert main([*chart, str(cube), "--out", str(out)]) == 0
+    # another cube's chart there is not replaced, nor one edited since
+    assert main([*chart, str(other), "--out", str(out)]) == 2
+    assert "another cube" in capsys.readouterr().err
+    (out / "fig12b.png").write_bytes(b"edited")
+    assert main([*chart, str(cube), "--out", str(out)]) == 2
+    assert "changed since" in capsys.readouterr().err
+    assert (out / "fig12b.png").read_bytes() == b"edited"
+    assert main([*chart, str(other), "--out", str(out), "--overwrite"]) == 0
+    assert (out / "fig12b.png").read_bytes()[:4] == b"\x89PNG"
+    # the sweep's own charts beside its cube: the user's file is skipped with one line
+    with_charts = write_config(tmp_path, {**raw, "charts": ["fig12b", "fig12c"]}, "c.yaml")
+    capsys.readouterr()
+    assert main(["sweep", str(with_charts), "--out", str(cube), "--quiet",
+                 "--overwrite"]) == 0
+    cap = capsys.readouterr()
+    assert mine.read_bytes() == b"my own figure"
+    assert "fig12b.png" in cap.err and "not replaced" in cap.err
+    assert (cube.parent / "fig12c.png").exists()
+
+
+def test_a_huge_name_attribute_does_not_hang_chart_or_info(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    cube = tmp_path / "cube.h5"
+    assert sweep(cfg, cube) == 0
+    with h5py.File(cube, "a") as f:
+        f.attrs["name"] = "n" * 10_000_000
+    capsys.readouterr()
+    assert main(["chart", str(cube), "--figure", "fig12b", "--quiet"]) == 0
+    assert (tmp_path / "fig12b.png").exists()
+    assert main(["info", str(cube)]) == 0
+    assert max(len(line) for line in capsys.readouterr().out.splitlines()) < 400
+
+
+def test_info_does_not_call_a_cube_with_a_corrupt_chunk_complete(tmp_path, whole, capsys):
+    source = whole.encoding["source"]
+    first, last = tmp_path / "first.h5", tmp_path / "last.h5"
+    shutil.copy(source, first)
+    shutil.copy(source, last)
+    _corrupt_chunk(first, "tip_force_max", 0)
+    with h5py.File(last, "r") as f:
+        n = f["bend_angle_max"].id.get_num_chunks()
+    assert n > 2
+    _corrupt_chunk(last, "bend_angle_max", n - 1)
+    _corrupt_chunk(last, "bend_angle_max", n - 2)
+    # plain info reads one chunk of each variable: the first chunk's damage shows
+    assert main(["info", str(first)]) == 1
+    out = capsys.readouterr().out
+    assert "DAMAGED" in out and "complete (" not in out and "tip_force_max" in out
+    # a later chunk needs --check: one line for each unreadable chunk, exit 1
+    assert main(["info", str(last)]) == 0
+    assert "complete (" in capsys.readouterr().out
+    assert main(["info", str(last), "--check"]) == 1
+    cap = capsys.readouterr()
+    bad = [line for line in cap.err.splitlines() if "cannot be read" in line]
+    assert len(bad) == 2 and all("bend_angle_max" in line for line in bad)
+    assert "Traceback" not in cap.err
+    assert main(["info", source, "--check"]) == 0
+    assert "every chunk" in capsys.readouterr().out
+
+
+def test_nylon_use_is_at_most_one_by_construction(monkeypatch):
+    """Even for a muscle far weaker than the accepted range (checks bypassed), in the
+    reference loop and in the compiled kernels; it was 1 + 1e-8 (and 1 + 6e-15 on the
+    reference cube's strength-limited designs)."""
+    import nylonflex as nf
+    import nylonflex.materials as materials
+    from nylonflex.physics.limits import design_limits
+
+    monkeypatch.setitem(materials.NYLON_RANGES, "tensile_strength_table",
+                        (1e-300, 1e300, "Pa"))
+    radius = np.linspace(4e-3, 25e-3, 23)
+    for table in ([1.0] * 4, [1e3] * 4, [2e8] * 4):
+        nylon = {"set": "silver_nylon66", "tensile_strength_table": table}
+        slow = design_limits(radius, 2e-3, 70e-3, 1.3, 0.14, nylon=nylon)
+        fast = nf.evaluate(radius, 2e-3, 70e-3, 1.3, 0.14, nylon=nylon)
+        for use in (slow["nylon_use"], fast["nylon_use"]):
+            assert np.all(np.isfinite(use)) and np.max(use) <= 1.0, table
+    ref = run_sweep(parse_config(yaml.safe_load(
+        open(os.path.join(os.path.dirname(__file__), "data", "reference_cube.yaml")))))
+    assert float(ref["nylon_use"].max()) == 1.0
+
+
+def test_a_simulation_over_its_budget_says_its_size_and_how_to_raise_it():
+    from nylonflex.simconfig import parse_sim_config
+
+    raw = {"name": "long", "time": {"duration": "1000 s", "step": "0.01 ms"},
+           "reference": {"kind": "step", "initial": 0, "final": 120, "at": "1 s"}}
+    with pytest.raises(InputError) as info:
+        parse_sim_config(raw)
+    msg = str(info.value)
+    assert "100,000,000" in msg and "GB" in msg and "limits: {samples: N}" in msg
+    assert "\n" not in msg
+    parse_sim_config({**raw, "limits": {"samples": 2e8}})  # raised: accepted
+    for bad in (0, True, float("nan")):
+        with pytest.raises(InputError, match="limits.samples"):
+            parse_sim_config({**raw, "limits": {"samples": bad}})

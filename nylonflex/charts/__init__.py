@@ -123,8 +123,33 @@ def _slice_kwargs(func, chosen):
     return kw
 
 
+def _short_attrs(ds, limit=80):
+    """``ds`` with every string attribute cut to ``limit`` characters (a shallow copy): a
+    title or footer never lays out a huge attribute (a 10 MB ``name`` hung the chart)."""
+    attrs = {k: (v if not isinstance(v, str) or len(v) <= limit else v[:limit] + "...")
+             for k, v in ds.attrs.items()}
+    if all(attrs[k] is v for k, v in ds.attrs.items()):
+        return ds
+    ds = ds.copy(deep=False)
+    ds.attrs = attrs
+    return ds
+
+
+def chart_owner(ds) -> str:
+    """Who draws charts of ``ds`` [-]: the cube's resolved path, or its name without one."""
+    source = ds.encoding.get("source")
+    if source:
+        return str(Path(source).resolve())
+    return f"cube named {str(ds.attrs.get('name', '?'))[:200]}"
+
+
+def _chart_file(name, model, fmt) -> str:
+    return f"{name}.{fmt}" if model is None else f"{name}_{model}.{fmt}"
+
+
 def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_index=None,
-                progress=None, variable=None) -> list[Path]:
+                progress=None, variable=None, overwrite=False,
+                refuse_foreign=True) -> list[Path]:
     """Draw the named charts of a cube into ``<out_dir>/<name>.<fmt>``.
 
     Parameters
@@ -149,6 +174,12 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         Called as ``progress(done, total)`` [charts] after each chart.
     variable : str, optional
         The variable ``compare`` draws (default ``tip_force_max``).
+    overwrite : bool
+        Replace files nylonflex did not write for this cube [-] (a manifest in the folder,
+        :class:`nylonflex.files.OwnedFiles`, records the charts each cube drew).
+    refuse_foreign : bool
+        With such a file in the way and no ``overwrite``: raise before drawing anything
+        (True) or leave that chart undrawn with a line to ``on_skip`` (False) [-].
 
     Returns
     -------
@@ -158,7 +189,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     Raises
     ------
     InputError
-        An unknown chart name or format.
+        An unknown chart name or format, or (``refuse_foreign``) a file in the way that
+        nylonflex did not write for this cube.
     """
     if not names:  # every chart the cube can show (feasibility only with requirements)
         names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
@@ -178,18 +210,41 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
             raise InputError(f"--variable: compare draws one of {', '.join(comparable(ds))}; "
                              f"got {variable!r}")
         chosen["variable"] = variable
-    plt = _plt()
+    from ..files import OwnedFiles
+
+    owner = chart_owner(ds)
+    ds = _short_attrs(ds)
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
     models = [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
     jobs = [(name, m) for name in names
             for m in (models if name not in ALL_MODELS else [None])]
+    owned = OwnedFiles(out_dir, owner)
+    targets = [out_dir / _chart_file(n, m, fmt) for n, m in jobs]
+    blocked = {} if overwrite else {p: why for p in targets if (why := owned.foreign(p))}
+    if blocked and refuse_foreign:
+        first = next(iter(blocked.values()))
+        more = f" (and {len(blocked) - 1} more)" if len(blocked) > 1 else ""
+        raise InputError(f"--out: {first}{more}; not replaced: give another folder or "
+                         "--overwrite")
+    plt = _plt()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
     for done, (name, model) in enumerate(jobs, 1):
         if progress is not None and done > 1:
             progress(done - 1, len(jobs))
         reason = _unmet(ds, name)
         if reason:
+            if on_skip is None:
+                import warnings
+
+                warnings.warn(reason, stacklevel=2)
+            else:
+                on_skip(reason)
+            continue
+        path = out_dir / _chart_file(name, model, fmt)
+        if path in blocked:
+            reason = f"{blocked[path]}; not replaced (draw it with 'nylonflex chart CUBE " \
+                     "--overwrite')"
             if on_skip is None:
                 import warnings
 
@@ -204,7 +259,6 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
             if model is not None:
                 fig.text(0.99, 0.995, f"model: {model}", ha="right", va="top",
                          fontsize="small", weight="bold")
-            path = out_dir / (f"{name}.{fmt}" if model is None else f"{name}_{model}.{fmt}")
             # fixed metadata so that the same cube gives byte-stable PDF/SVG files
             meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
                     "svg": {"Date": None}}[fmt]
@@ -212,6 +266,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
                         pad_inches=0.08)
             plt.close(fig)
         written.append(path)
+        owned.record([path])
     if progress is not None:
         progress(len(jobs), len(jobs))
     return written

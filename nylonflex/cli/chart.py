@@ -27,6 +27,8 @@ def add_arguments(c):
     c.add_argument("--out", help="folder for the images (default: beside the cube)")
     c.add_argument("--format", choices=["png", "pdf", "svg"], default="png",
                    help="image format: png, pdf or svg")
+    c.add_argument("--overwrite", action="store_true",
+                   help="replace image files nylonflex did not draw from this cube")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -56,7 +58,8 @@ def run(args) -> int:
         skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
         with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
             paths = draw_charts(ds, args.figure, out, args.format, on_skip=skip, at=at,
-                                coil_index=coils, progress=bar, variable=args.variable)
+                               coil_index=coils, progress=bar, variable=args.variable,
+                               overwrite=args.overwrite)
         for path in paths:
             print(path)
     finally:

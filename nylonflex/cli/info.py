@@ -2,16 +2,33 @@
 
 from __future__ import annotations
 
+import sys
+
 HELP = "describe a cube"
 
 
 def add_arguments(i):
     i.add_argument("cube")
+    i.add_argument("--check", action="store_true",
+                   help="read every chunk of every variable (bounded memory) and list the "
+                        "unreadable ones; exit 1 if any")
 
 
 def run(args) -> int:
-    from ..storage import cube_summary
+    from ..storage import check_cube, cube_summary
 
-    for line in cube_summary(args.cube):
+    lines = cube_summary(args.cube)
+    for line in lines:
         print(line)
-    return 0
+    damaged = any(line.startswith("damaged ") for line in lines)
+    if args.check:
+        from ._common import progress_bar
+
+        with progress_bar("check", unit="variable") as bar:
+            problems = check_cube(args.cube, full=True, progress=bar)
+        for line in problems:
+            print(f"nylonflex info: {line}", file=sys.stderr)
+        print(f"check     {len(problems)} unreadable chunk{'s' if len(problems) != 1 else ''}"
+              if problems else "check     every chunk of every variable read")
+        damaged = damaged or bool(problems)
+    return 1 if damaged else 0

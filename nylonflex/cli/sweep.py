@@ -63,8 +63,9 @@ def run(args) -> int:
 
         skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
         with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
+            # beside the cube: only this cube's earlier charts are replaced, others skipped
             paths = draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip,
-                                progress=bar)
+                                progress=bar, refuse_foreign=False)
         for path in paths:
             print(path)
     ds.close()

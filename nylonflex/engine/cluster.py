@@ -38,7 +38,8 @@ CONNECT_TIMEOUT = 5.0
 #: Seconds to wait for the first worker to join a scheduler that has none.
 WORKER_WAIT = 60.0
 #: Seconds without a finished slab, while no worker is alive, before a run gives up
-#: (``DaskExecutor(stall=...)``); the journal keeps what was done for --resume.
+#: (``DaskExecutor(stall=...)``, or the environment variable ``NYLONFLEX_DASK_STALL``);
+#: the journal keeps what was done for --resume.
 STALL_TIMEOUT = 60.0
 #: Slabs submitted per worker thread at a time: one computing, one queued behind it.
 IN_FLIGHT_PER_THREAD = 2
@@ -107,6 +108,45 @@ def _connect(client_class, address, timeout):
     return box["client"]
 
 
+def _quiet_dask_logs() -> dict:
+    """Silence dask.distributed's loggers below CRITICAL (a lost scheduler makes them log
+    reconnect tracebacks); returns the levels to restore with :func:`_restore_logs`."""
+    import logging
+
+    names = ["distributed", *(n for n in logging.root.manager.loggerDict
+                              if n.startswith("distributed."))]
+    saved = {}
+    for name in names:
+        log = logging.getLogger(name)
+        saved[name] = log.level
+        log.setLevel(logging.CRITICAL)
+    return saved
+
+
+def _restore_logs(saved: dict):
+    import logging
+
+    for name, level in saved.items():
+        logging.getLogger(name).setLevel(level)
+
+
+def _stall_seconds() -> float:
+    """The stall timeout [s]: ``NYLONFLEX_DASK_STALL`` if set, else :data:`STALL_TIMEOUT`."""
+    import os
+
+    text = os.environ.get("NYLONFLEX_DASK_STALL", "").strip()
+    if not text:
+        return STALL_TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < 1e7:
+        raise InputError(f"NYLONFLEX_DASK_STALL: expected seconds in (0, 1e7), got "
+                         f"{text[:40]!r}")
+    return value
+
+
 def _slab_task(cfg, i0: int, i1: int, expected: dict) -> dict:
     """Runs on a worker: one slab with the serial kernel (one level of parallelism)."""
     bad = _mismatch(expected, _versions())
@@ -130,9 +170,9 @@ class DaskExecutor:
         Seconds to wait for the scheduler to answer [s].
     worker_wait : float
         Seconds to wait for at least one worker to join [s].
-    stall : float
+    stall : float, optional
         Seconds without a finished slab while no worker is alive before the run stops with
-        a RuntimeError (resumable) [s].
+        a RuntimeError (resumable) [s]; default ``NYLONFLEX_DASK_STALL`` or 60.
 
     Raises
     ------
@@ -144,9 +184,9 @@ class DaskExecutor:
     """
 
     def __init__(self, address, *, timeout: float = CONNECT_TIMEOUT,
-                 worker_wait: float = WORKER_WAIT, stall: float = STALL_TIMEOUT):
+                 worker_wait: float = WORKER_WAIT, stall: float | None = None):
         self.address = _normalise_address(address)
-        self.stall = stall
+        self.stall = _stall_seconds() if stall is None else float(stall)
         try:
             from distributed import Client
         except ImportError:
@@ -159,6 +199,7 @@ class DaskExecutor:
                              f"within {timeout:g} s ({type(exc).__name__}); start one with "
                              "'dask scheduler' (its default port is 8786; 8787 is the "
                              "dashboard)") from None
+        self._quiet = _quiet_dask_logs()  # its reconnect tracebacks on scheduler loss
         self._pending: set = set()
         self._used: set[str] = set()
         self._fetcher = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-fetch")
@@ -166,6 +207,7 @@ class DaskExecutor:
             self._check_workers(worker_wait)
         except BaseException:
             self.client.close()
+            _restore_logs(self._quiet)
             raise
 
     def _check_workers(self, worker_wait):
@@ -233,7 +275,10 @@ class DaskExecutor:
                 pass
 
         def finish(fut, fetch):
-            arrays = fetch.result()
+            try:
+                arrays = fetch.result()
+            except Exception as exc:  # noqa: BLE001 - a lost scheduler is one line
+                raise self._lost(exc) from None
             self._used.update(self._who_ran(fut))
             self._pending.discard(fut)
             fut.release()
@@ -275,6 +320,22 @@ class DaskExecutor:
                     f"{self.address}; the finished slabs are journaled: start workers (or "
                     "the scheduler) and run again with --resume")
 
+    def _lost(self, exc):
+        """The error to raise for ``exc`` from a slab: the scheduler's loss in one line
+        with what to do, anything else (a worker's error) as it is."""
+        import asyncio
+
+        gone = self.client.status not in ("running", "connecting") or isinstance(
+            exc, (asyncio.CancelledError, OSError, TimeoutError)) or \
+            "scheduler-connection-lost" in str(exc) or "CommClosed" in type(exc).__name__
+        if not gone and type(exc).__name__ not in ("FuturesCancelledError",
+                                                   "CancelledError"):
+            return exc
+        return RuntimeError(
+            f"lost the Dask scheduler at {self.address} ({type(exc).__name__}); the "
+            "finished slabs are journaled: start the scheduler and workers and run again "
+            "with --resume")
+
     def _who_ran(self, fut) -> set[str]:
         # the worker that holds the result ran the task (results are not replicated)
         try:
@@ -288,9 +349,15 @@ class DaskExecutor:
         if client is None:
             return
         try:
-            if self._pending:
+            if self._pending and client.status == "running":
                 client.cancel(list(self._pending), force=True)
             self._pending.clear()
+        except Exception:  # noqa: BLE001 - the scheduler is gone: nothing to cancel
+            pass
         finally:
-            client.close()
+            try:
+                client.close(timeout=5)
+            except Exception:  # noqa: BLE001
+                pass
             self._fetcher.shutdown(wait=False, cancel_futures=True)
+            _restore_logs(getattr(self, "_quiet", {}))

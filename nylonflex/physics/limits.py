@@ -361,10 +361,18 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
 
 @formula
 def _design_values(s, limit, p, moment, kappa, force, kappa_full, force_limit, length):
-    """The nine design variables (order of DESIGN_VARIABLES) of a design of length L [m]."""
+    """The nine design variables (order of DESIGN_VARIABLES) of a design of length L [m].
+
+    ``nylon_use`` F_n(s*)/F_lim is at most 1 by construction: s* is either a stroke where
+    F_n <= F_lim or the root of F_n = F_lim, whose solver stops within a relative stroke
+    tolerance, so the ratio is clipped to 1 (it came out 1 + 6e-15, or 1 + 1e-8 for a
+    very weak muscle).
+    """
     fraction = 1.0 if limit == 0 else kappa / kappa_full
-    return (s, limit, p, moment, moment / length, kappa * length, fraction, force,
-            force / force_limit)
+    use = force / force_limit
+    if use > 1.0:
+        use = 1.0
+    return (s, limit, p, moment, moment / length, kappa * length, fraction, force, use)
 
 
 def _inputs(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness, ny):

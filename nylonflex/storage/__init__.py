@@ -9,8 +9,8 @@
 from ..engine.provenance import CUBE_FORMAT, VOLATILE_ATTRS
 from .cube import CubeFile
 from .journal import Journal, exclusive
-from .reader import cube_attrs, cube_summary, open_cube
+from .reader import check_cube, cube_attrs, cube_summary, open_cube
 from .run import CubeSink, DiskFull, Interrupted, sweep_to_file
 
 __all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "CubeFile", "CubeSink", "DiskFull", "Interrupted", "Journal",
-           "cube_attrs", "cube_summary", "exclusive", "open_cube", "sweep_to_file"]
+           "check_cube", "cube_attrs", "cube_summary", "exclusive", "open_cube", "sweep_to_file"]
