@@ -133,6 +133,12 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, mu, alpha,
                     _curvature_guess(p_full, pressure, kappa_curve, n_curve), NEWTON_RTOL,
                     False)
+                # the working temperatures of a stroke-limited design (s* = s_max) depend
+                # on the coil index only: once per C, not per wrap angle
+                temps_full = _working_temperatures(model, s_max, t_max, scale, t_amb, t_max,
+                                                   gamma, beta, t_g, sigma_g)
+            else:
+                temps_full = (0.0, 0.0, 0.0)
             for ip in range(npsi):
                 pitch = _pitch(a, t, b, wrap[ip], coil_width[ic])
                 lever = pitch / math.cos(wrap[ip])
@@ -141,8 +147,11 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                                              alpha, y_nodes, wy_nodes, wyy_nodes, p_atm,
                                              pressure, kappa_curve, n_curve)
                     closes = False
-                    temps = _working_temperatures(model, st[0], t_max, scale, t_amb, t_max,
-                                                  gamma, beta, t_g, sigma_g)
+                    if st[1] == 0:
+                        temps = temps_full
+                    else:
+                        temps = _working_temperatures(model, st[0], t_max, scale, t_amb,
+                                                      t_max, gamma, beta, t_g, sigma_g)
                 else:
                     st = (0.0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)
                     closes = False
