@@ -229,7 +229,7 @@ def test_sort_refusals(ds):
 def test_slabs_give_the_same_answer(ds, monkeypatch):
     whole = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use",
                              limit=7)
-    monkeypatch.setattr(query, "_SLAB_VALUES", 50)  # one radius per slab
+    monkeypatch.setattr(query.scan, "_SLAB_VALUES", 50)  # one radius per slab
     cut = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use", limit=7)
     for name in query.COLUMNS:
         np.testing.assert_array_equal(whole.data[name], cut.data[name])
