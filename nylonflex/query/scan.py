@@ -126,6 +126,69 @@ def _slab_rows(ds, at_loc, r0, r1):
     return rows
 
 
+def _where_rows(ds, at_loc, r0, r1, conditions):
+    """The rows of radius indices [r0, r1) that meet every condition (``--at`` on the grid).
+
+    The conditions are tested one variable at a time (axes first: they cost no read), each
+    variable read only over the box (an index range per axis) that still holds matching
+    designs after the ones before; the slab is left as soon as nothing matches. The other
+    columns are then read over the final box only, and the matching rows picked from it, in
+    grid order, as :func:`_slab_rows` gives them.
+    """
+    fixed = {name: loc[0] for name, loc in at_loc.items() if name != "radius"}
+    dims = [d for d in AXES if d not in fixed]
+    start = {d: (r0 if d == "radius" else 0) for d in dims}
+    box = {d: (0, (r1 - r0) if d == "radius" else ds.sizes[d]) for d in dims}
+    coords = {d: ds[d].values.astype(float)[start[d]:start[d] + box[d][1]] for d in dims}
+
+    def sel(b):
+        index = dict(fixed)
+        index.update({d: slice(start[d] + b[d][0], start[d] + b[d][1]) for d in dims})
+        return index
+
+    def axis_values(name, b):
+        if name in fixed:
+            return np.full([b[d][1] - b[d][0] for d in dims], at_value(at_loc, name, ds))
+        shape = [-1 if d == name else 1 for d in dims]
+        values = coords[name][b[name][0]:b[name][1]].reshape(shape)
+        return np.broadcast_to(values, [b[d][1] - b[d][0] for d in dims])
+
+    def read(name, b):
+        if name not in ds:  # heating_time: only with a supply
+            return np.full([b[d][1] - b[d][0] for d in dims], np.nan)
+        return np.asarray(ds[name].isel(sel(b)).transpose(*dims).values, dtype=float)
+
+    read_at = {}  # name: (values, the box they were read over)
+    mask = None
+    for c in sorted(conditions, key=lambda c: c.name not in AXES):
+        if c.name in AXES:
+            x = axis_values(c.name, box)
+        else:
+            x = read(c.name, box)
+            read_at[c.name] = (x, dict(box))
+        m = c.mask(x)
+        mask = m if mask is None else mask & m
+        if not mask.any():
+            return {name: np.empty(0) for name in COLUMNS + tuple(n for n in OPTIONAL
+                                                                   if n in ds)}
+        # shrink the box to the matches' bounding box before the next read
+        cut = {}
+        for j, d in enumerate(dims):
+            hit = np.flatnonzero(mask.any(axis=tuple(k for k in range(len(dims)) if k != j)))
+            cut[d] = (int(hit[0]), int(hit[-1]) + 1)
+        mask = mask[tuple(slice(*cut[d]) for d in dims)]
+        box = {d: (box[d][0] + cut[d][0], box[d][0] + cut[d][1]) for d in dims}
+    rows = {name: axis_values(name, box)[mask] for name in AXES}
+    for name in (*DESIGN, *(n for n in OPTIONAL if n in ds)):
+        if name in read_at:
+            x, b = read_at[name]
+            x = x[tuple(slice(box[d][0] - b[d][0], box[d][1] - b[d][0]) for d in dims)]
+        else:
+            x = read(name, box)
+        rows[name] = x[mask]
+    return rows
+
+
 def at_value(at_loc, name, ds):
     """SI value of an ``--at`` axis after location (the grid value on a grid point)."""
     i0, i1, w, on_grid = at_loc[name]
@@ -253,8 +316,12 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             if progress is not None:
                 progress(k + 1, len(slabs))
             continue  # an incomplete cube: nothing computed here
-        rows = _exact_rows(ds, at, at_loc, r0, r1, settings) if exact else \
-            _slab_rows(ds, at_loc, r0, r1)
+        if exact:
+            rows = _exact_rows(ds, at, at_loc, r0, r1, settings)
+        elif conditions and not off_grid:
+            rows = _where_rows(ds, at_loc, r0, r1, conditions)
+        else:
+            rows = _slab_rows(ds, at_loc, r0, r1)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
