@@ -101,12 +101,16 @@ def _curvature(moment, y, wy, wyy, mu, alpha, guess):
 
 
 def _guess(p, pressures, kappas):
-    """Quadratic interpolation of kappa/p through solved curve points (rows), else 0."""
+    """kappa/p through solved curve points (rows) as the kernel's start, else 0."""
     pos = pressures > 0.0
-    if pos.sum() < 3:
-        return np.zeros(p.shape)
     pp = pressures[pos]
     q = kappas[:, pos] / pp
+    if pp.size == 0:
+        return np.zeros(p.shape)
+    if pp.size < 3:
+        qq = q[:, 0] if pp.size == 1 else \
+            q[:, 0] + (q[:, 1] - q[:, 0]) * (p - pp[0]) / (pp[1] - pp[0])
+        return np.where(qq > 0.0, qq * p, 0.0)
     j = np.clip(np.searchsorted(pp, p), 1, pp.size - 2) - 1
     rows = np.arange(p.shape[0])
     p0, p1, p2 = pp[j], pp[j + 1], pp[j + 2]

@@ -233,13 +233,22 @@ def _curvature_guess(pressure, pressures, kappas, n):
     Quadratic interpolation (or extrapolation past the last point) in p of kappa(p) / p
     through the three nearest solved points with p > 0, which are sorted and increasing;
     kappa / p is smooth and nearly constant, so the start is close to the root and Newton
-    needs one or two steps. 0 (the linear start) when fewer than three points are there.
+    needs one or two steps. With one or two such points, kappa / p constant or linear
+    through them; 0 (the linear start) with none.
     """
     j0 = 0
     while j0 < n and pressures[j0] <= 0.0:
         j0 += 1
-    if n - j0 < 3 or pressure <= 0.0:
+    if n - j0 < 1 or pressure <= 0.0:
         return 0.0
+    if n - j0 < 3:
+        q0 = kappas[j0] / pressures[j0]
+        q = q0
+        if n - j0 == 2:
+            q1 = kappas[j0 + 1] / pressures[j0 + 1]
+            q = q0 + (q1 - q0) * (pressure - pressures[j0]) / (pressures[j0 + 1]
+                                                               - pressures[j0])
+        return q * pressure if q > 0.0 else 0.0
     j = j0
     while j < n - 1 and pressures[j] < pressure:
         j += 1
