@@ -388,3 +388,7 @@ def test_where_reads_variable_by_variable_and_finds_what_a_full_read_finds(ds, a
     assert (res.matched > 0) == ("1e9" not in where[0])
     for name in query.COLUMNS:
         np.testing.assert_array_equal(res.data[name], full[name][keep], err_msg=name)
+    few = query.query_cube(ds, at=at, where=where, limit=3)  # the rest only for kept rows
+    assert few.matched == res.matched
+    for name in query.COLUMNS:
+        np.testing.assert_array_equal(few.data[name], full[name][keep][:3], err_msg=name)

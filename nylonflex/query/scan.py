@@ -126,14 +126,16 @@ def _slab_rows(ds, at_loc, r0, r1):
     return rows
 
 
-def _where_rows(ds, at_loc, r0, r1, conditions):
-    """The rows of radius indices [r0, r1) that meet every condition (``--at`` on the grid).
+def _where_rows(ds, at_loc, r0, r1, conditions, room=None):
+    """The rows of radius indices [r0, r1) that meet every condition (``--at`` on the grid),
+    at most ``room`` of them (the first in grid order; None: all), and how many matched.
 
     The conditions are tested one variable at a time (axes first: they cost no read), each
     variable read only over the box (an index range per axis) that still holds matching
     designs after the ones before; the slab is left as soon as nothing matches. The other
-    columns are then read over the final box only, and the matching rows picked from it, in
-    grid order, as :func:`_slab_rows` gives them.
+    columns are then read over the final box of the rows kept only (none once ``--limit``
+    rows are kept: the scan then reads the tested variables alone), and the matching rows
+    picked from it, in grid order, as :func:`_slab_rows` gives them.
     """
     fixed = {name: loc[0] for name, loc in at_loc.items() if name != "radius"}
     dims = [d for d in AXES if d not in fixed]
@@ -158,6 +160,16 @@ def _where_rows(ds, at_loc, r0, r1, conditions):
             return np.full([b[d][1] - b[d][0] for d in dims], np.nan)
         return np.asarray(ds[name].isel(sel(b)).transpose(*dims).values, dtype=float)
 
+    def shrink(mask, box):
+        """The matches' bounding box, and the mask cut to it."""
+        cut = {}
+        for j, d in enumerate(dims):
+            hit = np.flatnonzero(mask.any(axis=tuple(k for k in range(len(dims)) if k != j)))
+            cut[d] = (int(hit[0]), int(hit[-1]) + 1)
+        return (mask[tuple(slice(*cut[d]) for d in dims)],
+                {d: (box[d][0] + cut[d][0], box[d][0] + cut[d][1]) for d in dims})
+
+    empty = {name: np.empty(0) for name in COLUMNS + tuple(n for n in OPTIONAL if n in ds)}
     read_at = {}  # name: (values, the box they were read over)
     mask = None
     for c in sorted(conditions, key=lambda c: c.name not in AXES):
@@ -169,15 +181,16 @@ def _where_rows(ds, at_loc, r0, r1, conditions):
         m = c.mask(x)
         mask = m if mask is None else mask & m
         if not mask.any():
-            return {name: np.empty(0) for name in COLUMNS + tuple(n for n in OPTIONAL
-                                                                   if n in ds)}
-        # shrink the box to the matches' bounding box before the next read
-        cut = {}
-        for j, d in enumerate(dims):
-            hit = np.flatnonzero(mask.any(axis=tuple(k for k in range(len(dims)) if k != j)))
-            cut[d] = (int(hit[0]), int(hit[-1]) + 1)
-        mask = mask[tuple(slice(*cut[d]) for d in dims)]
-        box = {d: (box[d][0] + cut[d][0], box[d][0] + cut[d][1]) for d in dims}
+            return empty, 0
+        mask, box = shrink(mask, box)  # before the next read
+    matched = int(mask.sum())
+    if room is not None:
+        if room <= 0:
+            return empty, matched
+        first = np.flatnonzero(mask.ravel())[:room]
+        mask = np.zeros(mask.shape, dtype=bool)
+        mask.ravel()[first] = True
+        mask, box = shrink(mask, box)
     rows = {name: axis_values(name, box)[mask] for name in AXES}
     for name in (*DESIGN, *(n for n in OPTIONAL if n in ds)):
         if name in read_at:
@@ -186,7 +199,7 @@ def _where_rows(ds, at_loc, r0, r1, conditions):
         else:
             x = read(name, box)
         rows[name] = x[mask]
-    return rows
+    return rows, matched
 
 
 def at_value(at_loc, name, ds):
@@ -316,10 +329,13 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             if progress is not None:
                 progress(k + 1, len(slabs))
             continue  # an incomplete cube: nothing computed here
+        room = None if limit is None or sort_name is not None else \
+            limit - len(kept[COLUMNS[0]])
+        n_where = None
         if exact:
             rows = _exact_rows(ds, at, at_loc, r0, r1, settings)
         elif conditions and not off_grid:
-            rows = _where_rows(ds, at_loc, r0, r1, conditions)
+            rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
         else:
             rows = _slab_rows(ds, at_loc, r0, r1)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
@@ -327,10 +343,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             mask &= c.mask(rows[c.name])
         if not conditions and done is not None and "radius" not in at_loc:
             mask &= ~np.isnan(rows["tip_force_max"])  # skip masked, uncomputed radii
-        n = int(mask.sum())
+        n = int(mask.sum()) if n_where is None else n_where
         matched += n
-        room = None if limit is None or sort_name is not None else \
-            limit - len(kept[COLUMNS[0]])
         if room is None or room > 0:
             kept = {name: np.concatenate([kept[name], rows[name][mask][:room]])
                     for name in columns}
