@@ -1,7 +1,8 @@
 """``nylonflex bench``: the kernels against the scipy reference, side by side in one run.
 
 Timings on shared machines are noisy, so the figures that matter are the ratios measured in
-the same process: the per-design speed-up over the adaptive-quadrature reference.
+the same process: the per-design speed-up over the adaptive-quadrature reference, and the kernel's speed-up
+over a plain NumPy implementation of the same structure (:mod:`nylonflex.bench_numpy`).
 """
 
 from __future__ import annotations
@@ -155,6 +156,21 @@ def _solve_count(ds) -> int:
     return na * nt * (ds.sizes["pressure"] + nc) + strength
 
 
+def _numpy_yardstick(cfg) -> tuple[float, float]:
+    """Seconds of the NumPy yardstick (:mod:`nylonflex.bench_numpy`) on ``cfg``'s whole grid
+    and of the threaded kernel on the same grid in one slab, back to back (after the
+    sweep, so that its memory does not count in the sweep's peak)."""
+    from .bench_numpy import grid_numpy
+    from .engine.grid import compute_slab
+
+    t0 = time.perf_counter()
+    grid_numpy(cfg)
+    t_numpy = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    compute_slab(cfg, 0, cfg.shape[0])
+    return t_numpy, time.perf_counter() - t0
+
+
 def run_bench(quick: bool = False, log=None) -> dict:
     """Time compile, kernels, the end-to-end sweep and the reference.
 
@@ -189,6 +205,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         size_mb = (Path(tmp) / "cube.h5").stat().st_size / 2**20
         ds.close()
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    t_numpy, t_kernel_whole = _numpy_yardstick(cfg)
 
     rng = np.random.default_rng(12)
     n_ref = sizes["reference_designs"]
@@ -223,6 +240,10 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "pointwise_vs_python_loop": t_loop_py / t_point,
         "closed_loop_s": t_loop,
         "closed_loop_run_s": t_sim,
+        "numpy_s": t_numpy,
+        "numpy_designs_per_s": cfg.n_designs / t_numpy,
+        "kernel_whole_grid_s": t_kernel_whole,
+        "kernel_vs_numpy": t_numpy / t_kernel_whole,
         "peak_rss_mb": peak_mb,
         "cube_mb": size_mb,
         "sampled_s": t_sampled,
@@ -233,6 +254,10 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f" designs/s  {result['angle_solves_per_s']:>10,.0f} angle solves/s")
     say(f"  sweep end to end (+ HDF5)  {t_total:8.2f} s  {result['sweep_designs_per_s']:>12,.0f}"
         f" designs/s  cube {size_mb:.0f} MB")
+    say(f"  NumPy yardstick            {t_numpy:8.2f} s  {result['numpy_designs_per_s']:>12,.0f}"
+        f" designs/s  (same structure vectorised over designs, mechanics only)")
+    say(f"  kernel vs NumPy            {result['kernel_vs_numpy']:>12.1f} x  (kernel "
+        f"{t_kernel_whole:.2f} s on the same grid, same run; nylonflex/bench_numpy.py)")
     say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
     say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
         "same run)")

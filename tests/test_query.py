@@ -229,7 +229,7 @@ def test_sort_refusals(ds):
 def test_slabs_give_the_same_answer(ds, monkeypatch):
     whole = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use",
                              limit=7)
-    monkeypatch.setattr(query, "_SLAB_VALUES", 50)  # one radius per slab
+    monkeypatch.setattr(query.scan, "_SLAB_VALUES", 50)  # one radius per slab
     cut = query.query_cube(ds, where=["tip_force_max >= 0.3 N"], sort="-nylon_use", limit=7)
     for name in query.COLUMNS:
         np.testing.assert_array_equal(whole.data[name], cut.data[name])
@@ -367,3 +367,28 @@ def test_query_progress_callback(ds):
     seen = []
     query.query_cube(ds, progress=lambda done, total: seen.append((done, total)))
     assert seen and seen[-1][0] == seen[-1][1]
+
+
+@pytest.mark.parametrize("at, where", [
+    (None, ["tip_force_max >= 0.3 N", "limit == strength"]),
+    (None, ["wall_thickness <= 3 mm", "nylon_use > 0.5", "bend_angle_max < 200 deg"]),
+    ("coil_index=1.7", ["range_fraction < 1", "radius >= 10 mm"]),
+    (None, ["tip_force_max > 1e9 N"]),  # nothing matches: the scan stops at the first read
+])
+def test_where_reads_variable_by_variable_and_finds_what_a_full_read_finds(ds, at, where):
+    # the reference: every column of every slab read, then all conditions tested
+    at_loc = {n: query.scan._locate(ds, n, v) for n, v in (query.parse_at(at) if at
+                                                            else {}).items()}
+    full = query.scan._slab_rows(ds, at_loc, 0, ds.sizes["radius"])
+    keep = np.ones(len(full["radius"]), dtype=bool)
+    for c in query.parse_where(where):
+        keep &= c.mask(full[c.name])
+    res = query.query_cube(ds, at=at, where=where, limit=None)
+    assert res.matched == int(keep.sum())
+    assert (res.matched > 0) == ("1e9" not in where[0])
+    for name in query.COLUMNS:
+        np.testing.assert_array_equal(res.data[name], full[name][keep], err_msg=name)
+    few = query.query_cube(ds, at=at, where=where, limit=3)  # the rest only for kept rows
+    assert few.matched == res.matched
+    for name in query.COLUMNS:
+        np.testing.assert_array_equal(few.data[name], full[name][keep][:3], err_msg=name)

@@ -4,12 +4,15 @@ Private compiled loops that write into ``out`` arrays and check nothing (numbagg
 :mod:`nylonflex.sweep` validates and shapes. The loops follow the model's structure so that
 nothing is computed twice that a design axis does not change:
 
-- per (a, t): the bend-angle curve over pressure (Newton warm-started along the sorted
-  pressure axis), independent of C, psi and L;
-- per (a, t, C): the curvature at the full stroke p(s_max(C));
+- per (a, t): the section's quadrature node table (heights and weights, no trigonometry),
+  then the bend-angle curve over pressure (Newton started from the quadratic extrapolation
+  of the solves already made along the sorted pressure axis), independent of C, psi and L;
+- per (a, t, C): the curvature at the full stroke p(s_max(C)), started from the solved
+  curve interpolated at p(s_max);
 - per stroke: p(s) and S_theta(s), shared by every design's nylon-force curve;
 - per (a, t, C, psi): the stroke limit and, only for strength-limited designs, one more
-  curvature solve (warm-started from the full-stroke one); the nylon-force curve;
+  curvature solve (started from the solved curve interpolated at p*, else from the
+  full-stroke one); the nylon-force curve;
 - per L: a multiply (theta = kappa L, F = M/L).
 
 :func:`_design_points` evaluates scattered designs (the pointwise evaluator behind
@@ -23,12 +26,13 @@ import math
 import numpy as np
 from numba import prange
 
-from ..physics.bending import NEWTON_RTOL, _curvature, _curvature_of, _pressure_moment
+from ..physics.bending import (NEWTON_RTOL, _curvature_guess, _curvature_nodes,
+                               _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _design_state, _design_values, _model_state,
                               _nylon_force_model, _reach,
-                              _stroke_state, _thermal_values, _validity,
+                              _stroke_state_nodes, _thermal_values, _validity,
                               _working_temperatures)
 from ..physics.nylon import _stroke_shape
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
@@ -93,12 +97,30 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             stroke_hoop[js] = _equibiaxial_stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
         else:
             stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
+    n_nodes = x_base.shape[0] + 2 * w_phi.shape[0]
     for k in prange(na * nt):
         ia = k // nt
         it = k % nt
         a = radius[ia]
         t = wall[it]
         b = t if b_fixed <= 0.0 else b_fixed
+        y_nodes = np.empty(n_nodes)
+        wy_nodes = np.empty(n_nodes)
+        wyy_nodes = np.empty(n_nodes)
+        _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
+        # the bend-angle curve first: its solves start the coil loop's Newton iterations
+        kappa_curve = np.empty(npr)
+        for jp in range(npr):
+            moment = _pressure_moment(pressure[jp], a, b)
+            kappa_curve[jp] = _curvature_nodes(
+                moment, y_nodes, wy_nodes, wyy_nodes, mu, alpha,
+                _curvature_guess(pressure[jp], pressure, kappa_curve, jp), NEWTON_RTOL,
+                cauchy)
+            for il in range(nl):
+                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il]
+                out_tip[ia, it, il, jp] = moment / length[il]
+        # curvature solves of the nominal stress may start from it (not the Cauchy variant's)
+        n_curve = npr if not cauchy else 0
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         for ic in range(nc):
             s_max = coil_s_max[ic]
@@ -106,18 +128,30 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             scale = s_max / top
             kappa_full = 0.0
             if default:
-                kappa_full = _curvature(_pressure_moment(_gauge_pressure(s_max, p_atm), a, b),
-                                        a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi,
-                                        0.0, NEWTON_RTOL)
+                p_full = _gauge_pressure(s_max, p_atm)
+                kappa_full = _curvature_nodes(
+                    _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, mu, alpha,
+                    _curvature_guess(p_full, pressure, kappa_curve, n_curve), NEWTON_RTOL,
+                    False)
+                # the working temperatures of a stroke-limited design (s* = s_max) depend
+                # on the coil index only: once per C, not per wrap angle
+                temps_full = _working_temperatures(model, s_max, t_max, scale, t_amb, t_max,
+                                                   gamma, beta, t_g, sigma_g)
+            else:
+                temps_full = (0.0, 0.0, 0.0)
             for ip in range(npsi):
                 pitch = _pitch(a, t, b, wrap[ip], coil_width[ic])
                 lever = pitch / math.cos(wrap[ip])
                 if default:
-                    st = _stroke_state(a, t, b, lever, f_lim, s_max, kappa_full, mu, alpha,
-                                       x_base, w_base, phi_trig, w_phi, p_atm)
+                    st = _stroke_state_nodes(a, t, b, lever, f_lim, s_max, kappa_full, mu,
+                                             alpha, y_nodes, wy_nodes, wyy_nodes, p_atm,
+                                             pressure, kappa_curve, n_curve)
                     closes = False
-                    temps = _working_temperatures(model, st[0], t_max, scale, t_amb, t_max,
-                                                  gamma, beta, t_g, sigma_g)
+                    if st[1] == 0:
+                        temps = temps_full
+                    else:
+                        temps = _working_temperatures(model, st[0], t_max, scale, t_amb,
+                                                      t_max, gamma, beta, t_g, sigma_g)
                 else:
                     st = (0.0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)
                     closes = False
@@ -165,15 +199,6 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     else:
                         out_force[ia, it, ic, ip, js] = _wrap_force(
                             stroke_pressure[js], stroke_hoop[js], a, t, lever)
-        kappa = 0.0
-        for jp in range(npr):
-            moment = _pressure_moment(pressure[jp], a, b)
-            guess = kappa * pressure[jp] / pressure[jp - 1] if kappa > 0.0 else 0.0
-            kappa = _curvature_of(moment, a, t, b, mu, alpha, x_base, w_base, phi_trig, w_phi,
-                                  guess, NEWTON_RTOL, cauchy)
-            for il in range(nl):
-                out_angle[ia, it, il, jp] = kappa * length[il]
-                out_tip[ia, it, il, jp] = moment / length[il]
 
 
 def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):

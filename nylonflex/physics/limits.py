@@ -14,7 +14,8 @@ import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
 from ._formula import check_input, check_section, check_wrap_angle, formula, scalar_or_array
-from .bending import NEWTON_RTOL, _curvature, _curvature_of, _pressure_moment, quadrature_nodes
+from .bending import (NEWTON_RTOL, _curvature_guess, _curvature_nodes, _curvature_of,
+                      _node_table, _pressure_moment, quadrature_nodes)
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke
@@ -340,11 +341,22 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     ``kappa_full`` is the curvature at p(s_max) (<= 0: computed here). Returns
     (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full).
     """
+    y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                             phi_trig, w_phi)
+    return _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit,
+                               s_max, kappa_full, mu, alpha, y, wy, wyy, p_atm, y, y, 0)
+
+
+@formula
+def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
+                        kappa_full, mu, alpha, y, wy, wyy, p_atm, pressures, kappas, n):
+    """:func:`_stroke_state` on a section's node table, with ``n`` solved points of
+    kappa(p) (``pressures[:n]``, ``kappas[:n]``) to start Newton from (none: ``n`` = 0)."""
     if kappa_full <= 0.0:
-        kappa_full = _curvature(
-            _pressure_moment(_gauge_pressure(s_max, p_atm), radius, base_thickness),
-            radius, wall_thickness, base_thickness, mu, alpha, x_base, w_base, phi_trig, w_phi,
-            0.0, NEWTON_RTOL)
+        p_full = _gauge_pressure(s_max, p_atm)
+        kappa_full = _curvature_nodes(
+            _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, mu, alpha,
+            _curvature_guess(p_full, pressures, kappas, n), NEWTON_RTOL, False)
     s, limit, force = _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu,
                                     alpha, p_atm, STROKE_RTOL)
     p = _gauge_pressure(s, p_atm)
@@ -352,10 +364,12 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     if limit == 0:
         kappa = kappa_full
     else:
-        # p* < p(s_max): start Newton from the full-stroke curvature scaled by the moment
-        kappa = _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha, x_base,
-                           w_base, phi_trig, w_phi,
-                           kappa_full * p / _gauge_pressure(s_max, p_atm), NEWTON_RTOL)
+        # p* < p(s_max): start Newton from the solved curve near p*, or from the full-stroke
+        # curvature scaled by the pressure
+        guess = _curvature_guess(p, pressures, kappas, n)
+        if guess <= 0.0:
+            guess = kappa_full * p / _gauge_pressure(s_max, p_atm)
+        kappa = _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, NEWTON_RTOL, False)
     return s, limit, p, moment, kappa, force, kappa_full
 
 

@@ -1,158 +1,26 @@
-"""``nylonflex query``: ask a saved cube about designs, with units, in bounded memory.
+"""The scan of ``nylonflex query``: a cube read slab by slab, in chunk order.
 
-A query picks designs three ways, which combine:
-
-* ``--at radius=7.5mm,coil_index=1.7``: fixes the named axes. A value on the grid (within a
-  tiny tolerance) is read as is ("grid point"); between grid points the model is evaluated
-  exactly at that design with the cube's own materials and settings from its provenance
-  ("exact model", :func:`nylonflex.evaluate`, milliseconds), or, with ``interpolate=True``
-  (``--interpolate``), the design variables are interpolated linearly in each axis
-  ("interpolated"; up to tens of per cent off where the response bends). Axes not named
-  keep all their grid values, so a partial ``--at`` lists a slice of the cube (one row per
-  design); naming all five axes gives one design. Outside the grid is refused.
-* ``--where "tip_force_max >= 0.5 N"``: conditions on axes or design variables, with units;
-  several are ANDed.
-* ``--sort NAME`` (``--sort=-NAME`` or ``--sort NAME:desc`` descending; ties keep grid
-  order) and ``--limit N``.
-
-The cube is read in slabs of radii, so memory stays bounded on a cube of any size; only the
-matching rows (at most ``--limit``) are kept, and every match is counted, so that the
-output can say how many rows it held back.
+``--where`` is tested one variable at a time (a slab none of whose designs passes is left
+after the first variable that rules it out) and the other columns are read only over the
+box of a slab's matching rows, so a selective query reads little more than the variables
+it tests.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import json
-import math
-import re
-
 import numpy as np
 
-from .units import InputError, from_si, parse_quantity
-from .variables import AXES, DESIGN, MODEL, VARIABLES, to_display
+from ..units import InputError, from_si
+from ..variables import AXES, DESIGN, VARIABLES
+from .parse import (_MODEL_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
+                    _parse_sort, parse_at)
 
-__all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_csv", "format_json", "format_table",
-           "held_back", "parse_at", "parse_where", "query_cube", "rows_note"]
-
-#: Columns of every row: the five axes, then the design variables (registry order).
-COLUMNS = (*AXES, *DESIGN)
-#: Columns a cube has only when its sweep asked for them (``requirements``).
-OPTIONAL = ("feasibility",)
-_FIELDS = ", ".join(COLUMNS + OPTIONAL)
 # Values this close (relative to the axis span) to a grid value are that grid value.
 _GRID_RTOL = 1e-6
 # Slab size when scanning a cube: about this many float64 values per variable.
 _SLAB_VALUES = 2**20
-#: How an ``--at`` design was found: on the grid, by the exact model, interpolated.
-GRID, EXACT, INTERPOLATED = "grid point", "exact model", "interpolated"
-_LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1,
-                "supply": 2, "supply_limited": 2, "load": 3, "load_limited": 3}
 
 
-# ---------------------------------------------------------------------------- parsing
-def _quantity(name, text, field):
-    v = VARIABLES[name]
-    if name == "limit" and str(text).strip().lower() in _LIMIT_WORDS:
-        return float(_LIMIT_WORDS[str(text).strip().lower()])
-    return parse_quantity(text, field, v.kind, v.display)
-
-
-def parse_at(text) -> dict:
-    """Parse ``"radius=7.5mm,wall_thickness=2mm"`` into ``{axis: SI value}``.
-
-    Bare numbers are in the axis's display unit (mm, deg; none for ``coil_index``). A list
-    of such texts (``--at`` given several times) is merged into one design.
-
-    Raises
-    ------
-    InputError
-        Not ``NAME=VALUE``, an unknown axis, an axis given twice (in one text or across
-        several) or a bad value.
-    """
-    texts = [text] if isinstance(text, str) else list(text or ())
-    repeated = len(texts) > 1
-    out = {}
-    for part in [p for t in texts for p in str(t).split(",") if p.strip()]:
-        if "=" not in part:
-            raise InputError(f"--at: expected NAME=VALUE, got {part.strip()!r}; names: "
-                             f"{', '.join(AXES)}")
-        name, value = (s.strip() for s in part.split("=", 1))
-        if name not in AXES:
-            raise InputError(f"--at: unknown axis {name!r}; accepted: {', '.join(AXES)}")
-        if name in out:
-            where = " (across repeated --at options, which are merged into one design)" \
-                if repeated else ""
-            raise InputError(f"--at: {name} given twice{where}; --at picks one design: "
-                             f"give each axis once, or use --where for a range, e.g. "
-                             f"--where \"{name} >= ...\"")
-        out[name] = float(_quantity(name, value, f"--at {name}"))
-    if not out:
-        raise InputError(f"--at: expected NAME=VALUE,...; names: {', '.join(AXES)}")
-    return out
-
-
-class Condition:
-    """One ``--where`` condition: ``name op value`` with ``value`` in SI."""
-
-    _OPS = {"<=": np.less_equal, ">=": np.greater_equal, "<": np.less, ">": np.greater,
-            "==": None, "=": None, "!=": None}
-    _PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
-
-    def __init__(self, text: str):
-        if str(text).strip() == "valid":  # issue 10: clean designs, validity == 0
-            text = "validity == 0"
-        m = self._PATTERN.match(str(text))
-        if not m:
-            raise InputError(f"--where: expected 'NAME OP VALUE [UNIT]' with OP one of "
-                             f"<, <=, ==, !=, >=, >, got {text!r}")
-        self.name, op, value = m.groups()
-        if self.name not in COLUMNS + OPTIONAL:
-            raise InputError(f"--where: unknown name {self.name!r}; accepted: {_FIELDS}")
-        self.op = "==" if op == "=" else op
-        self.value = float(_quantity(self.name, value, f"--where {self.name}"))
-        self.text = str(text).strip()
-
-    def mask(self, x: np.ndarray) -> np.ndarray:
-        """True where ``x`` [SI] meets the condition (NaN never does)."""
-        if self.op in ("==", "!="):
-            # equality to a typed value up to its float noise (7.5 mm, 8 deg, 1)
-            near = np.isclose(x, self.value, rtol=1e-9, atol=1e-12 * max(1.0, abs(self.value)))
-            return near if self.op == "==" else ~near & ~np.isnan(x)
-        return self._OPS[self.op](x, self.value)
-
-    def __repr__(self):
-        return f"Condition({self.text!r})"
-
-
-def parse_where(texts) -> list[Condition]:
-    """Parse ``--where`` strings (ANDed) into :class:`Condition` objects.
-
-    ``model == NAME`` stays a string: :func:`query_cube` selects that model's slice.
-    """
-    return [t if _MODEL_WHERE.match(str(t)) else Condition(t) for t in texts or ()]
-
-
-def _parse_sort(text):
-    if not text:
-        return None, False
-    name = text.strip()
-    descending = name.startswith("-")
-    name = name.lstrip("-+").strip()
-    # "NAME:desc" too: argparse reads "--sort -NAME" as an option (write --sort=-NAME)
-    if ":" in name:
-        name, order = (s.strip() for s in name.split(":", 1))
-        if order not in ("asc", "desc"):
-            raise InputError(f"--sort: order must be 'asc' or 'desc', got {order!r}")
-        descending = order == "desc"
-    if name not in COLUMNS + OPTIONAL:
-        raise InputError(f"--sort: unknown name {name!r}; accepted: {_FIELDS} "
-                         "(prefix '-' for descending)")
-    return name, descending
-
-
-# ---------------------------------------------------------------------------- the grid
 def _locate(ds, name, value):
     """Where ``value`` [SI] sits on axis ``name``: ``(i0, i1, weight of i1, on_grid)``.
 
@@ -265,6 +133,82 @@ def _slab_rows(ds, at_loc, r0, r1):
     return rows
 
 
+def _where_rows(ds, at_loc, r0, r1, conditions, room=None):
+    """The rows of radius indices [r0, r1) that meet every condition (``--at`` on the grid),
+    at most ``room`` of them (the first in grid order; None: all), and how many matched.
+
+    The conditions are tested one variable at a time (axes first: they cost no read), each
+    variable read only over the box (an index range per axis) that still holds matching
+    designs after the ones before; the slab is left as soon as nothing matches. The other
+    columns are then read over the final box of the rows kept only (none once ``--limit``
+    rows are kept: the scan then reads the tested variables alone), and the matching rows
+    picked from it, in grid order, as :func:`_slab_rows` gives them.
+    """
+    fixed = {name: loc[0] for name, loc in at_loc.items() if name != "radius"}
+    dims = [d for d in AXES if d not in fixed]
+    start = {d: (r0 if d == "radius" else 0) for d in dims}
+    box = {d: (0, (r1 - r0) if d == "radius" else ds.sizes[d]) for d in dims}
+    coords = {d: ds[d].values.astype(float)[start[d]:start[d] + box[d][1]] for d in dims}
+
+    def sel(b):
+        index = dict(fixed)
+        index.update({d: slice(start[d] + b[d][0], start[d] + b[d][1]) for d in dims})
+        return index
+
+    def axis_values(name, b):
+        if name in fixed:
+            return np.full([b[d][1] - b[d][0] for d in dims], at_value(at_loc, name, ds))
+        shape = [-1 if d == name else 1 for d in dims]
+        values = coords[name][b[name][0]:b[name][1]].reshape(shape)
+        return np.broadcast_to(values, [b[d][1] - b[d][0] for d in dims])
+
+    def read(name, b):
+        if name not in ds:  # heating_time: only with a supply
+            return np.full([b[d][1] - b[d][0] for d in dims], np.nan)
+        return np.asarray(ds[name].isel(sel(b)).transpose(*dims).values, dtype=float)
+
+    def shrink(mask, box):
+        """The matches' bounding box, and the mask cut to it."""
+        cut = {}
+        for j, d in enumerate(dims):
+            hit = np.flatnonzero(mask.any(axis=tuple(k for k in range(len(dims)) if k != j)))
+            cut[d] = (int(hit[0]), int(hit[-1]) + 1)
+        return (mask[tuple(slice(*cut[d]) for d in dims)],
+                {d: (box[d][0] + cut[d][0], box[d][0] + cut[d][1]) for d in dims})
+
+    empty = {name: np.empty(0) for name in COLUMNS + tuple(n for n in OPTIONAL if n in ds)}
+    read_at = {}  # name: (values, the box they were read over)
+    mask = None
+    for c in sorted(conditions, key=lambda c: c.name not in AXES):
+        if c.name in AXES:
+            x = axis_values(c.name, box)
+        else:
+            x = read(c.name, box)
+            read_at[c.name] = (x, dict(box))
+        m = c.mask(x)
+        mask = m if mask is None else mask & m
+        if not mask.any():
+            return empty, 0
+        mask, box = shrink(mask, box)  # before the next read
+    matched = int(mask.sum())
+    if room is not None:
+        if room <= 0:
+            return empty, matched
+        first = np.flatnonzero(mask.ravel())[:room]
+        mask = np.zeros(mask.shape, dtype=bool)
+        mask.ravel()[first] = True
+        mask, box = shrink(mask, box)
+    rows = {name: axis_values(name, box)[mask] for name in AXES}
+    for name in (*DESIGN, *(n for n in OPTIONAL if n in ds)):
+        if name in read_at:
+            x, b = read_at[name]
+            x = x[tuple(slice(box[d][0] - b[d][0], box[d][1] - b[d][0]) for d in dims)]
+        else:
+            x = read(name, box)
+        rows[name] = x[mask]
+    return rows, matched
+
+
 def at_value(at_loc, name, ds):
     """SI value of an ``--at`` axis after location (the grid value on a grid point)."""
     i0, i1, w, on_grid = at_loc[name]
@@ -279,7 +223,7 @@ def _exact_rows(ds, at, at_loc, r0, r1, settings):
     their grid values; :func:`nylonflex.evaluate` computes every design variable there with
     the cube's materials and settings (``settings``, from its provenance).
     """
-    from .engine.pointwise import evaluate
+    from ..engine.pointwise import evaluate
 
     free = [name for name in AXES if name not in at_loc]
     grids = []
@@ -302,7 +246,7 @@ def _exact_rows(ds, at, at_loc, r0, r1, settings):
 
 
 def _exact_settings(ds):
-    from .engine.provenance import evaluate_settings
+    from ..engine.provenance import evaluate_settings
 
     try:
         settings = evaluate_settings(ds.attrs)
@@ -370,7 +314,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
     if exact and log is not None:
-        from .engine.warmup import warm_up_points
+        from ..engine.warmup import warm_up_points
 
         warm_up_points(settings, notice=log)
 
@@ -396,17 +340,23 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             if progress is not None:
                 progress(k + 1, len(slabs))
             continue  # an incomplete cube: nothing computed here
-        rows = _exact_rows(ds, at, at_loc, r0, r1, settings) if exact else \
-            _slab_rows(ds, at_loc, r0, r1)
+        room = None if limit is None or sort_name is not None else \
+            limit - len(kept[COLUMNS[0]])
+        n_where = None
+        if exact:
+            rows = _exact_rows(ds, at, at_loc, r0, r1, settings)
+        elif conditions and not off_grid and "model" not in ds.dims:
+            # variable by variable (a cube of several models is read whole, per slab)
+            rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
+        else:
+            rows = _slab_rows(ds, at_loc, r0, r1)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
         if not conditions and done is not None and "radius" not in at_loc:
             mask &= ~np.isnan(rows["tip_force_max"])  # skip masked, uncomputed radii
-        n = int(mask.sum())
+        n = int(mask.sum()) if n_where is None else n_where
         matched += n
-        room = None if limit is None or sort_name is not None else \
-            limit - len(kept[COLUMNS[0]])
         if room is None or room > 0:
             kept = {name: np.concatenate([kept[name], rows[name][mask][:room]])
                     for name in columns}
@@ -425,9 +375,6 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                        at=at, columns=columns)
 
 
-_MODEL_WHERE = re.compile(r"^\s*model\s*(==|=)\s*([A-Za-z0-9_]+)\s*$")
-
-
 def _select_model(ds, where):
     """The cube at the model a ``--where "model == NAME"`` names, and the other conditions.
 
@@ -442,9 +389,7 @@ def _select_model(ds, where):
     for name in names:
         if name not in models:
             raise InputError(f"--where model: this cube has {', '.join(models)}, got {name!r}")
-    if "model" not in ds.dims:
-        return ds, rest
-    if not names:
+    if "model" not in ds.dims or not names:
         return ds, rest
     if len(set(names)) != 1:
         raise InputError(f"--where: one model at a time ({', '.join(models)}), or none for "
@@ -459,163 +404,3 @@ def _sorted(rows, name, descending, limit):
     if limit is not None:
         order = order[:limit]
     return {k: v[order] for k, v in rows.items()}
-
-
-# ---------------------------------------------------------------------------- output
-
-
-def _var(name):
-    return MODEL if name == "model" else VARIABLES[name]
-
-
-def _unit(name):
-    return _var(name).display
-
-
-def _sig3(x) -> str:
-    """Three significant figures, trailing zeros kept, no exponent in the usual range."""
-    if x is None or not np.isfinite(x):
-        return "nan"
-    if x == 0:
-        return "0"
-    mag = math.floor(math.log10(abs(x)))
-    if -4 <= mag < 6:
-        digits = max(0, 2 - mag)
-        return f"{x:.{digits}f}"
-    return f"{x:.2e}"
-
-
-def _cell(name, x) -> str:
-    if name == "model":
-        return str(x)
-    if name == "limit":
-        return {0.0: "stroke", 1.0: "strength", 2.0: "supply", 3.0: "load"}.get(
-            float(x), "boundary") \
-            if np.isfinite(x) else "boundary"
-    value = float(to_display(name, x))
-    if name in AXES:
-        return f"{value:.6g}"
-    return _sig3(value)
-
-
-def _describe_at(res) -> str:
-    parts = []
-    for name, value in res.at.items():
-        unit = _unit(name)
-        parts.append(f"{name}={float(to_display(name, value)):g}"
-                     + ("" if unit == "1" else f" {unit}"))
-    note = res.point
-    if res.point == EXACT:
-        note += (" at this design (between grid points in " + ", ".join(res.interpolated)
-                 + "; evaluated with the cube's materials and settings)")
-    elif res.interpolated:
-        note += (" linearly in " + ", ".join(res.interpolated)
-                 + " between grid points (--interpolate; the exact model may differ)")
-    return ", ".join(parts) + f": {note}"
-
-
-def format_table(res) -> str:
-    """Aligned text in display units: a key/value list for one design, else a table."""
-    out = io.StringIO()
-    n = len(res)
-    if res.single and n == 1:
-        print(f"design at {_describe_at(res)}", file=out)
-        for name in [*DESIGN, *(c for c in res.columns if c in OPTIONAL)]:
-            x = res.data[name][0]
-            unit = _unit(name)
-            text = _cell(name, x)
-            if name == "limit":
-                text = {"stroke": "stroke-limited (full range of motion)",
-                        "strength": "strength-limited (the nylon's strength cuts in)",
-                        "supply": "supply-limited (the supply cannot heat it to T_max)",
-                        "load": "load-limited (the muscle stalls against the wrap's load)",
-                        "boundary": "between grid points that disagree: refine the grid"
-                        }[text]
-            elif unit != "1":
-                text += f" {unit}"
-            print(f"  {name:<16} {text}", file=out)
-        return out.getvalue()
-    if res.at:
-        print(f"at {_describe_at(res)}", file=out)
-    heads = list(res.columns)
-    units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
-    cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
-    widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
-              enumerate(zip(heads, units))] if cells else [max(len(h), len(u)) for h, u in
-                                                          zip(heads, units)]
-    # names to the left (the model column), numbers to the right
-    just = [str.ljust if h == "model" else str.rjust for h in heads]
-    print("  ".join(j(h, w) for h, w, j in zip(heads, widths, just)), file=out)
-    print("  ".join(j(u, w) for u, w, j in zip(units, widths, just)), file=out)
-    for r in cells:
-        print("  ".join(j(c, w) for c, w, j in zip(r, widths, just)), file=out)
-    print(rows_note(res), file=out)
-    return out.getvalue()
-
-
-def held_back(res) -> int:
-    """How many matching designs a result does not show (past ``--limit``)."""
-    return 0 if res.matched is None else max(0, res.matched - len(res))
-
-
-def rows_note(res) -> str:
-    """``"20 designs shown of 11808 matching; 11788 held back (--limit N or --limit all)"``."""
-    n = len(res)
-    shown = f"{n} design{'s' if n != 1 else ''}"
-    hidden = held_back(res)
-    if hidden:
-        return (f"{shown} shown of {res.matched} matching; {hidden} held back "
-                "(--limit N for more, --limit all for every one)")
-    return shown
-
-
-def _json_value(x):
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def _records(res):
-    units = {name: _var(name).units for name in res.columns}
-    records = []
-    for i in range(len(res)):
-        rec = {}
-        if res.point:
-            rec["point"] = res.point
-        for name in res.columns:
-            x = res.data[name][i]
-            if name == "model":
-                rec[name] = str(x)
-                continue
-            rec[name] = (None if not np.isfinite(x) else int(x)) if name == "limit" \
-                else _json_value(x)
-        rec["units"] = units
-        records.append(rec)
-    return records
-
-
-def format_json(res) -> str:
-    """One JSON object for one design, else a list; SI values with a ``units`` map."""
-    records = _records(res)
-    doc = records[0] if res.single and len(records) == 1 else records
-    return json.dumps(doc, indent=1) + "\n"
-
-
-def format_csv(res) -> str:
-    """CSV in SI, one row per design; the header names the units (``radius [m]``)."""
-    out = io.StringIO()
-    w = csv.writer(out, lineterminator="\n")
-    head = ([] if not res.point else ["point"]) + \
-        [n if n == "model" else f"{n} [{VARIABLES[n].units}]" for n in res.columns]
-    w.writerow(head)
-    for i in range(len(res)):
-        row = [] if not res.point else [res.point]
-        for name in res.columns:
-            x = res.data[name][i]
-            if name == "model":
-                row.append(str(x))
-            elif name == "limit":
-                row.append("" if not np.isfinite(x) else int(x))
-            else:
-                row.append("" if not np.isfinite(x) else repr(float(x)))
-        w.writerow(row)
-    return out.getvalue()

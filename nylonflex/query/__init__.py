@@ -1,0 +1,36 @@
+"""``nylonflex query``: ask a saved cube about designs, with units, in bounded memory.
+
+A query picks designs three ways, which combine:
+
+* ``--at radius=7.5mm,coil_index=1.7``: fixes the named axes. A value on the grid (within a
+  tiny tolerance) is read as is ("grid point"); between grid points the model is evaluated
+  exactly at that design with the cube's own materials and settings from its provenance
+  ("exact model", :func:`nylonflex.evaluate`, milliseconds), or, with ``interpolate=True``
+  (``--interpolate``), the design variables are interpolated linearly in each axis
+  ("interpolated"; up to tens of per cent off where the response bends). Axes not named
+  keep all their grid values, so a partial ``--at`` lists a slice of the cube (one row per
+  design); naming all five axes gives one design. Outside the grid is refused.
+* ``--where "tip_force_max >= 0.5 N"``: conditions on axes or design variables, with units;
+  several are ANDed.
+* ``--sort NAME`` (``--sort=-NAME`` or ``--sort NAME:desc`` descending; ties keep grid
+  order) and ``--limit N``.
+
+The cube is read in slabs of radii, so memory stays bounded on a cube of any size; only the
+matching rows (at most ``--limit``) are kept, and every match is counted, so that the
+output can say how many rows it held back.
+"""
+
+from __future__ import annotations
+
+from ..variables import AXES, DESIGN, VARIABLES  # noqa: F401  (names the tests use)
+from .format import (_cell, _describe_at, _records, _sig3, _unit, format_csv,  # noqa: F401
+                     format_json, format_table, held_back, rows_note)
+from .parse import (_FIELDS, _LIMIT_WORDS, _MODEL_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
+                    INTERPOLATED, OPTIONAL, Condition, _parse_sort, _quantity, parse_at,
+                    parse_where)
+from .scan import (_GRID_RTOL, _SLAB_VALUES, QueryResult, _exact_rows,  # noqa: F401
+                   _exact_settings, _locate, _select_model, _slab_rows, _sorted, at_value,
+                   query_cube)
+
+__all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_csv", "format_json", "format_table",
+           "held_back", "parse_at", "parse_where", "query_cube", "rows_note"]
