@@ -275,6 +275,9 @@ class DaskExecutor:
                 pass
 
         def finish(fut, fetch):
+            # a slab whose worker died while it was fetched is recomputed: that wait too
+            # gives up when no worker is left (the watchdog)
+            self._wait_until(fetch.done)
             try:
                 arrays = fetch.result()
             except Exception as exc:  # noqa: BLE001 - a lost scheduler is one line
@@ -293,20 +296,20 @@ class DaskExecutor:
                 yield finish(*fetching)  # nothing else finished: don't wait for it
                 fetching = None
                 continue
-            self._wait_ready(done)
+            self._wait_until(done.has_ready)
             fut = next(done)
             started = (fut, self._fetcher.submit(fut.result))
             if fetching is not None:
                 yield finish(*fetching)
             fetching = started
 
-    def _wait_ready(self, done):
-        """Wait for a finished slab; give up after ``stall`` seconds with no live worker
+    def _wait_until(self, ready):
+        """Wait until ``ready()``; give up after ``stall`` seconds with no live worker
         (every worker died, or the scheduler is gone)."""
         import time
 
         last_alive = time.monotonic()
-        while not done.has_ready():
+        while not ready():
             time.sleep(0.2)
             try:
                 alive = bool(self.client.scheduler_info().get("workers"))
