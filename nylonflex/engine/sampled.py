@@ -155,7 +155,7 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
     else:
         out["nylon"] = cfg.nylon
     out["base_thickness"] = cfg.base_thickness
-    out["model"] = cfg.models[0]  # a sampled sweep has one model (config.py refuses more)
+    out["model"] = cfg.models[0]  # a sampled sweep has one model (nylonflex.config refuses more)
     out["supply_voltage"] = cfg.supply_voltage
     return out
 
