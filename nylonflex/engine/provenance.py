@@ -122,10 +122,11 @@ def evaluate_settings(attrs) -> dict:
         out["model"] = str(model[0])
     elif model is not None:  # several models: the caller picks one
         out["model"] = [str(m) for m in model]
-    supply = doc.get("supply")
+    # the resolved config stores the supply as supply_voltage [V] (config.canonical_yaml)
+    supply = doc.get("supply_voltage", doc.get("supply"))
     if isinstance(supply, dict) and supply.get("voltage") is not None:
         out["supply_voltage"] = float(supply["voltage"])
-    elif isinstance(supply, (int, float)):
+    elif isinstance(supply, (int, float)) and not isinstance(supply, bool):
         out["supply_voltage"] = float(supply)
     return out
 
