@@ -71,25 +71,18 @@ class DesignResult:
 
 
 def _materials(ds, spec):
-    """The model with the materials the cube was computed with (from its attributes)."""
-    silicone, nylon, base, memo = _cube_materials(ds.attrs["config_yaml"])
-    return Model(silicone, nylon, base, spec.model, memo)
+    """The model with the materials (and supply) the cube was computed with, from its
+    attributes; evaluations are remembered per cube config and model variant."""
+    silicone, nylon, base, supply, memo = _cube_materials(ds.attrs["config_yaml"], spec.model)
+    return Model(silicone, nylon, base, spec.model, memo, supply_voltage=supply)
 
 
 @functools.lru_cache(maxsize=8)
-def _cube_materials(config_yaml):
-    import yaml
+def _cube_materials(config_yaml, model):
+    from ..engine.provenance import evaluate_settings
 
-    from ..materials import Nylon, Silicone
-
-    cfg = yaml.safe_load(config_yaml)
-
-    def build(cls, d):
-        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
-
-    base = cfg.get("base_thickness", "wall")
-    return (build(Silicone, cfg["silicone"]), build(Nylon, cfg["nylon"]),
-            None if base == "wall" else float(base), {})
+    s = evaluate_settings({"config_yaml": config_yaml})
+    return s["silicone"], s["nylon"], s["base_thickness"], s.get("supply_voltage"), {}
 
 
 def _open(spec, cube):

@@ -41,11 +41,17 @@ class Model:
         b [m]; None for b = t.
     model : str
         Model variant.
+    memo : dict, optional
+        Designs already evaluated with these materials, model and supply.
+    supply_voltage : float, optional
+        The cube's supply [V] (docs/model.md s. 15); None: no supply limit.
     """
 
-    def __init__(self, silicone, nylon, base_thickness=None, model="paper", memo=None):
+    def __init__(self, silicone, nylon, base_thickness=None, model="paper", memo=None,
+                 supply_voltage=None):
         self.silicone, self.nylon = silicone, nylon
         self.base_thickness, self.model = base_thickness, model
+        self.supply_voltage = supply_voltage
         self.evaluations = 0
         # designs already evaluated with these materials (shared between runs on one cube)
         self.memo = {} if memo is None else memo
@@ -59,7 +65,8 @@ class Model:
             self.evaluations += len(todo)
             design = dict(zip(AXES, X[todo].T))
             values = _exact(**design, base_thickness=self.base_thickness,
-                            silicone=self.silicone, nylon=self.nylon, model=self.model)
+                            silicone=self.silicone, nylon=self.nylon, model=self.model,
+                            supply_voltage=self.supply_voltage)
             values = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in values.items()}
             if len(self.memo) > _MEMO_MAX:
                 self.memo.clear()
@@ -72,14 +79,14 @@ class Model:
 
 
 def _exact(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness,
-           silicone, nylon, model):
+           silicone, nylon, model, supply_voltage=None):
     """The one call into the exact pointwise model, :func:`nylonflex.evaluate` (compiled;
     every design variable, SI)."""
     from ..engine import evaluate
 
     return evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
                     base_thickness=base_thickness, silicone=silicone, nylon=nylon,
-                    model=model)
+                    model=model, supply_voltage=supply_voltage)
 
 
 def evaluate_rows(model, rows) -> dict:
