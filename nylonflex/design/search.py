@@ -15,13 +15,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..query import COLUMNS, _locate, _slab_rows, at_value
+from ..query.scan import radius_slabs
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
 
 __all__ = ["GridScan", "nondominated", "scan_grid", "violation"]
 
 # about this many float64 values per variable in one slab (as query)
-_SLAB_VALUES = 2**20
 # at most this many feasible designs kept for the chart's cloud
 CLOUD_MAX = 50_000
 
@@ -162,15 +162,7 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
     conds = [c for c in spec.constraints if not (c.op == "==" and c.name in AXES)]
     multi = len(spec.objectives) > 1
 
-    if "radius" in at_loc:
-        slabs = [(at_loc["radius"][0], at_loc["radius"][1] + 1)]
-    else:
-        other = 1
-        for name in AXES[1:]:
-            other *= 2 if name in at_loc else ds.sizes[name]
-        step = max(1, _SLAB_VALUES // max(other, 1))
-        slabs = [(r, min(r + step, ds.sizes["radius"]))
-                 for r in range(0, ds.sizes["radius"], step)]
+    slabs = radius_slabs(ds, at_loc)
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds else None
 
     total = feasible = 0

@@ -260,6 +260,20 @@ def _exact_settings(ds):
     return settings
 
 
+def radius_slabs(ds, at_loc) -> list[tuple[int, int]]:
+    """Radius index ranges to scan: the ``--at`` bracket, or the whole axis cut so that a
+    slab holds about :data:`_SLAB_VALUES` values of one variable (bounded memory)."""
+    if "radius" in at_loc:
+        i0, i1 = at_loc["radius"][:2]
+        return [(i0, i1 + 1)]
+    other = 1
+    for name in AXES[1:]:
+        other *= 2 if name in at_loc else ds.sizes[name]
+    other *= ds.sizes.get("model", 1)
+    step = max(1, _SLAB_VALUES // max(other, 1))
+    return [(r, min(r + step, ds.sizes["radius"])) for r in range(0, ds.sizes["radius"], step)]
+
+
 def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=False,
                progress=None, log=None) -> QueryResult:
     """Designs of a cube selected by ``--at``, filtered by ``--where``, sorted, limited.
@@ -318,18 +332,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
 
         warm_up_points(settings, notice=log)
 
-    # radius slabs: the --at bracket, or the whole axis cut to bounded memory
-    if "radius" in at_loc:
-        i0, i1 = at_loc["radius"][:2]
-        slabs = [(i0, i1 + 1)]
-    else:
-        other = 1
-        for name in AXES[1:]:
-            other *= 2 if name in at_loc else ds.sizes[name]
-        other *= ds.sizes.get("model", 1)
-        step = max(1, _SLAB_VALUES // max(other, 1))
-        slabs = [(r, min(r + step, ds.sizes["radius"]))
-                 for r in range(0, ds.sizes["radius"], step)]
+    slabs = radius_slabs(ds, at_loc)
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
     kept = {name: np.empty(0, dtype=object if name == "model" else float)
