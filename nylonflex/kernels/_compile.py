@@ -43,7 +43,6 @@ def source_digest() -> str:
     return digest.hexdigest()[:16]
 
 
-_source_digest = source_digest  # the name provenance and worker checks used first
 
 
 def _cache_dir() -> str:
