@@ -43,8 +43,6 @@ def source_digest() -> str:
     return digest.hexdigest()[:16]
 
 
-
-
 def _cache_dir() -> str:
     base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
