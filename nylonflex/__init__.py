@@ -6,12 +6,7 @@
 0.150...
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("nylonflex")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0+unknown"
+from ._version import __version__
 
 
 __all__ = [

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .config import ResolvedConfig
 
-__all__ = ["default_output", "estimate", "run_sweep"]
+__all__ = ["default_output", "estimate", "run_sweep", "sweep_file"]
 
 
 def default_output(cfg: ResolvedConfig) -> Path:
@@ -54,21 +54,41 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     nylonflex.storage.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
-    if scheduler is None:  # compile first, so that the run's timings exclude it
-        from .engine.slabs import set_workers
-        from .engine.warmup import warm_up_grid
-
-        set_workers(workers)
-        compiled = warm_up_grid(cfg, notice=log)
-        if compiled and log is not None:
-            log(f"kernels compiled in {compiled:.1f} s (not counted below)")
     if out is None:
+        _warm_up(cfg, workers, scheduler, log)
         return _in_memory(cfg, workers, scheduler, progress)
-    from .storage import open_cube, sweep_to_file
+    from .storage import open_cube
 
-    sweep_to_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
-                  progress=progress, log=log, overwrite=overwrite)
+    sweep_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
+               progress=progress, log=log, overwrite=overwrite)
     return open_cube(out)
+
+
+def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
+               scheduler=None, progress=None, log=None, overwrite: bool = False) -> Path:
+    """:func:`run_sweep` into the cube file ``out``, without opening the cube afterwards.
+
+    The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
+    command line uses it: a sweep without charts never imports xarray.
+    """
+    from .storage import sweep_to_file
+
+    _warm_up(cfg, workers, scheduler, log)
+    return sweep_to_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
+                         progress=progress, log=log, overwrite=overwrite)
+
+
+def _warm_up(cfg, workers, scheduler, log):
+    """Compile (or load) the local kernel first, so that the run's timings exclude it."""
+    if scheduler is not None:
+        return
+    from .engine.slabs import set_workers
+    from .engine.warmup import warm_up_grid
+
+    set_workers(workers)
+    compiled = warm_up_grid(cfg, notice=log)
+    if compiled and log is not None:
+        log(f"kernels compiled in {compiled:.1f} s (not counted below)")
 
 
 def _in_memory(cfg, workers, scheduler, progress):
@@ -100,18 +120,22 @@ def _resident_bytes() -> int:
     return int(psutil.Process().memory_info().rss)
 
 
-def _packed_bytes(value, chunks) -> int:
-    """Bytes of ``value`` stored in ``chunks`` with the cube's shuffle and deflate."""
+def _packed_bytes(value, chunks, codec) -> int:
+    """Bytes of ``value`` stored in ``chunks`` with the cube's codec (name)."""
     import itertools
 
-    from .storage.cube import _shuffle_deflate
+    from .storage.cube import CODECS, _encode_chunk
+
+    codec = CODECS[codec]
+    if codec.encode is None:  # lz4: HDF5 compresses; zstd's size is close enough here
+        codec = CODECS["zstd"]
 
     chunks = tuple(min(c, n) for c, n in zip(chunks, value.shape))
     starts = [range(0, n, c) for n, c in zip(value.shape, chunks)]
     total = 0
     for corner in itertools.product(*starts):
         block = value[tuple(slice(i, i + c) for i, c in zip(corner, chunks))]
-        total += len(_shuffle_deflate(block, chunks))
+        total += len(_encode_chunk(block, chunks, codec))
     return total
 
 
@@ -124,7 +148,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
 
     A few radii spread over the grid are computed with the kernel a local run uses (after
     compiling it, which is not counted), and their arrays compressed as the cube is
-    (shuffle and deflate), so the rate and the compression ratio are this machine's and this
+    (with the config's codec), so the rate and the compression ratio are this machine's and this
     design space's.
 
     Parameters
@@ -178,7 +202,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         for name, value in arrays.items():
             raw += value.nbytes
             packed += _packed_bytes(value, _chunks(VARIABLES[name].dims, sizes,
-                                                   min(radius_chunk, size)))
+                                                   min(radius_chunk, size)), cfg.compression)
         compress += time.perf_counter() - t0
     picks = range(len(starts) * size)
     sample = len(picks) * per_radius

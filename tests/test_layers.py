@@ -15,7 +15,7 @@ PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 #: Layer of each top-level module or subpackage, lowest first. Same-layer imports are
 #: allowed only inside one subpackage.
 LAYERS = {
-    "units": 0, "safe_yaml": 0.05, "files": 0.05, "examples": 0.05, "variables": 0.1,
+    "_version": 0, "units": 0, "safe_yaml": 0.05, "files": 0.05, "examples": 0.05, "variables": 0.1,
     "material_files": 0.15, "materials": 0.2, "requirements": 0.25, "config": 0.3,
     "physics": 1, "reference": 1,
     "kernels": 2,

@@ -45,8 +45,13 @@ def _module(name):
     return importlib.import_module(f".{COMMANDS[name]}", __name__)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The parser of every ``nylonflex`` command (INTERFACE.md)."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every ``nylonflex`` command (INTERFACE.md).
+
+    ``command``: only that command's arguments are added (the others are listed by name
+    and help line only, which is all ``--help`` and ``--version`` need), so a command
+    imports nothing it does not use; None adds every command's arguments.
+    """
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     p = _Parser(prog="nylonflex", parents=[common],
@@ -58,8 +63,14 @@ def build_parser() -> argparse.ArgumentParser:
         sp = sub.add_parser(name, parents=[common], help=mod.HELP,
                             description=getattr(mod, "DESCRIPTION", mod.HELP),
                             formatter_class=argparse.RawDescriptionHelpFormatter)
-        mod.add_arguments(sp)
+        if command is None or name == command:
+            mod.add_arguments(sp)
     return p
+
+
+def _command(argv) -> str:
+    """The command named in ``argv`` ("" when there is none: ``--help``, ``--version``)."""
+    return next((a for a in argv if a in COMMANDS), "")
 
 
 def _join_negative_values(argv):
@@ -82,8 +93,8 @@ def main(argv=None) -> int:
 
 
 def _main(argv=None) -> int:
-    parser = build_parser()
     argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser(_command(argv))
     args = parser.parse_args(_join_negative_values(argv))
     if args.command is None:
         parser.print_help()

@@ -27,17 +27,31 @@ def add_arguments(s):
                         "estimated time (measured on a small sample); write nothing")
 
 
+class _NoBar:
+    """The bar when there is no terminal (or --quiet): tqdm is not even imported."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def update(self, n):
+        pass
+
+
 def _progress(total, quiet):
+    if quiet or not sys.stderr.isatty():
+        return _NoBar()
     from tqdm import tqdm
 
-    disable = quiet or not sys.stderr.isatty()
-    return tqdm(total=total, unit="design", unit_scale=True, disable=disable,
-                desc="sweep", smoothing=0.1, dynamic_ncols=True)
+    return tqdm(total=total, unit="design", unit_scale=True, desc="sweep", smoothing=0.1,
+                dynamic_ncols=True)
 
 
 def run(args) -> int:
     from ..config import load_config
-    from ..sweep import default_output, run_sweep
+    from ..sweep import default_output, sweep_file
     from ..files import refuse_special
 
     cfg = load_config(args.config, args.set)
@@ -52,14 +66,17 @@ def run(args) -> int:
         return _dry_run(cfg, out, args, log)
 
     with _progress(cfg.n_designs, args.quiet) as bar:
-        ds = run_sweep(cfg, out, resume=args.resume, workers=args.workers,
-                       scheduler=args.scheduler, progress=bar.update, log=log,
-                       overwrite=args.overwrite)
+        sweep_file(cfg, out, resume=args.resume, workers=args.workers,
+                   scheduler=args.scheduler, progress=bar.update, log=log,
+                   overwrite=args.overwrite)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if cfg.charts and not args.no_charts:
         from ..charts import draw_charts
+        from ..storage import open_cube
 
         from ._common import progress_bar
+
+        ds = open_cube(out)
 
         skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
         with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
@@ -68,7 +85,7 @@ def run(args) -> int:
                                 progress=bar, refuse_foreign=False)
         for path in paths:
             print(path)
-    ds.close()
+        ds.close()
     return 0
 
 
