@@ -369,9 +369,10 @@ print(rc, time.perf_counter() - t, peak, flush=True)
 """
 
 
-def test_an_alias_bomb_is_refused_quickly_in_little_memory(tmp_path):
+@pytest.mark.parametrize("levels", [9, 12])  # 9^9 and 9^12 strings; 12 levels: 700 bytes
+def test_an_alias_bomb_is_refused_quickly_in_little_memory(tmp_path, levels):
     cfg = tmp_path / "bomb.yaml"
-    cfg.write_text(_bomb())
+    cfg.write_text(_bomb(levels))
     assert len(cfg.read_bytes()) < 800
     proc = subprocess.run([sys.executable, "-c", _MEASURE, str(cfg), str(tmp_path / "c.h5")],
                           capture_output=True, text=True, timeout=120)
