@@ -67,7 +67,13 @@ class DesignResult:
 
     @property
     def reasons(self) -> list:
-        return self.scan.reasons
+        if self.designs or self.scan.reasons or not self.scan.feasible:
+            return self.scan.reasons
+        # the grid met the spec, but every candidate broke a constraint when evaluated
+        # exactly: it sits on a constraint's boundary, within the cube's last bits
+        return [f"the {self.dropped} best grid design(s) meeting the constraints in the cube "
+                "break one when evaluated exactly (they sit on a constraint's bound, within "
+                "the cube's rounding); loosen that bound slightly"]
 
 
 def _materials(ds, spec):
@@ -142,10 +148,12 @@ def run_design(spec, cube=None) -> DesignResult:
 
     # every reported design, exactly, once more; drop any that breaks a constraint
     grid = evaluate_rows(model, scan.best)
-    grid = {k: v[meets(spec, grid, scan.fixed)] for k, v in grid.items()}
+    ok = meets(spec, grid, scan.fixed)
+    dropped = int((~ok).sum())
+    grid = {k: v[ok] for k, v in grid.items()}
     new = evaluate_rows(model, _rows(refined)) if refined else {k: np.empty(0) for k in grid}
     ok = meets(spec, new, scan.fixed)
-    dropped = int((~ok).sum())
+    dropped += int((~ok).sum())
     new = {k: v[ok] for k, v in new.items()}
 
     signs = np.array([o.sign for o in spec.objectives])

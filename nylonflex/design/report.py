@@ -31,9 +31,13 @@ def summary(res) -> list:
              + (" subject to " + "; ".join(c.text for c in spec.constraints)
                 if spec.constraints else "")]
     if not res.designs:
-        lines.append(f"infeasible: none of the {scan.total} designs scanned meets every "
-                     "constraint")
-        lines += [f"  {r}" for r in scan.reasons]
+        if scan.feasible:
+            lines.append(f"infeasible once evaluated exactly: {scan.feasible} of the "
+                         f"{scan.total} designs scanned meet every constraint in the cube")
+        else:
+            lines.append(f"infeasible: none of the {scan.total} designs scanned meets every "
+                         "constraint")
+        lines += [f"  {r}" for r in res.reasons]
         return lines
     lines.append(f"grid: {scan.feasible} of {scan.total} designs feasible")
     for name, (g, b, rel) in res.improvement.items():
@@ -54,7 +58,7 @@ def summary(res) -> list:
     elif not res.improvement:
         lines.append(f"grid front: {len(res.designs)} designs (refine is off)")
     if res.dropped:
-        lines.append(f"{res.dropped} refined design(s) dropped: exact re-evaluation broke "
+        lines.append(f"{res.dropped} design(s) dropped: exact re-evaluation broke "
                      "a constraint")
     lines.append(f"{res.evaluations} exact evaluations")
     return lines
