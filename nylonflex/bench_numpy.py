@@ -1,12 +1,13 @@
 """The NumPy yardstick of ``nylonflex bench``: the grid kernel's structure in plain NumPy.
 
 What a user might write instead of the Numba kernel: the same quadrature (one node table per
-section, :func:`nylonflex.physics.bending.quadrature_nodes`), the same safeguarded Newton
-solves with the same tolerances and the same starts (along the pressure axis from the
-previous solves, the full-stroke and strength-limited solves from the solved curve), and
-the same loop structure (per section, per coil index, per wrap angle, per length), each
-level vectorised over every design it covers instead of looping. The Newton loops iterate
-on the designs not yet converged only.
+section, :func:`nylonflex.physics.bending.quadrature_nodes`), safeguarded Newton solves to
+the same tolerance (``NEWTON_RTOL``) started as the kernel's Newton solves were before it
+moved to Halley steps and Hermite starts (docs/model.md s. 12): along the pressure axis
+from the previous solves, the full-stroke and strength-limited solves from the solved
+curve; and the same loop structure (per section, per coil index, per wrap angle, per
+length), each level vectorised over every design it covers instead of looping. The Newton
+loops iterate on the designs not yet converged only.
 
 It covers the paper's model without a supply and the mechanical variables (usable stroke,
 limit, pressure, torque, tip force, bend angle, range fraction, nylon force and use) and the

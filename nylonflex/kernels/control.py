@@ -45,7 +45,7 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
     x_base, w_base, phi_trig, w_phi : ndarray
         Gauss-Legendre nodes and weights (``physics.bending.quadrature_nodes()``).
     rtol : float
-        Newton tolerance of the curvature [-].
+        Tolerance of the curvature solve [-] (``physics.bending.NEWTON_RTOL``).
     out_angle, out_slope : ndarray, shape (points,)
         Written with theta(p_k) [rad] and d theta/dp [rad/Pa].
 
@@ -56,7 +56,7 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
     kappa = 0.0
     lever = _pressure_moment(1.0, radius, base_thickness)  # dM_P/dp: M_P is linear in p
     for k in range(out_angle.shape[0]):
-        # warm start from the previous grid point: a few Newton steps each
+        # warm start from the previous grid point: a few Halley steps each
         kappa = _curvature(lever * (k * pressure_step), radius, wall_thickness,
                            base_thickness, mu, alpha, x_base, w_base, phi_trig, w_phi, kappa,
                            rtol)

@@ -5,8 +5,9 @@ Private compiled loops that write into ``out`` arrays and check nothing (numbagg
 nothing is computed twice that a design axis does not change:
 
 - per (a, t): the section's quadrature node table (heights and weights, no trigonometry),
-  then the bend-angle curve over pressure (Newton started from the quadratic extrapolation
-  of the solves already made along the sorted pressure axis), independent of C, psi and L;
+  then the bend-angle curve over pressure, each solve started from the quintic Hermite
+  extrapolation of the two before it (values, dkappa/dp and d2kappa/dp2), independent of
+  C, psi and L;
 - per (a, t, C): the curvature at the full stroke p(s_max(C)), started from the solved
   curve interpolated at p(s_max);
 - per stroke: p(s) and S_theta(s), shared by every design's nylon-force curve;
@@ -26,8 +27,9 @@ import math
 import numpy as np
 from numba import prange
 
-from ..physics.bending import (NEWTON_RTOL, _curvature_guess, _curvature_nodes,
-                               _pressure_moment, _section_nodes)
+from ..physics.bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates,
+                               _curvature_solve, _curvature_start, _pressure_moment,
+                               _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _design_state, _design_values, _model_state,
@@ -108,14 +110,20 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         wy_nodes = np.empty(n_nodes)
         wyy_nodes = np.empty(n_nodes)
         _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
-        # the bend-angle curve first: its solves start the coil loop's Newton iterations
+        # the bend-angle curve first, with dkappa/dp and d2kappa/dp2: each solve starts from
+        # the previous ones, and they start the coil loop's solves
         kappa_curve = np.empty(npr)
+        rate_curve = np.empty(npr)
+        rate2_curve = np.empty(npr)
+        lever_p = _pressure_moment(1.0, a, b)  # dM_P/dp
         for jp in range(npr):
             moment = _pressure_moment(pressure[jp], a, b)
-            kappa_curve[jp] = _curvature_nodes(
+            kappa, dm, d2m = _curvature_solve(
                 moment, y_nodes, wy_nodes, wyy_nodes, mu, alpha,
-                _curvature_guess(pressure[jp], pressure, kappa_curve, jp), NEWTON_RTOL,
-                cauchy)
+                _curvature_start(pressure[jp], pressure, kappa_curve, rate_curve, rate2_curve,
+                                 jp), NEWTON_RTOL, cauchy)
+            kappa_curve[jp] = kappa
+            rate_curve[jp], rate2_curve[jp] = _curvature_rates(lever_p, dm, d2m)
             for il in range(nl):
                 out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il]
                 out_tip[ia, it, il, jp] = moment / length[il]
@@ -131,8 +139,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 p_full = _gauge_pressure(s_max, p_atm)
                 kappa_full = _curvature_nodes(
                     _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, mu, alpha,
-                    _curvature_guess(p_full, pressure, kappa_curve, n_curve), NEWTON_RTOL,
-                    False)
+                    _curvature_start(p_full, pressure, kappa_curve, rate_curve, rate2_curve,
+                                     n_curve), NEWTON_RTOL, False)
                 # the working temperatures of a stroke-limited design (s* = s_max) depend
                 # on the coil index only: once per C, not per wrap angle
                 temps_full = _working_temperatures(model, s_max, t_max, scale, t_amb, t_max,
@@ -145,7 +153,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 if default:
                     st = _stroke_state_nodes(a, t, b, lever, f_lim, s_max, kappa_full, mu,
                                              alpha, y_nodes, wy_nodes, wyy_nodes, p_atm,
-                                             pressure, kappa_curve, n_curve)
+                                             pressure, kappa_curve, rate_curve, rate2_curve,
+                                             n_curve)
                     closes = False
                     if st[1] == 0:
                         temps = temps_full

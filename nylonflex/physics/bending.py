@@ -24,7 +24,7 @@ import numpy as np
 
 from ..materials import silicone_parameters
 from ._formula import check, check_section, formula, scalar_or_array
-from .silicone import _stress_and_slope
+from .silicone import _stress_slope_curvature
 
 __all__ = [
     "QUADRATURE_ORDERS",
@@ -43,8 +43,11 @@ __all__ = [
 #: adaptive reference, 1.6e-14 against (24, 12) (docs/model.md s. 12).
 QUADRATURE_ORDERS = {"phi": 24, "base": 7}
 
-#: Relative Newton step below which the curvature counts as converged [-]. The error
-#: after that step is of the order of its square.
+#: Tolerance of the curvature solve [-]: it stops after a step whose predicted relative error
+#: is of the order of NEWTON_RTOL^2. A Newton step leaves an error of the order of its
+#: square, so it stops below NEWTON_RTOL (the NumPy yardstick, :mod:`nylonflex.bench_numpy`);
+#: a Halley step leaves one of the order of its cube (:func:`_curvature_solve`), so it stops
+#: below NEWTON_RTOL^(2/3) = 1e-6 (docs/model.md s. 12).
 NEWTON_RTOL = 1e-9
 
 
@@ -83,11 +86,12 @@ def _pressure_moment(pressure, radius, base_thickness):
 
 @formula
 def _section_stress(stretch, mu, alpha, cauchy):
-    """Stress of the moment integral and its slope [Pa]: nominal S(l), or Cauchy l S(l)."""
-    s, ds = _stress_and_slope(stretch, mu, alpha)
+    """Stress of the moment integral [Pa], its slope and second derivative in the stretch
+    [Pa]: nominal S(l), or Cauchy l S(l)."""
+    s, ds, d2s = _stress_slope_curvature(stretch, mu, alpha)
     if cauchy:
-        return stretch * s, s + stretch * ds
-    return s, ds
+        return stretch * s, s + stretch * ds, 2.0 * ds + stretch * d2s
+    return s, ds, d2s
 
 
 @formula
@@ -98,7 +102,7 @@ def _section_nodes(radius, wall_thickness, base_thickness, x_base, w_base, phi_t
     One table for the whole section (base layer, outer half disc, inner half disc with
     negative weights), so that M_S(kappa) = sum wy S(1 + kappa y) and dM_S/dkappa =
     sum wyy S'(1 + kappa y): the nodes depend on (a, t, b) only, not on kappa, and are
-    computed once per section instead of at every Newton step (docs/model.md s. 12).
+    computed once per section instead of at every step of the solve (docs/model.md s. 12).
     ``y``, ``wy``, ``wyy`` have ``x_base.size + 2 w_phi.size`` entries.
     """
     half = 0.5 * base_thickness
@@ -126,19 +130,23 @@ def _section_nodes(radius, wall_thickness, base_thickness, x_base, w_base, phi_t
 
 @formula
 def _section_moment(kappa, y, wy, wyy, mu, alpha, cauchy):
-    """M_S(kappa) [N m] and dM_S/dkappa [N m^2] from a :func:`_section_nodes` table.
+    """M_S(kappa) [N m], dM_S/dkappa [N m^2] and d2M_S/dkappa2 [N m^3] from a
+    :func:`_section_nodes` table.
 
     One flat loop over every node of the section (one log and one exp a term a node), no
     trigonometry and no per-node weight arithmetic: those live in the table.
+    d2M_S/dkappa2 = sum wyy y S''(1 + kappa y) reuses the powers of M_S and its slope.
     """
     n = y.shape[0]
     m = 0.0
     dm = 0.0
+    d2m = 0.0
     for i in range(n):
-        s, ds = _section_stress(1.0 + kappa * y[i], mu, alpha, cauchy)
+        s, ds, d2s = _section_stress(1.0 + kappa * y[i], mu, alpha, cauchy)
         m += wy[i] * s
         dm += wyy[i] * ds
-    return m, dm
+        d2m += wyy[i] * y[i] * d2s
+    return m, dm, d2m
 
 
 @formula
@@ -167,7 +175,8 @@ def _material_moment_of(kappa, radius, wall_thickness, base_thickness, mu, alpha
     """:func:`_material_moment` with nominal or (``cauchy``) Cauchy stress (docs/model.md s. 16)."""
     y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
                              phi_trig, w_phi)
-    return _section_moment(kappa, y, wy, wyy, mu, alpha, cauchy)
+    m, dm, _ = _section_moment(kappa, y, wy, wyy, mu, alpha, cauchy)
+    return m, dm
 
 
 @formula
@@ -181,14 +190,11 @@ def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
 @formula
 def _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
                   x_base, w_base, phi_trig, w_phi, guess, rtol, cauchy):
-    """Solve M_S(kappa) = moment for kappa >= 0 [1/m] by safeguarded Newton.
+    """Solve M_S(kappa) = moment for kappa >= 0 [1/m] (:func:`_curvature_solve`).
 
     ``cauchy`` integrates the Cauchy stress l S(l) instead of the nominal S(l)
-    (``cauchy_moment``, docs/model.md s. 16).
-
-    ``guess`` <= 0 starts from the linear (small-angle) solution. M_S is smooth and strictly
-    increasing, so the root is unique; a step that leaves the bracket is replaced by
-    bisection (or doubling while no upper bound is known).
+    (``cauchy_moment``, docs/model.md s. 16). ``guess`` <= 0 starts from the small-angle
+    solution.
     """
     y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
                              phi_trig, w_phi)
@@ -200,72 +206,125 @@ def _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, rtol, cauchy):
     """:func:`_curvature_of` on a section's node table (:func:`_section_nodes`) [1/m]."""
     if moment <= 0.0:
         return 0.0
-    if guess > 0.0:
-        k = guess
+    return _curvature_solve(moment, y, wy, wyy, mu, alpha, guess, rtol, cauchy)[0]
+
+
+@formula
+def _curvature_solve(moment, y, wy, wyy, mu, alpha, guess, rtol, cauchy):
+    """kappa >= 0 solving M_S(kappa) = moment [1/m], and dM_S/dkappa [N m^2] and
+    d2M_S/dkappa2 [N m^3] there, by safeguarded Halley iteration.
+
+    Each evaluation of the section gives M_S and its first two derivatives, and Halley's step
+    ``f / (f' - f f'' / (2 f'))`` converges cubically: after a step delta the error is about
+    C delta^3 / kappa^2 with C <= 3.5 over the accepted range (every set, both stresses;
+    docs/model.md s. 12). So the solve stops after a step with |delta| <= rtol^(2/3) kappa
+    (1e-6 for rtol 1e-9, an error below 4e-18 relative), without evaluating again: one
+    evaluation a solve from a close start. ``guess`` <= 0 starts from the root of the
+    second-order expansion of M_S at kappa = 0 (the linear small-angle solution where it has
+    none). M_S is smooth and strictly increasing, so the root is unique; every evaluation
+    narrows a bracket, and a step that leaves it is replaced by bisection (or doubling while
+    no upper bound is known). A zero ``moment`` gives kappa = 0 and the derivatives there.
+    """
+    if moment <= 0.0 or guess <= 0.0:
+        m0, dm0, d2m0 = _section_moment(0.0, y, wy, wyy, mu, alpha, cauchy)
+        if moment <= 0.0:
+            return 0.0, dm0, d2m0
+        disc = dm0 * dm0 + 2.0 * d2m0 * moment
+        k = 2.0 * moment / (dm0 + math.sqrt(disc)) if disc > 0.0 else moment / dm0
     else:
-        m0, dm0 = _section_moment(0.0, y, wy, wyy, mu, alpha, cauchy)
-        k = moment / dm0
+        k = guess
     lo = 0.0
     hi = math.inf
+    tol = rtol * rtol
+    m, dm, d2m = 0.0, 0.0, 0.0
     for _ in range(200):
-        m, dm = _section_moment(k, y, wy, wyy, mu, alpha, cauchy)
+        m, dm, d2m = _section_moment(k, y, wy, wyy, mu, alpha, cauchy)
         f = m - moment
         if f == 0.0:
-            return k
+            return k, dm, d2m
         if f > 0.0:
             hi = k
         else:
             lo = k
-        step = f / dm
+        newton = f / dm
+        den = 1.0 - 0.5 * newton * d2m / dm
+        if den > 0.5:  # Halley's step; far from the root, where it may misbehave, Newton's
+            step = newton / den
+            r = abs(step) / k
+            if r * r * r <= tol:
+                # the step leaves an error of order C r^3 << rtol^2; the root is in the bracket
+                k_new = min(max(k - step, lo), hi)
+                return k_new, dm + d2m * (k_new - k), d2m
+        else:
+            step = newton
         k_new = k - step
-        if abs(step) <= rtol * k and lo < k_new < hi:
-            return k_new
         if not (lo < k_new < hi):
             k_new = 0.5 * (lo + hi) if hi < math.inf else 2.0 * k
         k = k_new
-    return k
+    return k, dm, d2m
 
 
 @formula
-def _curvature_guess(pressure, pressures, kappas, n):
-    """Newton start for kappa(p) from solves already made at ``pressures[:n]`` [1/m].
+def _curvature_rates(pressure_lever, dm, d2m):
+    """dkappa/dp [1/(m Pa)] and d2kappa/dp2 [1/(m Pa^2)] on the curve M_S(kappa) = M_P(p).
 
-    Quadratic interpolation (or extrapolation past the last point) in p of kappa(p) / p
-    through the three nearest solved points with p > 0, which are sorted and increasing;
-    kappa / p is smooth and nearly constant, so the start is close to the root and Newton
-    needs one or two steps. With one or two such points, kappa / p constant or linear
-    through them; 0 (the linear start) with none.
+    ``pressure_lever`` is dM_P/dp [m^3] (M_P is linear in p), ``dm``, ``d2m`` the first two
+    derivatives of M_S at kappa(p) (:func:`_curvature_solve`): M_S' kappa' = dM_P/dp and
+    M_S'' kappa'^2 + M_S' kappa'' = 0.
     """
-    j0 = 0
-    while j0 < n and pressures[j0] <= 0.0:
-        j0 += 1
-    if n - j0 < 1 or pressure <= 0.0:
+    rate = pressure_lever / dm
+    return rate, -d2m * rate * rate / dm
+
+
+@formula
+def _curvature_start(pressure, pressures, kappas, rates, rates2, n):
+    """Start of the curvature solve at ``pressure`` from solves already made [1/m].
+
+    ``pressures[:n]`` (increasing) hold solved points kappa(p) (``kappas``) with their
+    dkappa/dp (``rates``) and d2kappa/dp2 (``rates2``, :func:`_curvature_rates`). The start
+    is the quintic Hermite interpolant through the two solved points around ``pressure``
+    (through the last two beyond them), whose error is of order h^6 in their spacing h: the
+    curvature solve then needs one evaluation (docs/model.md s. 12). Second-order Taylor
+    from a single point; 0 (the solve's own start) with none, or when the interpolant is not
+    a positive number.
+    """
+    if n < 1 or pressure <= 0.0:
         return 0.0
-    if n - j0 < 3:
-        q0 = kappas[j0] / pressures[j0]
-        q = q0
-        if n - j0 == 2:
-            q1 = kappas[j0 + 1] / pressures[j0 + 1]
-            q = q0 + (q1 - q0) * (pressure - pressures[j0]) / (pressures[j0 + 1]
-                                                               - pressures[j0])
-        return q * pressure if q > 0.0 else 0.0
-    j = j0
-    while j < n - 1 and pressures[j] < pressure:
-        j += 1
-    i = j - 1
-    if i > n - 3:
-        i = n - 3
-    if i < j0:
-        i = j0
-    p0, p1, p2 = pressures[i], pressures[i + 1], pressures[i + 2]
-    q0, q1, q2 = kappas[i] / p0, kappas[i + 1] / p1, kappas[i + 2] / p2
-    if q0 <= 0.0 or q1 <= 0.0 or q2 <= 0.0:
-        return 0.0
-    x = pressure
-    q = (q0 * (x - p1) * (x - p2) / ((p0 - p1) * (p0 - p2))
-         + q1 * (x - p0) * (x - p2) / ((p1 - p0) * (p1 - p2))
-         + q2 * (x - p0) * (x - p1) / ((p2 - p0) * (p2 - p1)))
-    return q * x if q > 0.0 else 0.0
+    if n == 1:
+        g = _taylor_start(pressure, pressures[0], kappas[0], rates[0], rates2[0])
+    else:
+        j = 1
+        while j < n - 1 and pressures[j] < pressure:
+            j += 1
+        g = _hermite_start(pressure, pressures[j - 1], kappas[j - 1], rates[j - 1],
+                           rates2[j - 1], pressures[j], kappas[j], rates[j], rates2[j])
+    return g if 0.0 < g < math.inf else 0.0
+
+
+@formula
+def _taylor_start(pressure, p0, k0, rate, rate2):
+    """kappa(p0) + kappa'(p0) h + kappa''(p0) h^2 / 2 with h = p - p0 [1/m]."""
+    h = pressure - p0
+    return k0 + h * (rate + 0.5 * h * rate2)
+
+
+@formula
+def _hermite_start(pressure, p0, k0, r0, s0, p1, k1, r1, s1):
+    """Quintic Hermite interpolant of values, first and second derivatives at p0 < p1 [1/m]."""
+    h = p1 - p0
+    t = (pressure - p0) / h
+    t2 = t * t
+    t3 = t2 * t
+    t4 = t3 * t
+    t5 = t4 * t
+    h00 = 1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5
+    h01 = 10.0 * t3 - 15.0 * t4 + 6.0 * t5
+    h10 = t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5
+    h11 = -4.0 * t3 + 7.0 * t4 - 3.0 * t5
+    h20 = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5
+    h21 = 0.5 * t3 - t4 + 0.5 * t5
+    return (h00 * k0 + h01 * k1 + h * (h10 * r0 + h11 * r1)
+            + h * h * (h20 * s0 + h21 * s1))
 
 
 def pressure_moment(pressure, radius, base_thickness):
@@ -344,8 +403,8 @@ def curvature(pressure, radius, wall_thickness, base_thickness=None, silicone="t
     Returns
     -------
     float or array
-        kappa >= 0 solving M_P(p) = M_S(kappa) [1/m] (eq. 13), by Newton on the analytic
-        derivative of the quadrature.
+        kappa >= 0 solving M_P(p) = M_S(kappa) [1/m] (eq. 13), by Halley iteration on the
+        analytic derivatives of the quadrature.
 
     References
     ----------

@@ -14,8 +14,9 @@ import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
 from ._formula import check_input, check_section, check_wrap_angle, formula, scalar_or_array
-from .bending import (NEWTON_RTOL, _curvature_guess, _curvature_nodes, _curvature_of,
-                      _node_table, _pressure_moment, quadrature_nodes)
+from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
+                      _curvature_start, _node_table, _pressure_moment, _taylor_start,
+                      quadrature_nodes)
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke
@@ -188,14 +189,19 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
             closes = True
             if s_top > s_close * (1.0 - 1e-9):
                 s_top = s_close * (1.0 - 1e-9)
+    y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                             phi_trig, w_phi)
+    rate_full = 0.0
+    rate2_full = 0.0
     if closes:
         kappa_full = math.inf
         p_full = math.inf
     else:
         p_full = _nylon_pressure(model, s_max, p_atm, solid)
-        kappa_full = _curvature_of(_pressure_moment(p_full, radius, base_thickness), radius,
-                                   wall_thickness, base_thickness, mu, alpha, x_base, w_base,
-                                   phi_trig, w_phi, 0.0, NEWTON_RTOL, cauchy)
+        kappa_full, dm, d2m = _curvature_solve(_pressure_moment(p_full, radius, base_thickness),
+                                               y, wy, wyy, mu, alpha, 0.0, NEWTON_RTOL, cauchy)
+        rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
+                                                 dm, d2m)
     if model == COUPLED_MUSCLE:
         s_eq = _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, alpha,
                                p_atm, STROKE_RTOL)
@@ -217,9 +223,10 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
     if limit == 0:
         kappa = kappa_full
     else:
-        guess = kappa_full * p / p_full if p_full < math.inf else 0.0
-        kappa = _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
-                              x_base, w_base, phi_trig, w_phi, guess, NEWTON_RTOL, cauchy)
+        guess = 0.0
+        if p_full < math.inf:  # second-order Taylor from the full-stroke solve
+            guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
+        kappa = _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, NEWTON_RTOL, cauchy)
     return s, limit, p, moment, kappa, force, kappa_full, closes
 
 
@@ -344,19 +351,27 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
                              phi_trig, w_phi)
     return _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit,
-                               s_max, kappa_full, mu, alpha, y, wy, wyy, p_atm, y, y, 0)
+                               s_max, kappa_full, mu, alpha, y, wy, wyy, p_atm, y, y, y, y, 0)
 
 
 @formula
 def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                        kappa_full, mu, alpha, y, wy, wyy, p_atm, pressures, kappas, n):
-    """:func:`_stroke_state` on a section's node table, with ``n`` solved points of
-    kappa(p) (``pressures[:n]``, ``kappas[:n]``) to start Newton from (none: ``n`` = 0)."""
-    if kappa_full <= 0.0:
-        p_full = _gauge_pressure(s_max, p_atm)
-        kappa_full = _curvature_nodes(
+                        kappa_full, mu, alpha, y, wy, wyy, p_atm, pressures, kappas, rates,
+                        rates2, n):
+    """:func:`_stroke_state` on a section's node table, with ``n`` solved points of kappa(p)
+    and its first two derivatives in p (``pressures[:n]``, ``kappas[:n]``, ``rates[:n]``,
+    ``rates2[:n]``, :func:`_curvature_start`) to start the curvature solves from (none:
+    ``n`` = 0)."""
+    p_full = _gauge_pressure(s_max, p_atm)
+    solved = kappa_full <= 0.0
+    rate_full = 0.0
+    rate2_full = 0.0
+    if solved:
+        kappa_full, dm, d2m = _curvature_solve(
             _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, mu, alpha,
-            _curvature_guess(p_full, pressures, kappas, n), NEWTON_RTOL, False)
+            _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, False)
+        rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
+                                                 dm, d2m)
     s, limit, force = _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu,
                                     alpha, p_atm, STROKE_RTOL)
     p = _gauge_pressure(s, p_atm)
@@ -364,11 +379,13 @@ def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_lim
     if limit == 0:
         kappa = kappa_full
     else:
-        # p* < p(s_max): start Newton from the solved curve near p*, or from the full-stroke
-        # curvature scaled by the pressure
-        guess = _curvature_guess(p, pressures, kappas, n)
-        if guess <= 0.0:
-            guess = kappa_full * p / _gauge_pressure(s_max, p_atm)
+        # p* < p(s_max): start from the solved curve around p*, else from the full-stroke
+        # solve (second-order Taylor when it was made here, else scaled by the pressure)
+        guess = _curvature_start(p, pressures, kappas, rates, rates2, n)
+        if guess <= 0.0 and solved:
+            guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
+        if not guess > 0.0:
+            guess = kappa_full * p / p_full
         kappa = _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, NEWTON_RTOL, False)
     return s, limit, p, moment, kappa, force, kappa_full
 

@@ -49,6 +49,29 @@ def _stress_and_slope(stretch, mu, alpha):
 
 
 @formula
+def _stress_slope_curvature(stretch, mu, alpha):
+    """S(l) [Pa], dS/dl [Pa] and d2S/dl2 [Pa] of :func:`_stress_and_slope`'s stress.
+
+    d2S/dl2 = sum mu_i ((a_i-1)(a_i-2) l^(a_i-3) - (a_i+1)(a_i+2) l^(-a_i-3)): from the same
+    powers, so the second derivative (Halley's step of the curvature solve, docs/model.md
+    s. 12) costs a few multiplies.
+    """
+    ln = math.log(stretch)
+    inv_l2 = 1.0 / (stretch * stretch)
+    s = 0.0
+    ds = 0.0
+    d2s = 0.0
+    for i in range(mu.shape[0]):
+        a = alpha[i]
+        e1 = math.exp((a - 1.0) * ln)
+        e2 = inv_l2 / e1
+        s += mu[i] * (e1 - e2)
+        ds += mu[i] * ((a - 1.0) * e1 + (a + 1.0) * e2)
+        d2s += mu[i] * ((a - 1.0) * (a - 2.0) * e1 - (a + 1.0) * (a + 2.0) * e2)
+    return s, ds / stretch, d2s * inv_l2
+
+
+@formula
 def _equibiaxial_stress_and_slope(stretch, mu, alpha):
     """Nominal hoop stress of the paper's eq. (10)-(12) state and its slope [Pa].
 
