@@ -270,7 +270,7 @@ def _curvature_solve(moment, y, wy, wyy, work, mu, alpha, guess, rtol, cauchy):
 
     Each evaluation of the section gives M_S and its first two derivatives, and Halley's step
     ``f / (f' - f f'' / (2 f'))`` converges cubically: after a step delta the error is about
-    C delta^3 / kappa^2 with C <= 3.5 over the accepted range (every set, both stresses;
+    C delta^3 / kappa^2 with C <= 3.4 over the accepted range (every set, both stresses;
     docs/model.md s. 12). So the solve stops after a step with |delta| <= rtol^(2/3) kappa
     (1e-6 for rtol 1e-9, an error below 4e-18 relative), without evaluating again: one
     evaluation a solve from a close start. ``guess`` <= 0 starts from the root of the

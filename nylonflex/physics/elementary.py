@@ -7,8 +7,9 @@ AVX2) without ``fastmath``: the material moment (:func:`.bending._section_moment
 docs/model.md s. 12). They are fdlibm's ``e_log.c`` and ``e_exp.c`` (Sun Microsystems,
 freely distributable; the same constants and polynomials as musl's ``log`` and ``exp``)
 with the branches for special arguments replaced by selects: within one unit in the last
-place of the correctly rounded result, measured against the C library on 2 million
-arguments each (``tests/test_kernels.py``). The IEEE bits are read and written by two
+place of the C library's result, measured on 2 million arguments each (1.9 % of the logs
+and 9.7 % of the exps differ from it by that unit; ``tests/test_kernels.py`` checks
+400,000). The IEEE bits are read and written by two
 primitives (:func:`._formula.primitive`): :mod:`struct` in Python, one bit cast each in the
 kernels, so the functions run as plain Python too, with the same bits.
 """
