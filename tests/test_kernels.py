@@ -1,11 +1,19 @@
 """The compiled kernels against the physics functions (rtol 1e-9, docs/model.md section 11)."""
 
+import math
+import platform
+import re
+
+import numba
 import numpy as np
 import pytest
 
 from nylonflex import design_limits
 from nylonflex.config import parse_config
-from nylonflex.physics import bending, chamber, nylon, wrap
+from nylonflex.kernels import _compile  # noqa: F401  (registers the formulas with Numba)
+from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
+from nylonflex.physics import bending, chamber, elementary, nylon, wrap
+from nylonflex.physics.elementary import _exp, _log
 from nylonflex.engine.grid import compute_slab
 from nylonflex.sweep import run_sweep
 
@@ -88,3 +96,108 @@ def test_slabs_do_not_change_results():
     parts = [compute_slab(cfg, i, i + 1) for i in range(4)]
     for name in whole:
         np.testing.assert_array_equal(whole[name], np.concatenate([p[name] for p in parts]))
+
+
+# --- the section moment's SIMD-friendly log and exp, and the Halley solve (docs/model.md
+# s. 12) ---------------------------------------------------------------------------------
+
+
+@numba.njit(error_model="numpy")
+def _logs_and_exps(x, out_log, y, out_exp):
+    for i in range(x.shape[0]):
+        out_log[i] = _log(x[i])
+    for i in range(y.shape[0]):
+        out_exp[i] = _exp(y[i])
+
+
+def test_log_and_exp_are_within_an_ulp_of_the_c_library_compiled_or_not():
+    rng = np.random.default_rng(3)
+    x = np.concatenate([np.exp(rng.uniform(-700.0, 700.0, 200_000)),
+                        1.0 + rng.uniform(0.0, 4.0, 200_000), 1.0 + rng.uniform(0, 1e-6, 10_000),
+                        [1.0, 2.0, math.sqrt(2.0), 5e-308, 1.7e308]])
+    y = np.concatenate([rng.uniform(-745.0, 709.7, 200_000), rng.uniform(-40.0, 40.0, 200_000),
+                        [0.0, -0.0, 1e-300, -1e-300, 709.78]])
+    out_log, out_exp = np.empty_like(x), np.empty_like(y)
+    _logs_and_exps(x, out_log, y, out_exp)
+    libm_log = np.array([math.log(v) for v in x])
+    libm_exp = np.array([math.exp(v) for v in y])
+    assert np.all(np.abs(out_log - libm_log) <= np.spacing(np.abs(libm_log))), "log"
+    assert out_log[x == 1.0][0] == 0.0
+    normal = libm_exp > 2.2250738585072014e-308  # below it the C library's is subnormal too
+    assert np.all(np.abs(out_exp - libm_exp)[normal] <= np.spacing(libm_exp[normal])), "exp"
+    # the same bits uncompiled (the physics layer's reference runs them as Python)
+    for i in rng.choice(x.size, 300):
+        assert elementary._log(float(x[i])) == out_log[i]
+    for i in rng.choice(y.size, 300):
+        assert elementary._exp(float(y[i])) == out_exp[i]
+    specials = np.array([800.0, 710.0, -746.0, -800.0, math.inf, -math.inf, math.nan])
+    got = np.empty_like(specials)
+    _logs_and_exps(np.array([math.nan]), np.empty(1), specials, got)
+    np.testing.assert_array_equal(got, [math.inf, math.inf, 0.0, 0.0, math.inf, 0.0, math.nan])
+    assert math.isnan(elementary._log(math.nan)) and math.isnan(elementary._exp(math.nan))
+
+
+@pytest.mark.parametrize("name", list(SILICONE_PARAMETERS))
+@pytest.mark.parametrize("cauchy", [False, True])
+def test_section_moment_and_its_two_derivatives(name, cauchy):
+    mu, alpha = silicone_parameters(name).arrays()
+    y, wy, wyy, work = bending._node_table(12e-3, 3e-3, 3e-3, *bending.quadrature_nodes())
+
+    def numpy_moment(kappa):  # the sums of docs/model.md s. 12 with NumPy's powers
+        lam = 1.0 + kappa * y
+        s = sum(m * (lam ** (a - 1) - lam ** (-a - 1)) for m, a in zip(mu, alpha))
+        ds = sum(m * ((a - 1) * lam ** (a - 2) + (a + 1) * lam ** (-a - 2))
+                 for m, a in zip(mu, alpha))
+        d2s = sum(m * ((a - 1) * (a - 2) * lam ** (a - 3) - (a + 1) * (a + 2) * lam ** (-a - 3))
+                  for m, a in zip(mu, alpha))
+        if cauchy:
+            s, ds, d2s = lam * s, s + lam * ds, 2 * ds + lam * d2s
+        return np.sum(wy * s), np.sum(wyy * ds), np.sum(wyy * y * d2s)
+
+    for kappa in (0.5, 20.0, 120.0):
+        got = bending._section_moment(kappa, y, wy, wyy, work, mu, alpha, cauchy)
+        np.testing.assert_allclose(got, numpy_moment(kappa), rtol=1e-12)
+        h = 1e-4 * kappa  # and the derivatives are M_S's: central differences, O(h^2)
+        up = bending._section_moment(kappa + h, y, wy, wyy, work, mu, alpha, cauchy)
+        down = bending._section_moment(kappa - h, y, wy, wyy, work, mu, alpha, cauchy)
+        assert got[1] == pytest.approx((up[0] - down[0]) / (2 * h), rel=1e-6)
+        assert got[2] == pytest.approx((up[1] - down[1]) / (2 * h), rel=1e-6)
+
+
+def test_curvature_solve_stops_after_one_evaluation_from_a_close_start(monkeypatch):
+    # Halley's error after a step delta is ~C delta^3 / kappa^2 with C <= 3.4: a step below
+    # 1e-6 kappa is accepted without evaluating again (docs/model.md s. 12)
+    mu, alpha = silicone_parameters("ecoflex_00_30").arrays()
+    y, wy, wyy, work = bending._node_table(9e-3, 1.2e-3, 1.2e-3, *bending.quadrature_nodes())
+    moment = bending._pressure_moment(12e3, 9e-3, 1.2e-3)
+    args = (y, wy, wyy, work, mu, alpha)
+    exact = bending._curvature_solve(moment, *args, 0.0, 1e-13, False)[0]
+    evaluations = []
+    moment_of = bending._section_moment
+    monkeypatch.setattr(bending, "_section_moment",
+                        lambda *a: evaluations.append(a[0]) or moment_of(*a))
+    for start, count in ((1 + 5e-7, 1), (1 - 5e-7, 1), (1 + 3e-5, 2), (1.3, 3)):
+        evaluations.clear()
+        kappa, dm, d2m = bending._curvature_solve(moment, *args, exact * start,
+                                                  bending.NEWTON_RTOL, False)
+        assert len(evaluations) == count, start
+        assert kappa == pytest.approx(exact, rel=3e-15, abs=0.0), start
+    # a step below an ulp of kappa stays in the bracket (it used to start doubling)
+    evaluations.clear()
+    assert bending._curvature_solve(moment, *args, exact, bending.NEWTON_RTOL, False)[0] \
+        == pytest.approx(exact, rel=3e-15, abs=0.0)
+    assert len(evaluations) == 1
+
+
+def test_section_moment_compiles_to_a_loop_without_calls_to_log_or_exp():
+    # the condition for LLVM to vectorise it: this llvmlite has no vector log or exp (SVML)
+    @numba.njit(error_model="numpy")
+    def moment(kappa, y, wy, wyy, work, mu, alpha):
+        return bending._section_moment(kappa, y, wy, wyy, work, mu, alpha, False)
+
+    mu, alpha = silicone_parameters("tc5005").arrays()
+    moment(10.0, *bending._node_table(8e-3, 2e-3, 2e-3, *bending.quadrature_nodes()), mu, alpha)
+    asm = next(iter(moment.inspect_asm().values()))
+    assert not re.search(r"\$_*(log|exp)\b", asm)
+    if platform.machine().lower() in ("x86_64", "amd64"):
+        assert re.search(r"\bv?mulpd\b", asm)  # packed: the node loops are vectorised

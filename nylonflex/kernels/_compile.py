@@ -4,7 +4,10 @@ The physics modules mark their small pure functions with ``@formula`` and never 
 Numba. This module registers every formula with Numba's own mechanism for calling plain
 Python functions from jitted code (``numba.extending.register_jitable``): a kernel calls the
 physics function by its ordinary name and Numba compiles that very function into it. One
-formula, one place; both layers run the same source lines.
+formula, one place; both layers run the same source lines. The two ``@primitive`` functions
+(the bits of a float and back, :mod:`nylonflex.physics.elementary`) are the exception: plain
+Python cannot express a bit cast that Numba compiles, so they get a compiled form here, one
+LLVM ``bitcast`` each, with the same result.
 
 Numba's cache checks only the timestamp of the file that holds a kernel, not of the
 formulas it compiles in from other files, so the cache folder is keyed on a digest of every
@@ -22,7 +25,9 @@ from functools import lru_cache
 from pathlib import Path
 
 import numba
-from numba.extending import register_jitable
+from llvmlite import ir
+from numba.core import types as nb_types
+from numba.extending import intrinsic, overload, register_jitable
 
 #: Options of every kernel. ``cache`` writes compiled code to a folder keyed on the model
 #: sources so a second run starts warm; ``fastmath`` stays off: the kernels must match the
@@ -73,6 +78,50 @@ def _register_formulas():
                 obj.__nylonflex_registered__ = True
 
 
+@intrinsic
+def _bitcast_float_int(typingctx, x):
+    """The IEEE 754 bits of a float64 as an int64: one LLVM ``bitcast``."""
+    if not isinstance(x, nb_types.Float):
+        return None
+
+    def codegen(context, builder, signature, args):
+        value = context.cast(builder, args[0], x, nb_types.float64)
+        return builder.bitcast(value, ir.IntType(64))
+
+    return nb_types.int64(x), codegen
+
+
+@intrinsic
+def _bitcast_int_float(typingctx, bits):
+    """The float64 whose IEEE 754 bits are an int64: one LLVM ``bitcast``."""
+    if not isinstance(bits, nb_types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        value = context.cast(builder, args[0], bits, nb_types.int64)
+        return builder.bitcast(value, ir.DoubleType())
+
+    return nb_types.float64(bits), codegen
+
+
+def _register_primitives():
+    """Compile the physics layer's ``@primitive`` functions (plain Python there) to bit casts."""
+    from ..physics import elementary
+
+    def float_bits(x):
+        return lambda x: _bitcast_float_int(x)
+
+    def bits_float(bits):
+        return lambda bits: _bitcast_int_float(bits)
+
+    for func, impl in ((elementary._float_bits, float_bits),
+                       (elementary._bits_float, bits_float)):
+        if not getattr(func, "__nylonflex_registered__", False):
+            overload(func)(impl)
+            func.__nylonflex_registered__ = True
+
+
+_register_primitives()
 _register_formulas()
 
 

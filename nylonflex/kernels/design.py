@@ -27,9 +27,9 @@ import math
 import numpy as np
 from numba import prange
 
-from ..physics.bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates,
-                               _curvature_solve, _curvature_start, _pressure_moment,
-                               _section_nodes)
+from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
+                               _curvature_rates, _curvature_solve, _curvature_start,
+                               _node_count, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _design_state, _design_values, _model_state,
@@ -99,7 +99,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             stroke_hoop[js] = _equibiaxial_stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
         else:
             stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
-    n_nodes = x_base.shape[0] + 2 * w_phi.shape[0]
+    n_nodes = _node_count(x_base, w_phi)
     for k in prange(na * nt):
         ia = k // nt
         it = k % nt
@@ -109,6 +109,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         y_nodes = np.empty(n_nodes)
         wy_nodes = np.empty(n_nodes)
         wyy_nodes = np.empty(n_nodes)
+        work = np.empty((MOMENT_WORK_ROWS, n_nodes))
         _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
         # the bend-angle curve first, with dkappa/dp and d2kappa/dp2: each solve starts from
         # the previous ones, and they start the coil loop's solves
@@ -119,7 +120,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         for jp in range(npr):
             moment = _pressure_moment(pressure[jp], a, b)
             kappa, dm, d2m = _curvature_solve(
-                moment, y_nodes, wy_nodes, wyy_nodes, mu, alpha,
+                moment, y_nodes, wy_nodes, wyy_nodes, work, mu, alpha,
                 _curvature_start(pressure[jp], pressure, kappa_curve, rate_curve, rate2_curve,
                                  jp), NEWTON_RTOL, cauchy)
             kappa_curve[jp] = kappa
@@ -138,9 +139,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             if default:
                 p_full = _gauge_pressure(s_max, p_atm)
                 kappa_full = _curvature_nodes(
-                    _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, mu, alpha,
-                    _curvature_start(p_full, pressure, kappa_curve, rate_curve, rate2_curve,
-                                     n_curve), NEWTON_RTOL, False)
+                    _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, work, mu,
+                    alpha, _curvature_start(p_full, pressure, kappa_curve, rate_curve,
+                                            rate2_curve, n_curve), NEWTON_RTOL, False)
                 # the working temperatures of a stroke-limited design (s* = s_max) depend
                 # on the coil index only: once per C, not per wrap angle
                 temps_full = _working_temperatures(model, s_max, t_max, scale, t_amb, t_max,
@@ -152,9 +153,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 lever = pitch / math.cos(wrap[ip])
                 if default:
                     st = _stroke_state_nodes(a, t, b, lever, f_lim, s_max, kappa_full, mu,
-                                             alpha, y_nodes, wy_nodes, wyy_nodes, p_atm,
-                                             pressure, kappa_curve, rate_curve, rate2_curve,
-                                             n_curve)
+                                             alpha, y_nodes, wy_nodes, wyy_nodes, work,
+                                             p_atm, pressure, kappa_curve, rate_curve,
+                                             rate2_curve, n_curve)
                     closes = False
                     if st[1] == 0:
                         temps = temps_full

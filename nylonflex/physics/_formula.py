@@ -23,6 +23,14 @@ def formula(func):
     return func
 
 
+def primitive(func):
+    """Mark ``func`` as a primitive: a formula may call it, and :mod:`nylonflex.kernels`
+    compiles it to machine instructions of its own (a bit cast) with the same result, bit
+    for bit, because the Python form here does not compile (it is returned unchanged)."""
+    func.__nylonflex_primitive__ = True
+    return func
+
+
 def check(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False, unit=""):
     """Return ``value`` as a float array after checking it lies in the accepted range.
 

@@ -189,8 +189,8 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
             closes = True
             if s_top > s_close * (1.0 - 1e-9):
                 s_top = s_close * (1.0 - 1e-9)
-    y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                             phi_trig, w_phi)
+    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                                   phi_trig, w_phi)
     rate_full = 0.0
     rate2_full = 0.0
     if closes:
@@ -199,7 +199,8 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
     else:
         p_full = _nylon_pressure(model, s_max, p_atm, solid)
         kappa_full, dm, d2m = _curvature_solve(_pressure_moment(p_full, radius, base_thickness),
-                                               y, wy, wyy, mu, alpha, 0.0, NEWTON_RTOL, cauchy)
+                                               y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
+                                               cauchy)
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
     if model == COUPLED_MUSCLE:
@@ -226,7 +227,8 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
         guess = 0.0
         if p_full < math.inf:  # second-order Taylor from the full-stroke solve
             guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
-        kappa = _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, NEWTON_RTOL, cauchy)
+        kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
+                                 cauchy)
     return s, limit, p, moment, kappa, force, kappa_full, closes
 
 
@@ -348,17 +350,19 @@ def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_
     ``kappa_full`` is the curvature at p(s_max) (<= 0: computed here). Returns
     (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full).
     """
-    y, wy, wyy = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                             phi_trig, w_phi)
+    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                                   phi_trig, w_phi)
     return _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit,
-                               s_max, kappa_full, mu, alpha, y, wy, wyy, p_atm, y, y, y, y, 0)
+                               s_max, kappa_full, mu, alpha, y, wy, wyy, work, p_atm, y, y, y,
+                               y, 0)
 
 
 @formula
 def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                        kappa_full, mu, alpha, y, wy, wyy, p_atm, pressures, kappas, rates,
-                        rates2, n):
-    """:func:`_stroke_state` on a section's node table, with ``n`` solved points of kappa(p)
+                        kappa_full, mu, alpha, y, wy, wyy, work, p_atm, pressures, kappas,
+                        rates, rates2, n):
+    """:func:`_stroke_state` on a section's node table and scratch (:func:`_section_moment`),
+    with ``n`` solved points of kappa(p)
     and its first two derivatives in p (``pressures[:n]``, ``kappas[:n]``, ``rates[:n]``,
     ``rates2[:n]``, :func:`_curvature_start`) to start the curvature solves from (none:
     ``n`` = 0)."""
@@ -368,7 +372,7 @@ def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_lim
     rate2_full = 0.0
     if solved:
         kappa_full, dm, d2m = _curvature_solve(
-            _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, mu, alpha,
+            _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, work, mu, alpha,
             _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, False)
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
@@ -386,7 +390,8 @@ def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_lim
             guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
         if not guess > 0.0:
             guess = kappa_full * p / p_full
-        kappa = _curvature_nodes(moment, y, wy, wyy, mu, alpha, guess, NEWTON_RTOL, False)
+        kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
+                                 False)
     return s, limit, p, moment, kappa, force, kappa_full
 
 

@@ -33,8 +33,9 @@ def _stress_and_slope(stretch, mu, alpha):
     """Plane-strain nominal stress S(l) = sum mu_i (l^(a_i-1) - l^(-a_i-1)) [Pa] and dS/dl.
 
     This is sigma_1 / l with sigma_1 = sum mu_i (l^a_i - l^-a_i), the Ogden Cauchy stress
-    for l2 = 1, l3 = 1/l, sigma_3 = 0 (docs/model.md section 5). The hot spot of every kernel:
-    one log for all terms and one exp a term, since l^(-a-1) = 1 / (l^(a-1) l^2).
+    for l2 = 1, l3 = 1/l, sigma_3 = 0 (docs/model.md section 5). One log for all terms and
+    one exp a term, since l^(-a-1) = 1 / (l^(a-1) l^2); the material moment computes the same
+    powers in its own vectorised loop (:func:`.bending._section_moment`).
     """
     ln = math.log(stretch)
     inv_l2 = 1.0 / (stretch * stretch)
@@ -46,29 +47,6 @@ def _stress_and_slope(stretch, mu, alpha):
         s += mu[i] * (e1 - e2)
         ds += mu[i] * ((alpha[i] - 1.0) * e1 + (alpha[i] + 1.0) * e2)
     return s, ds / stretch
-
-
-@formula
-def _stress_slope_curvature(stretch, mu, alpha):
-    """S(l) [Pa], dS/dl [Pa] and d2S/dl2 [Pa] of :func:`_stress_and_slope`'s stress.
-
-    d2S/dl2 = sum mu_i ((a_i-1)(a_i-2) l^(a_i-3) - (a_i+1)(a_i+2) l^(-a_i-3)): from the same
-    powers, so the second derivative (Halley's step of the curvature solve, docs/model.md
-    s. 12) costs a few multiplies.
-    """
-    ln = math.log(stretch)
-    inv_l2 = 1.0 / (stretch * stretch)
-    s = 0.0
-    ds = 0.0
-    d2s = 0.0
-    for i in range(mu.shape[0]):
-        a = alpha[i]
-        e1 = math.exp((a - 1.0) * ln)
-        e2 = inv_l2 / e1
-        s += mu[i] * (e1 - e2)
-        ds += mu[i] * ((a - 1.0) * e1 + (a + 1.0) * e2)
-        d2s += mu[i] * ((a - 1.0) * (a - 2.0) * e1 - (a + 1.0) * (a + 2.0) * e2)
-    return s, ds / stretch, d2s * inv_l2
 
 
 @formula
