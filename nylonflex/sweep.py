@@ -55,8 +55,11 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
     if out is None:
-        _warm_up(cfg, workers, scheduler, log)
-        return _in_memory(cfg, workers, scheduler, progress)
+        from .engine.slabs import deferred_signals
+
+        with deferred_signals(on_second=_interrupt):
+            _warm_up(cfg, workers, scheduler, log)
+            return _in_memory(cfg, workers, scheduler, progress)
     from .storage import open_cube
 
     sweep_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
@@ -71,11 +74,21 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
     The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
     command line uses it: a sweep without charts never imports xarray.
     """
+    from .engine.slabs import deferred_signals
     from .storage import sweep_to_file
 
-    _warm_up(cfg, workers, scheduler, log)
-    return sweep_to_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
-                         progress=progress, log=log, overwrite=overwrite)
+    # from here on Ctrl-C and SIGTERM are recorded, never raised inside a finaliser (where
+    # Python would print and drop them): the slab loop stops on them, before or after a slab
+    with deferred_signals(on_second=_interrupt):
+        _warm_up(cfg, workers, scheduler, log)
+        return sweep_to_file(cfg, out, resume=resume, workers=workers,
+                             scheduler=scheduler, progress=progress, log=log,
+                             overwrite=overwrite)
+
+
+def _interrupt():
+    """The second Ctrl-C while a run is set up: stop at once."""
+    raise KeyboardInterrupt
 
 
 def _warm_up(cfg, workers, scheduler, log):

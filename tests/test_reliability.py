@@ -7,6 +7,7 @@ disk. The fast ones run in-process on small grids; the kill-and-resume loops are
 """
 
 import errno
+from pathlib import Path
 import fcntl
 import os
 import random
@@ -190,7 +191,21 @@ def _tamper_arrays(parts):
         np.savez(fh, **arrays)
 
 
-@pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_deflate,
+def _tamper_copy(parts):
+    # a slab replaced by a copy of another (the old journal resumed it: 17 % NaN, complete)
+    shutil.copy(parts / "slab-000001.npz", parts / "slab-000000.npz")
+
+
+def _tamper_foreign(parts):
+    # a slab replaced by the same slab of another config's journal (old: wrong values)
+    other = parts.parent / "other" / "cube.h5"
+    other.parent.mkdir()
+    interrupted(other, k=1, raw={**MULTI, "silicone": "ecoflex_00_30"})
+    shutil.copy(Journal(other).dir / "slab-000000.npz", parts / "slab-000000.npz")
+
+
+@pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_copy, _tamper_deflate,
+                                    pytest.param(_tamper_foreign, marks=pytest.mark.slow),
                                     pytest.param(_tamper_empty, marks=pytest.mark.slow),
                                     pytest.param(_tamper_arrays, marks=pytest.mark.slow)])
 def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
@@ -204,12 +219,17 @@ def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
     xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
 
 
-def test_an_edited_manifest_is_refused(tmp_path):
+@pytest.mark.parametrize("edit", [
+    lambda doc: doc.update(radius_chunk=doc["radius_chunk"] + 1),
+    # slabs 0-2 declared as one of 9 radii (the old journal resumed it: 33 % NaN, complete)
+    lambda doc: doc.update(slabs=[[0, 9], *doc["slabs"][3:]]),
+], ids=["radius_chunk", "slab_plan"])
+def test_an_edited_manifest_is_refused(tmp_path, edit):
     out = tmp_path / "cube.h5"
     interrupted(out, k=3)
     manifest = Journal(out).manifest
     doc = json.loads(manifest.read_text())
-    doc["radius_chunk"] += 1  # any edit the digest does not cover
+    edit(doc)  # any edit the digest does not cover
     manifest.write_text(json.dumps(doc))
     with pytest.raises(InputError, match="damaged or was edited"):
         resume(out)
@@ -346,6 +366,23 @@ def test_simulate_never_writes_over_a_cube(tmp_path, small_cfg):
     assert out.read_bytes() == before
 
 
+def test_every_rename_that_publishes_follows_an_fsync(tmp_path, small_cfg, monkeypatch):
+    # a slab, the manifest and the cube are renamed into place only after their bytes
+    # (and, for the cube, its folder) are on disk (the old code called fsync nowhere)
+    log, real_fsync, real_replace = [], os.fsync, os.replace
+    monkeypatch.setattr(os, "fsync", lambda fd: (log.append("fsync"), real_fsync(fd))[1])
+    monkeypatch.setattr(os, "replace",
+                        lambda a, b: (log.append(("replace", str(b))), real_replace(a, b))[1])
+    raw, cfg = small_cfg
+    assert sweep(cfg, tmp_path / "cube.h5") == 0
+    renames = [i for i, entry in enumerate(log) if entry != "fsync"]
+    published = {Path(log[i][1]).name for i in renames}
+    assert "cube.h5" in published and "manifest.json" in published
+    assert any(name.startswith("slab-") for name in published)
+    for i in renames:
+        assert i > 0 and log[i - 1] == "fsync", log[i]
+
+
 # --------------------------------------------------------------------------- 2, 10. input
 
 def _bomb(levels=9):
@@ -385,9 +422,13 @@ def test_an_alias_bomb_is_refused_quickly_in_little_memory(tmp_path, levels):
 
 @pytest.mark.parametrize("text,match", [
     ("a: " + "[" * 200 + "]" * 200 + "\n", "nested deeper"),
+    # deep enough that a recursive reader fails (RecursionError from depth ~500)
+    ("a: " + "[" * 5000 + "]" * 5000 + "\n", "nested deeper"),
     ("name: x\nname: y\n", "appears twice"),
+    # a complete config with a second name: a reader that lets the last win runs it
+    (yaml.safe_dump(MULTI) + "name: second\n", "appears twice"),
     ("a: &x [*x]\n", "not valid YAML|refers to itself"),
-])
+], ids=["depth200", "depth5000", "duplicate", "duplicate_in_a_whole_config", "self_alias"])
 def test_hostile_yaml_is_one_line_exit_2(tmp_path, capsys, text, match):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(text)
@@ -397,17 +438,23 @@ def test_hostile_yaml_is_one_line_exit_2(tmp_path, capsys, text, match):
     assert __import__("re").search(match, err), err
 
 
-def test_deep_set_and_non_utf8_config(tmp_path, small_cfg, capsys):
+@pytest.mark.parametrize("setting", [".".join(["a"] * 5000) + "=1",
+                                     "name=" + "[" * 2000 + "]" * 2000],
+                         ids=["deep_key", "deep_value"])
+def test_a_deep_set_is_one_line_exit_2(tmp_path, small_cfg, capsys, setting):
     raw, cfg = small_cfg
-    assert main(["sweep", str(cfg), "--set", ".".join(["a"] * 5000) + "=1"]) == 2
-    assert "nested deeper" in capsys.readouterr().err
-    assert main(["sweep", str(cfg), "--set", "name=" + "[" * 2000 + "]" * 2000]) == 2
-    capsys.readouterr()
+    assert main(["sweep", str(cfg), "--out", str(tmp_path / "c.h5"), "--set", setting]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "RecursionError" not in err, err
+    assert "nested deeper" in err, err
+
+
+def test_a_non_utf8_config_names_its_file(tmp_path, capsys):
     bad = tmp_path / "latin1.yaml"
     bad.write_bytes("name: caf\xe9\n".encode("latin-1"))
     assert main(["sweep", str(bad)]) == 2
     err = capsys.readouterr().err
-    assert str(bad) in err and "UTF-8" in err
+    assert err.count("\n") == 1 and str(bad) in err and "UTF-8" in err
 
 
 @pytest.mark.parametrize("path,value", [
@@ -431,15 +478,28 @@ def test_messages_print_only_a_prefix_of_a_huge_value():
 
 # --------------------------------------------------------------------------- 6. budget
 
-def test_a_huge_grid_is_refused_before_any_file(tmp_path, capsys):
+_BOUNDED = """
+import resource, sys
+resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
+resource.setrlimit(resource.RLIMIT_FSIZE, (64 * 2**20, 64 * 2**20))
+from nylonflex.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_a_huge_grid_is_refused_before_any_file(tmp_path):
     raw = {**MULTI, "grid": {**MULTI["grid"],
                              "radius": {"start": 1, "stop": 50, "num": 100_000},
                              "wall_thickness": {"start": 1, "stop": 6, "num": 100_000},
                              "length": {"start": 20, "stop": 200, "num": 100}}}
     cfg = write_config(tmp_path, raw)
     out = tmp_path / "run" / "cube.h5"
-    assert main(["sweep", str(cfg), "--out", str(out)]) == 2
-    err = capsys.readouterr().err
+    # in a bounded process (memory, file size, time): code with the bug would start
+    # writing a 10^12-design cube
+    proc = subprocess.run([sys.executable, "-c", _BOUNDED, "sweep", str(cfg), "--out",
+                           str(out)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    err = proc.stderr
     assert "designs" in err and "GB" in err and "limits" in err
     assert not (tmp_path / "run").exists()
     raw["grid"]["radius"]["num"] = 10
@@ -451,7 +511,8 @@ def test_a_huge_grid_is_refused_before_any_file(tmp_path, capsys):
 
 def test_long_value_lists_are_capped():
     raw = yaml.safe_load(yaml.safe_dump(MULTI))
-    raw["curves"]["stroke"] = {"values": [0.01] * 200_001}
+    # increasing (a valid axis but for its length): 200,001 strokes would be 52 GB of curves
+    raw["curves"]["stroke"] = {"values": [float(x) for x in np.linspace(0, 0.1, 200_001)]}
     with pytest.raises(InputError, match="at most"):
         parse_config(raw)
 
@@ -581,6 +642,63 @@ def test_a_signal_while_a_slab_computes_stops_after_it(tmp_path):
     cfg = parse_config(MULTI)
     stats = run_slabs(cfg, [(0, 4), (4, 8), (8, 12)], [0, 1, 2], Executor(), Sink())
     assert stats.stopped and Sink.stored == [0, 1]
+
+
+_FINALISER_SIGNAL = """
+import os, signal, sys
+import nylonflex.engine.slabs as slabs
+import nylonflex.storage.run as run_mod
+
+WHERE, SIG = sys.argv[1], int(sys.argv[2])
+
+
+class Finalised:  # the signal lands inside a finaliser, where Python drops an exception
+    def __del__(self):
+        os.kill(os.getpid(), SIG)
+        for _ in range(1000):
+            pass
+
+
+def fire():
+    x = Finalised()
+    del x
+
+
+class Executor(run_mod.LocalExecutor):
+    def __init__(self, *args, **kwargs):
+        if WHERE == "setup":  # while the run is set up, before any slab
+            fire()
+        super().__init__(*args, **kwargs)
+
+    def map_slabs(self, cfg, plan, todo):
+        for n, (k, arrays) in enumerate(super().map_slabs(cfg, plan, todo)):
+            if WHERE == "loop" and n == 1:
+                fire()
+            yield k, arrays
+
+
+run_mod.LocalExecutor = Executor
+from nylonflex.cli import main
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("where", ["setup", "loop"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["INT", "TERM"])
+def test_a_signal_in_a_finaliser_is_never_swallowed(tmp_path, where, sig):
+    # Python prints "Exception ignored" and drops a KeyboardInterrupt raised inside a
+    # finaliser; the run must stop anyway (the old code ran on to exit 0)
+    cfg = write_config(tmp_path, MULTI)
+    out = tmp_path / "cube.h5"
+    proc = subprocess.run([sys.executable, "-c", _FINALISER_SIGNAL, where, str(int(sig)),
+                           "sweep", str(cfg), "--out", str(out), "--no-charts"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 130, (proc.returncode, proc.stderr)
+    assert "Traceback" not in proc.stderr and "ignored" not in proc.stderr, proc.stderr
+    assert "--resume" in proc.stderr
+    ds = open_cube(out, quiet=True)
+    assert ds.attrs["complete"] == "false"
+    ds.close()
 
 
 _SIGNAL_AT = """

@@ -49,27 +49,46 @@ class _Stop(Exception):
     """Raised by the SIGTERM handler to stop a sweep like Ctrl-C does."""
 
 
+#: The signal record of the outermost :func:`deferred_signals` scope, and the second-signal
+#: action of each open scope (innermost last); None outside any scope.
+_SCOPE: dict | None = None
+
+
 @contextlib.contextmanager
 def deferred_signals(on_second=None):
     """Record SIGINT and SIGTERM instead of acting on them; yields the list of signals seen.
 
     ``on_second`` (a callable) runs on the second signal (e.g. raise to stop at once);
-    without it every signal is only recorded. Outside the main thread it does nothing.
+    without it every signal is only recorded. Scopes nest: an inner one shares the outer
+    one's record, so a Ctrl-C that came while a run was being set up (compiling, opening
+    files) is seen by the slab loop, which then stops before it computes anything; while
+    the inner scope is open its ``on_second`` applies. Outside the main thread it does
+    nothing.
     """
-    seen: list = []
+    global _SCOPE
     if threading.current_thread() is not threading.main_thread():
-        yield seen
+        yield []
         return
+    if _SCOPE is not None:  # nested: same record, this scope's second-signal action
+        _SCOPE["actions"].append(on_second)
+        try:
+            yield _SCOPE["seen"]
+        finally:
+            _SCOPE["actions"].pop()
+        return
+    scope = _SCOPE = {"seen": [], "actions": [on_second]}
 
     def handler(signum, frame):
-        seen.append(signum)
-        if len(seen) > 1 and on_second is not None:
-            on_second()
+        scope["seen"].append(signum)
+        action = scope["actions"][-1]
+        if len(scope["seen"]) > 1 and action is not None:
+            action()
 
     previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield seen
+        yield scope["seen"]
     finally:
+        _SCOPE = None
         for sig, old in previous.items():
             signal.signal(sig, old)
 
@@ -147,6 +166,8 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
     t0 = time.perf_counter()
     try:
         with deferred_signals(on_second=stop_now) as seen:
+            if seen:  # Ctrl-C or SIGTERM while the run was set up: stop before computing
+                raise _Stop()
             for k, arrays in executor.map_slabs(cfg, slabs, todo):
                 i0, i1 = slabs[k]
                 sink.put(k, i0, i1, arrays)
