@@ -32,7 +32,7 @@ from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _node_count, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _design_state, _design_values, _model_state,
+                              _design_state, _design_values, _model_state_nodes,
                               _nylon_force_model, _reach,
                               _stroke_state_nodes, _thermal_values, _validity,
                               _working_temperatures)
@@ -58,8 +58,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     nc, npsi), curves as the registry says.
 
     The paper's model without a supply runs the loops it always ran (the stroke state once
-    per (a, t, C, psi)); a variant or a supply runs :func:`_model_state`, per length when
-    the supply makes the reachable stroke depend on the muscle's length.
+    per (a, t, C, psi)); a variant or a supply runs :func:`_model_state_nodes`, per length
+    when the supply makes the reachable stroke depend on the muscle's length, its curvature
+    solves started from the bend-angle curve, which is the model's own kappa(p).
     """
     radius, wall, length, wrap = grid.radius, grid.wall, grid.length, grid.wrap
     stroke, pressure, p_atm = grid.stroke, grid.pressure, grid.p_atm
@@ -128,7 +129,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             for il in range(nl):
                 out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il]
                 out_tip[ia, it, il, jp] = moment / length[il]
-        # curvature solves of the nominal stress may start from it (not the Cauchy variant's)
+        # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
         n_curve = npr if not cauchy else 0
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         for ic in range(nc):
@@ -171,9 +172,11 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                         t_reach, s_free, limited = _reach(
                             s_max, scale, length[il], pitch, a, t, b, wrap[ip], voltage,
                             t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len, loss_per_len)
-                        ms = _model_state(model, a, t, b, lever, f_lim, s_free, s_max,
-                                          force_coeff * (t_reach - t_amb), limited, mu, alpha,
-                                          x_base, w_base, phi_trig, w_phi, p_atm)
+                        ms = _model_state_nodes(
+                            model, a, t, b, lever, f_lim, s_free, s_max,
+                            force_coeff * (t_reach - t_amb), limited, mu, alpha, y_nodes,
+                            wy_nodes, wyy_nodes, work, p_atm, pressure, kappa_curve,
+                            rate_curve, rate2_curve, npr)
                         st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
                         closes = ms[7]
                         temps = _working_temperatures(model, ms[0], t_reach, scale, t_amb,

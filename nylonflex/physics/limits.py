@@ -178,6 +178,21 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
     2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes`` (``incompressible_wall``) when
     the chamber would close before s_max, and then kappa_full is inf (range fraction 0).
     """
+    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                                   phi_trig, w_phi)
+    return _model_state_nodes(model, radius, wall_thickness, base_thickness, lever,
+                              force_limit, s_free, s_max, force_blocked, supply_limited, mu,
+                              alpha, y, wy, wyy, work, p_atm, y, y, y, y, 0)
+
+
+@formula
+def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, force_limit,
+                       s_free, s_max, force_blocked, supply_limited, mu, alpha, y, wy, wyy,
+                       work, p_atm, pressures, kappas, rates, rates2, n):
+    """:func:`_model_state` on a section's node table and scratch, with ``n`` solved points
+    of the model's kappa(p) to start the curvature solves from (:func:`_stroke_state_nodes`;
+    none: ``n`` = 0, the full-stroke solve from its own start and the strength-limited one
+    from a second-order Taylor of it)."""
     cauchy = model == CAUCHY_MOMENT
     solid = 0.0
     closes = False
@@ -189,8 +204,6 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
             closes = True
             if s_top > s_close * (1.0 - 1e-9):
                 s_top = s_close * (1.0 - 1e-9)
-    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                                   phi_trig, w_phi)
     rate_full = 0.0
     rate2_full = 0.0
     if closes:
@@ -198,9 +211,9 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
         p_full = math.inf
     else:
         p_full = _nylon_pressure(model, s_max, p_atm, solid)
-        kappa_full, dm, d2m = _curvature_solve(_pressure_moment(p_full, radius, base_thickness),
-                                               y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
-                                               cauchy)
+        kappa_full, dm, d2m = _curvature_solve(
+            _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, work, mu, alpha,
+            _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, cauchy)
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
     if model == COUPLED_MUSCLE:
@@ -224,8 +237,8 @@ def _model_state(model, radius, wall_thickness, base_thickness, lever, force_lim
     if limit == 0:
         kappa = kappa_full
     else:
-        guess = 0.0
-        if p_full < math.inf:  # second-order Taylor from the full-stroke solve
+        guess = _curvature_start(p, pressures, kappas, rates, rates2, n)
+        if guess <= 0.0 and p_full < math.inf:  # second-order Taylor from the full stroke
             guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
         kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
                                  cauchy)
