@@ -670,8 +670,8 @@ class Executor(run_mod.LocalExecutor):
             fire()
         super().__init__(*args, **kwargs)
 
-    def map_slabs(self, cfg, plan, todo):
-        for n, (k, arrays) in enumerate(super().map_slabs(cfg, plan, todo)):
+    def map_slabs(self, cfg, plan, todo, **kwargs):
+        for n, (k, arrays) in enumerate(super().map_slabs(cfg, plan, todo, **kwargs)):
             if WHERE == "loop" and n == 1:
                 fire()
             yield k, arrays

@@ -113,17 +113,27 @@ class LocalExecutor:
     arithmetic of slab k+1; at most two slabs are in memory.
     """
 
+    #: ``map_slabs`` takes a sink's ``prepare`` (run in the computing thread)
+    prepares = True
+
     def __init__(self, workers=None):
         self.workers = set_workers(workers)
 
     def info(self) -> dict:
         return {"scheduler": "local (numba threads)", "workers": str(self.workers)}
 
-    def map_slabs(self, cfg, slabs, todo):
+    def map_slabs(self, cfg, slabs, todo, prepare=None):
+        """Yield ``(k, arrays)`` as slabs finish; with ``prepare``, ``(k, prepare(i0,
+        arrays))``, called in the computing thread (a sink's compression starts there)."""
+
+        def job(i0, i1):
+            arrays = compute_slab(cfg, i0, i1)
+            return arrays if prepare is None else prepare(i0, arrays)
+
         with ThreadPoolExecutor(1, thread_name_prefix="nylonflex-slab") as pool:
             pending = None
             for k in todo:
-                future = pool.submit(compute_slab, cfg, *slabs[k])
+                future = pool.submit(job, *slabs[k])
                 if pending is not None:
                     yield pending[0], pending[1].result()
                 pending = (k, future)
@@ -168,7 +178,11 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
         with deferred_signals(on_second=stop_now) as seen:
             if seen:  # Ctrl-C or SIGTERM while the run was set up: stop before computing
                 raise _Stop()
-            for k, arrays in executor.map_slabs(cfg, slabs, todo):
+            prepare = getattr(sink, "prepare", None)
+            slabs_done = (executor.map_slabs(cfg, slabs, todo, prepare=prepare)
+                          if prepare is not None and getattr(executor, "prepares", False)
+                          else executor.map_slabs(cfg, slabs, todo))
+            for k, arrays in slabs_done:
                 i0, i1 = slabs[k]
                 sink.put(k, i0, i1, arrays)
                 stats.done.add(k)

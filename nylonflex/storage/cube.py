@@ -130,11 +130,20 @@ class CubeFile:
     def encode(self, i0: int, arrays: dict) -> dict:
         """The slab of radii from ``i0`` as it will be stored: a flat dict of arrays.
 
-        Chunks that lie wholly inside the slab are shuffled and deflated here, by a small
-        thread pool (zlib releases the GIL; HDF5 would compress them one by one in the
-        writing thread), as ``NAME:offsets``, ``NAME:sizes`` and ``NAME:bytes``; anything
-        else stays a plain array under its name. The journal keeps exactly this, so a slab
-        is compressed once and its journal file is as small as its share of the cube.
+        Chunks that lie wholly inside the slab are shuffled and compressed here, by a small
+        thread pool (zlib, zstd and the compiled shuffle release the GIL; HDF5 would
+        compress them one by one in the writing thread), as ``NAME:offsets``,
+        ``NAME:sizes`` and ``NAME:bytes``; anything else stays a plain array under its
+        name. The journal keeps exactly this, so a slab is compressed once and its journal
+        file is as small as its share of the cube.
+        """
+        return self.encode_finish(self.encode_start(i0, arrays))
+
+    def encode_start(self, i0: int, arrays: dict):
+        """Submit a slab's chunks to the compression pool; :meth:`encode_finish` collects.
+
+        Called from the thread that computed the slab, so its compression overlaps the
+        storing of the previous slab (and the computing of the next).
         """
         out, jobs = {}, []
         for name, data in arrays.items():
@@ -146,6 +155,12 @@ class CubeFile:
                 jobs.append((name, list(self._compress(dset, i0, data))))
             else:
                 out[name] = np.asarray(data)
+        return out, jobs
+
+    @staticmethod
+    def encode_finish(started) -> dict:
+        """Wait for the chunks :meth:`encode_start` submitted: the dict :meth:`encode` gives."""
+        out, jobs = started
         for name, chunks in jobs:
             blobs = [future.result() for _, future in chunks]
             out[f"{name}:offsets"] = np.array([off for off, _ in chunks], dtype=np.int64)

@@ -41,17 +41,47 @@ class DiskFull(RuntimeError):
 
 
 class CubeSink:
-    """Journals each slab, then writes it into the building cube file."""
+    """Journals each slab and writes it into the building cube file.
+
+    :meth:`prepare` starts a slab's compression as soon as it is computed (the executor
+    calls it from the computing thread); :meth:`put` journals it (in a second thread) while
+    it writes it into the cube, and returns once both are done: a slab ``put`` has stored
+    is on disk in the journal.
+    """
 
     def __init__(self, cube: CubeFile, journal: Journal, config_sha: str = ""):
+        from concurrent.futures import ThreadPoolExecutor
+
         self.cube = cube
         self.journal = journal
         self.config_sha = config_sha
+        self._journaling = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-journal")
+
+    def prepare(self, i0, arrays):
+        """Start compressing the slab of radii from ``i0`` (returns what :meth:`put` takes)."""
+        return _Started(self.cube.encode_start(i0, arrays))
 
     def put(self, k, i0, i1, arrays):
-        encoded = self.cube.encode(i0, arrays)
-        self.journal.save(k, encoded, slab=(i0, i1), config_sha=self.config_sha)
-        self.cube.write_encoded(i0, i1, encoded)
+        encoded = self.cube.encode_finish(arrays.started) if isinstance(arrays, _Started) \
+            else self.cube.encode(i0, arrays)
+        saving = self._journaling.submit(self.journal.save, k, encoded, slab=(i0, i1),
+                                         config_sha=self.config_sha)
+        try:
+            self.cube.write_encoded(i0, i1, encoded)
+        finally:
+            saving.result()  # the journal's error (a full disk) first, if both failed
+
+    def close(self):
+        self._journaling.shutdown()
+
+
+class _Started:
+    """A slab whose compression :meth:`CubeSink.prepare` started."""
+
+    __slots__ = ("started",)
+
+    def __init__(self, started):
+        self.started = started
 
 
 def _versions() -> dict:
@@ -251,8 +281,11 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
             progress((i1 - i0) * per_radius)
     keep = kept
     todo = [k for k in range(len(slabs)) if k not in keep]
-    stats = run_slabs(cfg, slabs, todo, executor, CubeSink(cube, journal, cfg.sha256),
-                      progress)
+    sink = CubeSink(cube, journal, cfg.sha256)
+    try:
+        stats = run_slabs(cfg, slabs, todo, executor, sink, progress)
+    finally:
+        sink.close()
     done = len(keep) + len(stats.done)
     complete = not stats.stopped and done == len(slabs)
     seconds = stats.seconds
