@@ -248,6 +248,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         todo.append((name, model, path, fmt, _slice_kwargs(CHARTS[name], chosen)))
     from ._parallel import draw_all
 
+    _plt()  # matplotlib imported once, before the drawing processes fork
+
     def done(k, total, path):  # recorded as each is written: a later failure keeps them ours
         owned.record([path])
         if progress is not None:
