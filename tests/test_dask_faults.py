@@ -114,19 +114,28 @@ def _assert_one_line(err):
     return lines[0]
 
 
-def test_every_worker_gone_stops_on_the_watchdog_and_resumes(tmp_path, scheduler):
-    _, address = scheduler
+def _break_after_first_slab(tmp_path, address, fault):
+    """Sweep ``CONFIG`` on one worker; ``fault(worker)`` once a slab is journaled.
+
+    Returns the config path, the cube path, the sweep's exit status and its stderr.
+    """
     cfg = tmp_path / "faults.yaml"
     cfg.write_text(CONFIG)
     out = tmp_path / "cube.h5"
     worker = _worker(address, tmp_path, "w1")
     try:
         run = _sweep(cfg, out, address)
-        _after_first_slab(out, run, lambda: _stop(worker))
+        _after_first_slab(out, run, lambda: fault(worker))
         _, err = run.communicate(timeout=120)
     finally:
         _stop(worker)
-    assert run.returncode == 1, err
+    return cfg, out, run.returncode, err
+
+
+def test_every_worker_gone_stops_on_the_watchdog_and_resumes(tmp_path, scheduler):
+    _, address = scheduler
+    cfg, out, returncode, err = _break_after_first_slab(tmp_path, address, _stop)
+    assert returncode == 1, err
     line = _assert_one_line(err)
     assert "no Dask worker is alive" in line and "--resume" in line
     assert not out.exists() and Journal(out).done()
@@ -142,17 +151,9 @@ def test_every_worker_gone_stops_on_the_watchdog_and_resumes(tmp_path, scheduler
 
 def test_a_killed_scheduler_is_one_line_and_no_traceback(tmp_path, scheduler):
     proc, address = scheduler
-    cfg = tmp_path / "faults.yaml"
-    cfg.write_text(CONFIG)
-    out = tmp_path / "cube.h5"
-    worker = _worker(address, tmp_path, "w1")
-    try:
-        run = _sweep(cfg, out, address)
-        _after_first_slab(out, run, lambda: _stop(proc))
-        _, err = run.communicate(timeout=120)
-    finally:
-        _stop(worker)
-    assert run.returncode == 1, err
+    _, out, returncode, err = _break_after_first_slab(tmp_path, address,
+                                                      lambda worker: _stop(proc))
+    assert returncode == 1, err
     line = _assert_one_line(err)
     assert "--resume" in line, line
     assert not out.exists() and Journal(out).done()
