@@ -242,13 +242,15 @@ class DaskExecutor:
             pass
         return IN_FLIGHT_PER_THREAD * max(1, sum(self._threads.values()))
 
-    def map_slabs(self, cfg, slabs: list[tuple[int, int]],
-                  todo: Iterable[int]) -> Iterator[tuple[int, dict]]:
+    def map_slabs(self, cfg, slabs: list[tuple[int, int]], todo: Iterable[int],
+                  prepare=None) -> Iterator[tuple[int, dict]]:
         """Yield ``(k, arrays)`` for each slab index in ``todo``, as they finish.
 
         ``arrays`` is what ``compute_slab(cfg, *slabs[k], parallel=False)`` returns,
-        computed on a worker. At most :data:`IN_FLIGHT_PER_THREAD` slabs per worker thread
-        are submitted at once; a slab is released from the cluster once yielded.
+        computed on a worker (``prepare(i0, arrays)`` when given: a sink's first step, run
+        here once the slab is fetched). At most :data:`IN_FLIGHT_PER_THREAD` slabs per
+        worker thread are submitted at once; a slab is released from the cluster once
+        yielded.
         """
         from distributed import as_completed
 
@@ -286,6 +288,8 @@ class DaskExecutor:
             self._pending.discard(fut)
             fut.release()
             top_up()
+            if prepare is not None:
+                arrays = prepare(slabs[fut.slab][0], arrays)
             return fut.slab, arrays
 
         # While the caller writes one slab, the next finished one is fetched in a thread.

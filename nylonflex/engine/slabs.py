@@ -113,9 +113,6 @@ class LocalExecutor:
     arithmetic of slab k+1; at most two slabs are in memory.
     """
 
-    #: ``map_slabs`` takes a sink's ``prepare`` (run in the computing thread)
-    prepares = True
-
     def __init__(self, workers=None):
         self.workers = set_workers(workers)
 
@@ -156,7 +153,8 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
     todo : iterable of int
         Indices into ``slabs`` to compute.
     executor : LocalExecutor or DaskExecutor
-        Yields ``(k, arrays)`` from ``map_slabs(cfg, slabs, todo)``.
+        Yields ``(k, arrays)`` from ``map_slabs(cfg, slabs, todo)`` (with
+        ``prepare=sink.prepare`` when the sink has one).
     sink : object with ``put(k, i0, i1, arrays)``
         Stores a finished slab.
     progress : callable, optional
@@ -178,11 +176,10 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
         with deferred_signals(on_second=stop_now) as seen:
             if seen:  # Ctrl-C or SIGTERM while the run was set up: stop before computing
                 raise _Stop()
-            prepare = getattr(sink, "prepare", None)
-            slabs_done = (executor.map_slabs(cfg, slabs, todo, prepare=prepare)
-                          if prepare is not None and getattr(executor, "prepares", False)
-                          else executor.map_slabs(cfg, slabs, todo))
-            for k, arrays in slabs_done:
+            # a sink with a first step (CubeSink starts compressing) has the executor run it
+            # as soon as a slab is computed
+            first = {"prepare": sink.prepare} if hasattr(sink, "prepare") else {}
+            for k, arrays in executor.map_slabs(cfg, slabs, todo, **first):
                 i0, i1 = slabs[k]
                 sink.put(k, i0, i1, arrays)
                 stats.done.add(k)
