@@ -50,9 +50,22 @@ def _progress(total, quiet):
 
 
 def run(args) -> int:
+    from contextlib import nullcontext
+
+    from ..charts_ahead import ChartsAhead
+
+    # the charts' process starts first, so that its imports (matplotlib, xarray, about a
+    # second) overlap the config and the sweep; it is ended at once if there is nothing
+    # to draw
+    charts = not (args.no_charts or args.dry_run)
+    with ChartsAhead() if charts else nullcontext() as ahead:
+        return _run(args, ahead)
+
+
+def _run(args, ahead) -> int:
     from ..config import load_config
-    from ..sweep import default_output, sweep_file
     from ..files import refuse_special
+    from ..sweep import default_output, sweep_file
 
     cfg = load_config(args.config, args.set)
     out = Path(args.out) if args.out else default_output(cfg)
@@ -64,28 +77,24 @@ def run(args) -> int:
 
     if args.dry_run:
         return _dry_run(cfg, out, args, log)
-
+    if ahead is not None and not cfg.charts:
+        ahead.close()
     with _progress(cfg.n_designs, args.quiet) as bar:
         sweep_file(cfg, out, resume=args.resume, workers=args.workers,
                    scheduler=args.scheduler, progress=bar.update, log=log,
                    overwrite=args.overwrite)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
-    if cfg.charts and not args.no_charts:
-        from ..charts import draw_charts
-        from ..storage import open_cube
+    if ahead is None or not cfg.charts:
+        return 0
+    from ._common import progress_bar
 
-        from ._common import progress_bar
-
-        ds = open_cube(out)
-
-        skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
-        with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
-            # beside the cube: only this cube's earlier charts are replaced, others skipped
-            paths = draw_charts(ds, cfg.charts, out.parent, "png", on_skip=skip,
-                                progress=bar, refuse_foreign=False)
-        for path in paths:
-            print(path)
-        ds.close()
+    skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
+    with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
+        # beside the cube: only this cube's earlier charts are replaced, others skipped
+        paths = ahead.draw(out, cfg.charts, out.parent, "png", on_skip=skip,
+                           progress=bar, refuse_foreign=False)
+    for path in paths:
+        print(path)
     return 0
 
 
