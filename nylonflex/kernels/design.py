@@ -34,11 +34,12 @@ from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _design_state, _design_values, _model_state_nodes,
                               _nylon_force_model, _reach,
-                              _stroke_state_nodes, _thermal_values, _validity,
-                              _working_temperatures)
+                              _stroke_state_nodes, _thermal_values, _thermal_values_at,
+                              _validity, _working_temperatures)
 from ..physics.nylon import _stroke_shape
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
-from ..physics.wrap import _pitch, _wrap_force
+from ..physics.thermal import _cooling_time
+from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
 from ._compile import jit_kernel
 
 #: Number of float design variables in ``out.design``: the registry's float design
@@ -80,6 +81,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     c_per_len = muscle.c_per_len[0]
     loss_per_len = muscle.loss_per_len[0]
     force_coeff = muscle.force_coeff[0]
+    tau = c_per_len / loss_per_len
     default = model == PAPER and voltage <= 0.0
     cauchy = model == CAUCHY_MOMENT
     top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
@@ -112,6 +114,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         wyy_nodes = np.empty(n_nodes)
         work = np.empty((MOMENT_WORK_ROWS, n_nodes))
         _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
+        perimeter = _outer_perimeter(a, t, b)
         # the bend-angle curve first, with dkappa/dp and d2kappa/dp2: each solve starts from
         # the previous ones, and they start the coil loop's solves
         kappa_curve = np.empty(npr)
@@ -151,7 +154,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 temps_full = (0.0, 0.0, 0.0)
             for ip in range(npsi):
                 pitch = _pitch(a, t, b, wrap[ip], coil_width[ic])
-                lever = pitch / math.cos(wrap[ip])
+                cos_wrap = math.cos(wrap[ip])
+                lever = pitch / cos_wrap
                 if default:
                     st = _stroke_state_nodes(a, t, b, lever, f_lim, s_max, kappa_full, mu,
                                              alpha, y_nodes, wy_nodes, wyy_nodes, work,
@@ -167,6 +171,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     st = (0.0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)
                     closes = False
                     temps = (0.0, 0.0, 0.0)
+                # the cooling time does not depend on the length: once for all lengths
+                # while the working temperatures stay
+                cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                 for il in range(nl):
                     if not default and (il == 0 or voltage > 0.0):
                         t_reach, s_free, limited = _reach(
@@ -181,6 +188,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                         closes = ms[7]
                         temps = _working_temperatures(model, ms[0], t_reach, scale, t_amb,
                                                       t_max, gamma, beta, t_g, sigma_g)
+                        cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                     v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim,
                                        length[il])
                     out_design[0, ia, it, il, ic, ip] = v[0]
@@ -192,9 +200,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[5, ia, it, il, ic, ip] = v[6]
                     out_design[6, ia, it, il, ic, ip] = v[7]
                     out_design[7, ia, it, il, ic, ip] = v[8]
-                    th = _thermal_values(length[il], pitch, a, t, b, wrap[ip], voltage,
-                                         temps[0], temps[1], temps[2], t_amb, r_per_len,
-                                         c_per_len, loss_per_len)
+                    th = _thermal_values_at(length[il], pitch, perimeter, cos_wrap, voltage,
+                                            temps[0], temps[2], t_amb, r_per_len, c_per_len,
+                                            loss_per_len, cooling)
                     out_design[8, ia, it, il, ic, ip] = th[0]
                     out_design[9, ia, it, il, ic, ip] = th[1]
                     out_design[10, ia, it, il, ic, ip] = th[2]

@@ -29,9 +29,15 @@ _SQRT2 = math.sqrt(2.0)
 def _stroke_shape(temperature, t_amb, gamma, beta, t_g, sigma_g):
     """Reference stroke eps_ref(T_amb) - eps_ref(T) of the eq. (2) shape [-]; T in K."""
     c = 1.0 / (sigma_g * _SQRT2)
-    return gamma * (temperature - t_amb) + beta * (
-        math.erf((temperature - t_g) * c) - math.erf((t_amb - t_g) * c)
-    )
+    return _stroke_shape_at(temperature, t_amb, gamma, beta, t_g, c,
+                            math.erf((t_amb - t_g) * c))
+
+
+@formula
+def _stroke_shape_at(temperature, t_amb, gamma, beta, t_g, c, erf_amb):
+    """:func:`_stroke_shape` with c = 1/(sigma_g sqrt 2) [1/K] and erf((T_amb - T_g) c)
+    [-] given: a solver over T computes those once (the same operations, the same bits)."""
+    return gamma * (temperature - t_amb) + beta * (math.erf((temperature - t_g) * c) - erf_amb)
 
 
 @formula
@@ -71,14 +77,16 @@ def _temperature_for_stroke(stroke_value, scale, t_amb, t_max, gamma, beta, t_g,
     if stroke_value <= 0.0:
         return t_amb
     target = stroke_value / scale
-    top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
+    c = 1.0 / (sigma_g * _SQRT2)
+    erf_amb = math.erf((t_amb - t_g) * c)  # once a solve, not once an iteration
+    top = _stroke_shape_at(t_max, t_amb, gamma, beta, t_g, c, erf_amb)
     if target >= top:
         return t_max
     lo = t_amb
     hi = t_max
     temp = t_amb + (t_max - t_amb) * target / top
     for _ in range(200):
-        f = _stroke_shape(temp, t_amb, gamma, beta, t_g, sigma_g) - target
+        f = _stroke_shape_at(temp, t_amb, gamma, beta, t_g, c, erf_amb) - target
         if f == 0.0:
             return temp
         if f > 0.0:
