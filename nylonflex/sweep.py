@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .config import ResolvedConfig
 
-__all__ = ["default_output", "estimate", "run_sweep", "sweep_file"]
+__all__ = ["default_output", "estimate", "prepare", "run_sweep", "sweep_file"]
 
 
 def default_output(cfg: ResolvedConfig) -> Path:
@@ -89,6 +89,18 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
 def _interrupt():
     """The second Ctrl-C while a run is set up: stop at once."""
     raise KeyboardInterrupt
+
+
+def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
+    """Import and load (or compile) what a sweep of ``cfg`` runs: the kernel, the storage.
+
+    :func:`sweep_file` and :func:`run_sweep` do it themselves; a caller may do it first to
+    keep the start apart (the command line does, with the garbage collector paused).
+    Parameters as :func:`run_sweep`'s.
+    """
+    from . import storage  # noqa: F401 - h5py, h5netcdf, hdf5plugin
+
+    _warm_up(cfg, workers, scheduler, log)
 
 
 def _warm_up(cfg, workers, scheduler, log):
