@@ -29,7 +29,7 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..units import InputError
-from .grid import compute_slab, coords, cube_variables, global_arrays
+from .grid import ArrayPool, compute_slab, coords, cube_variables, global_arrays
 
 __all__ = ["LocalExecutor", "MemorySink", "RunStats", "deferred_signals", "run_slabs",
            "set_workers"]
@@ -121,21 +121,27 @@ class LocalExecutor:
 
     def map_slabs(self, cfg, slabs, todo, prepare=None):
         """Yield ``(k, arrays)`` as slabs finish; with ``prepare``, ``(k, prepare(i0,
-        arrays))``, called in the computing thread (a sink's compression starts there)."""
+        arrays))``, called in the computing thread (a sink's compression starts there).
+
+        A slab's arrays are reused for a later slab once the caller asks for the next one
+        (they come from an :class:`~nylonflex.engine.grid.ArrayPool`): store or copy them
+        before that, as the sinks do.
+        """
+        buffers = ArrayPool()
 
         def job(i0, i1):
-            arrays = compute_slab(cfg, i0, i1)
-            return arrays if prepare is None else prepare(i0, arrays)
+            arrays = compute_slab(cfg, i0, i1, pool=buffers)
+            return arrays, (arrays if prepare is None else prepare(i0, arrays))
 
         with ThreadPoolExecutor(1, thread_name_prefix="nylonflex-slab") as pool:
             pending = None
-            for k in todo:
-                future = pool.submit(job, *slabs[k])
+            for k in [*todo, None]:
+                future = None if k is None else pool.submit(job, *slabs[k])
                 if pending is not None:
-                    yield pending[0], pending[1].result()
+                    arrays, item = pending[1].result()
+                    yield pending[0], item
+                    buffers.give_back(arrays)  # stored: the next slabs may write them
                 pending = (k, future)
-            if pending is not None:
-                yield pending[0], pending[1].result()
 
     def close(self):
         pass
