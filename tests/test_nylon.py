@@ -67,6 +67,53 @@ def test_temperature_for_stroke_inverts_stroke():
         assert stroke(nylon.temperature_for_stroke(s, 1.7), 1.7) == pytest.approx(s, abs=1e-13)
 
 
+def _bisected_temperature(s, scale, ny):
+    """The root of eq. (2) by plain bisection on the same float64 shape, run until the
+    bracket cannot shrink: the slow reference of the Newton solve [K]."""
+    args = (ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    lo, hi = ny.t_amb, ny.t_max
+    while True:
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            return mid
+        if nylon._stroke_shape(mid, *args) * scale < s:
+            lo = mid
+        else:
+            hi = mid
+
+
+def test_temperature_solve_converges_in_a_few_steps_to_the_rounding_of_the_root(
+        monkeypatch):
+    # the solve once tested convergence only after its bracket test, so a step below half
+    # an ulp, which leaves T on the bracket's edge, was bisected away from the root: 16
+    # steps on average (46 at most), ending on a bisection midpoint up to 7e-11 of
+    # T - T_amb from the root, which the cooling time's log then carried (docs/model.md
+    # s. 15)
+    from nylonflex.materials import nylon_parameters
+
+    ny = nylon_parameters("silver_nylon66")
+    calls = []
+    shape_at = nylon._stroke_shape_at
+    monkeypatch.setattr(nylon, "_stroke_shape_at", lambda *a: calls.append(1) or shape_at(*a))
+    scale = 0.05
+    top = nylon._stroke_shape(ny.t_max, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    steps, errors = [], []
+    for frac in np.concatenate([np.linspace(1e-4, 0.999, 120), np.geomspace(1e-6, 1e-2, 30)]):
+        s = frac * top * scale
+        calls.clear()
+        t = nylon._temperature_for_stroke(s, scale, ny.t_amb, ny.t_max, ny.gamma, ny.beta,
+                                          ny.t_g, ny.sigma_g)
+        steps.append(len(calls) - 1)  # the first call is T_max's stroke
+        # as close as the best float64 root: its stroke misses s by no more than the
+        # bisected root's (plus a few roundings of s)
+        miss = lambda temp: abs(scale * nylon._stroke_shape(  # noqa: E731
+            temp, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g) - s)
+        errors.append(miss(t) / (2.0 * miss(_bisected_temperature(s, scale, ny))
+                                 + 8.0 * np.finfo(float).eps * s))
+    assert max(steps) <= 8 and np.mean(steps) < 6
+    assert max(errors) <= 1.0
+
+
 def test_thermomechanical_force_eq1():
     # F = k (x - x0) + b_d v + c (T - T0), docs/model.md section 9 constants
     f = nylon.thermomechanical_force(0.002, 0.01, T_AMB + 50, rest_displacement=0.001)
