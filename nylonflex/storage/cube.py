@@ -252,9 +252,19 @@ def _encode_chunk(block, chunks, codec: Codec):
         from ..kernels.bytes import shuffle_bytes
 
         src = raw.reshape(-1, size)
-        raw = np.empty((size, src.shape[0]), dtype=np.uint8)
+        raw = _shuffle_buffer(raw.size).reshape(size, src.shape[0])
         shuffle_bytes(src, raw)
-    return codec.encode(raw.reshape(-1).data)  # a 1-D byte view: no copy
+    # a 1-D byte view (no copy); every codec returns new bytes, so the buffer is free after
+    return codec.encode(raw.reshape(-1).data)
+
+
+def _shuffle_buffer(nbytes: int) -> np.ndarray:
+    """This thread's shuffle buffer, ``nbytes`` long: a fresh 2 MB array a chunk cost the
+    zeroing of its pages every time (the arenas hand freed memory back)."""
+    buf = getattr(_compressors, "shuffle", None)
+    if buf is None or buf.size < nbytes:
+        buf = _compressors.shuffle = np.empty(nbytes, dtype=np.uint8)
+    return buf[:nbytes]
 
 
 def _shuffle_deflate(block, chunks):
