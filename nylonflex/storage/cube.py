@@ -54,7 +54,7 @@ def _zstd(raw: bytes) -> bytes:
 
 
 #: The codecs a config may choose (``compression:``). zstd is the default: the file size of
-#: gzip at about a third of its CPU; nylonflex opens it (it imports hdf5plugin), and so does
+#: gzip at about a quarter of its CPU; nylonflex opens it (it imports hdf5plugin), and so does
 #: any reader with the HDF5 zstd filter plugin. ``gzip`` is for readers without it
 #: (HDFView, MATLAB, netCDF-C).
 CODECS = {
