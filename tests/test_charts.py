@@ -185,3 +185,10 @@ def test_a_cube_with_single_value_axes_skips_what_it_cannot_draw(tmp_path, capsy
     assert "fig6 skipped" in captured.err and "fig12b skipped" in captured.err
     assert (tmp_path / "fig4.png").is_file() and (tmp_path / "fig12a.png").is_file()
     assert not (tmp_path / "design_map.png").exists()
+
+
+def test_files_come_back_in_the_order_asked_though_drawn_longest_first(ds, tmp_path):
+    names = ["fig4", "fig12b", "design_map"]  # drawn design_map, fig12b, fig4
+    assert [charts.COST[n] for n in names] == sorted(charts.COST[n] for n in names)
+    paths = charts.draw_charts(ds, names, tmp_path, "png", processes=2)
+    assert [p.name for p in paths] == ["fig4.png", "fig12b.png", "design_map.png"]

@@ -114,3 +114,17 @@ def test_sweep_charts_through_the_process_ahead(tmp_path, capsys):
     assert "design_map skipped" in captured.err  # printed by the command itself
     assert (out.parent / "fig4.png").stat().st_size > 10_000
     _no_children_left()
+
+
+def test_the_sweep_command_leaves_the_garbage_collector_running(tmp_path):
+    # it pauses the collector while it starts (imports) and freezes what that made
+    import gc
+
+    import yaml
+
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml.safe_dump(SMALL))
+    assert main(["sweep", str(cfg), "--out", str(tmp_path / "cube.h5"), "--quiet",
+                 "--no-charts"]) == 0
+    assert gc.isenabled() and gc.get_freeze_count() > 0
+    gc.unfreeze()

@@ -139,3 +139,44 @@ def test_the_grid_engine_writes_the_cube_the_code_wrote_before_the_rewrite():
                                   np.interp(cfg.axes["coil_index"],
                                             cfg.nylon.coil_index_table,
                                             cfg.nylon.stroke_max_table))
+
+
+def test_array_pool_hands_back_what_was_given_back():
+    from nylonflex.engine.grid import ArrayPool
+
+    pool = ArrayPool()
+    a = pool.empty((3, 4))
+    b = pool.empty((3, 4), dtype=np.int8)
+    stranger = np.empty((3, 4))
+    pool.give_back({"view": a[1], "whole": b, "stranger": stranger})
+    assert pool.empty((3, 4)) is a  # a view counts as its array
+    assert pool.empty((3, 4), dtype=np.int8) is b
+    assert pool.empty((3, 4)) is not stranger  # only the pool's own arrays come back
+    assert pool.empty((2, 4)) is not a
+
+
+def test_slabs_from_reused_arrays_are_the_slabs_computed_alone(tmp_path):
+    # the local executor reuses a stored slab's arrays for the slab after next: every slab
+    # of a many-slab sweep must still be what computing it alone gives
+    from nylonflex.config import parse_config
+    from nylonflex.engine.grid import compute_slab, plan_slabs
+    from nylonflex.engine.slabs import LocalExecutor
+
+    raw = {"name": "pool", "slab_megabytes": 1,  # one radius a slab (0.6 MB a radius)
+           "grid": {"radius": {"start": 5, "stop": 25, "num": 6, "units": "mm"},
+                    "wall_thickness": {"start": 1, "stop": 6, "num": 10, "units": "mm"},
+                    "length": {"start": 50, "stop": 140, "num": 10, "units": "mm"},
+                    "coil_index": {"start": 1.1, "stop": 1.7, "num": 5},
+                    "wrap_angle": {"start": 2, "stop": 30, "num": 10, "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 5},
+                      "pressure": {"start": 0, "stop": 25, "num": 5, "units": "kPa"}}}
+    cfg = parse_config(raw)
+    slabs, _ = plan_slabs(cfg)
+    assert len(slabs) >= 4
+    seen = set()
+    for k, arrays in LocalExecutor().map_slabs(cfg, slabs, range(len(slabs))):
+        alone = compute_slab(cfg, *slabs[k])
+        for name, value in alone.items():
+            np.testing.assert_array_equal(arrays[name], value, err_msg=name)
+        seen.update(id(a.base) for a in arrays.values() if a.base is not None)
+    assert len(seen) < 2 * len(slabs)  # arrays were reused, not made afresh each slab
