@@ -95,6 +95,22 @@ def _chunks(dims, sizes, radius_chunk):
     return tuple(int(x) for x in shape)
 
 
+@dataclass(frozen=True)
+class _Layout:
+    """A cube variable's HDF5 dataset, its dimension names, chunk shape, shape and dtype."""
+
+    dset: object
+    dims: tuple
+    chunks: tuple | None
+    shape: tuple
+    dtype: np.dtype
+
+    def aligned(self, i0: int, i1: int) -> bool:
+        """Whether radii [i0, i1) cover whole chunks (the last may end with the axis)."""
+        rc = self.chunks[0]
+        return i0 % rc == 0 and (i1 % rc == 0 or i1 == self.shape[0])
+
+
 class CubeFile:
     """Writes one cube file slab by slab (h5netcdf; by default gzip level 1 with shuffle)."""
 
@@ -136,6 +152,11 @@ class CubeFile:
         done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
         done.attrs.update(slab_done_attrs())
         self.f.attrs.update({**attrs, "compression": self.codec.name})
+        # each variable's HDF5 dataset and layout, looked up once: through h5netcdf and
+        # h5py a lookup costs about 0.1 ms with the GIL held, several a variable a slab
+        self._layout = {name: _Layout(v._h5ds, tuple(v.dimensions), v._h5ds.chunks,
+                                      v._h5ds.shape, v._h5ds.dtype)
+                        for name, v in self.f.variables.items()}
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def write(self, i0: int, i1: int, arrays: dict):
@@ -162,12 +183,11 @@ class CubeFile:
         """
         out, jobs = {}, []
         for name, data in arrays.items():
-            var = self.f.variables[name]
-            dset = var._h5ds
-            i1 = i0 + (np.shape(data)[0] if var.dimensions else 0)
-            if var.dimensions and var.dimensions[0] == "radius" and \
-                    self.codec.encode is not None and self._aligned(dset, i0, i1):
-                jobs.append((name, list(self._compress(dset, i0, data))))
+            layout = self._layout[name]
+            i1 = i0 + (np.shape(data)[0] if layout.dims else 0)
+            if layout.dims and layout.dims[0] == "radius" and \
+                    self.codec.encode is not None and layout.aligned(i0, i1):
+                jobs.append((name, list(self._compress(layout, i0, data))))
             else:
                 out[name] = np.asarray(data)
         return out, jobs
@@ -187,32 +207,27 @@ class CubeFile:
         """Store what :meth:`encode` made for the radii [i0, i1)."""
         for key, value in encoded.items():
             name, _, part = key.partition(":")
-            var = self.f.variables[name]
+            layout = self._layout[name]
             if part == "offsets":
                 sizes = encoded[f"{name}:sizes"]
                 blob = memoryview(encoded[f"{name}:bytes"])
-                write_chunk = var._h5ds.id.write_direct_chunk  # one lookup a variable
+                write_chunk = layout.dset.id.write_direct_chunk
                 end = 0
                 for offset, size in zip(value.tolist(), sizes.tolist()):
                     write_chunk(tuple(offset), blob[end:end + size])  # a view: no copy
                     end += size
             elif part:
                 continue  # sizes and bytes go with their offsets
-            elif var.dimensions and var.dimensions[0] == "radius":
-                var[i0:i1] = value
+            elif layout.dims and layout.dims[0] == "radius":
+                layout.dset[i0:i1] = value  # (h5netcdf writes plain types so too)
             else:
-                var[...] = value
-        self.f.variables["slab_done"][i0:i1] = 1
+                layout.dset[...] = value
+        self._layout["slab_done"].dset[i0:i1] = 1
 
-    @staticmethod
-    def _aligned(dset, i0, i1):
-        rc = dset.chunks[0]
-        return i0 % rc == 0 and (i1 % rc == 0 or i1 == dset.shape[0])
-
-    def _compress(self, dset, i0, data):
+    def _compress(self, layout, i0, data):
         """Yield ``(chunk offset, future of its filtered bytes)`` for a slab's chunks."""
-        chunks, shape = dset.chunks, dset.shape
-        data = np.ascontiguousarray(data, dtype=dset.dtype)
+        chunks, shape = layout.chunks, layout.shape
+        data = np.ascontiguousarray(data, dtype=layout.dtype)
         starts = [range(0, data.shape[0], chunks[0])] + \
             [range(0, n, c) for n, c in zip(shape[1:], chunks[1:])]
         for corner in itertools.product(*starts):
