@@ -10,7 +10,7 @@ import os
 import subprocess
 import sys
 
-#: Runs ``nylonflex ARGS`` and signals itself once the sink has stored K slabs: the kill
+#: Runs ``nylonflex ARGS`` and signals itself once the sink has journaled K slabs: the kill
 #: lands at the same point on a fast machine and a slow one (no race with a timer).
 _KILL_AFTER = """
 import os, signal, sys
@@ -29,6 +29,9 @@ def run_slabs(cfg, plan, todo, executor, sink, progress=None):
             sink.put(*args)
             Killing.stored += 1
             if Killing.stored == K:
+                # a file sink journals a slab while the next one is stored: wait for the
+                # K-th journal file, so the kill lands after K journaled slabs
+                getattr(sink, "flush", lambda: None)()
                 os.kill(os.getpid(), SIG)
 
     return original(cfg, plan, todo, executor, Killing(), progress)
