@@ -103,15 +103,21 @@ def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
     _warm_up(cfg, workers, scheduler, log)
 
 
+#: The (config hash, workers) whose kernel this process has warmed up: :func:`prepare`
+#: followed by :func:`sweep_file` warms once.
+_WARMED: set = set()
+
+
 def _warm_up(cfg, workers, scheduler, log):
     """Compile (or load) the local kernel first, so that the run's timings exclude it."""
-    if scheduler is not None:
+    if scheduler is not None or (cfg.sha256, workers) in _WARMED:
         return
     from .engine.slabs import set_workers
     from .engine.warmup import warm_up_grid
 
     set_workers(workers)
     compiled = warm_up_grid(cfg, notice=log)
+    _WARMED.add((cfg.sha256, workers))
     if compiled and log is not None:
         log(f"kernels compiled in {compiled:.1f} s (not counted below)")
 

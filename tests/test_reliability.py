@@ -678,12 +678,22 @@ class Executor(run_mod.LocalExecutor):
 
 
 run_mod.LocalExecutor = Executor
+if WHERE == "warmup":  # while the kernels load, before the run is set up
+    import nylonflex.engine.warmup as warmup
+
+    load = warmup.warm_up_grid
+
+    def warm_up_grid(*args, **kwargs):
+        fire()
+        return load(*args, **kwargs)
+
+    warmup.warm_up_grid = warm_up_grid
 from nylonflex.cli import main
 sys.exit(main(sys.argv[3:]))
 """
 
 
-@pytest.mark.parametrize("where", ["setup", "loop"])
+@pytest.mark.parametrize("where", ["warmup", "setup", "loop"])
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["INT", "TERM"])
 def test_a_signal_in_a_finaliser_is_never_swallowed(tmp_path, where, sig):
     # Python prints "Exception ignored" and drops a KeyboardInterrupt raised inside a

@@ -63,28 +63,36 @@ def run(args) -> int:
 
 
 def _run(args, ahead) -> int:
+    from contextlib import ExitStack
+
     from ..files import refuse_special
 
     def log(msg):
         if not args.quiet:
             print(msg, file=sys.stderr)
 
-    with _collect_after_start():
-        from ..config import load_config
-        from ..sweep import default_output, prepare, sweep_file
+    # from the kernels' loading to the sweep's end, Ctrl-C and SIGTERM are recorded, never
+    # raised inside a finaliser where Python would drop them (Numba's loading runs them):
+    # the sweep then stops before its first slab (docs/reliability.md)
+    with ExitStack() as signals:
+        with _collect_after_start():
+            from ..config import load_config
+            from ..engine.slabs import deferred_signals
+            from ..sweep import default_output, prepare, sweep_file
 
-        cfg = load_config(args.config, args.set)
-        out = Path(args.out) if args.out else default_output(cfg)
-        refuse_special(out, "--out")
-        if args.dry_run:
-            return _dry_run(cfg, out, args, log)
-        if ahead is not None and not cfg.charts:
-            ahead.close()
-        prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
-    with _progress(cfg.n_designs, args.quiet) as bar:
-        sweep_file(cfg, out, resume=args.resume, workers=args.workers,
-                   scheduler=args.scheduler, progress=bar.update, log=log,
-                   overwrite=args.overwrite)
+            cfg = load_config(args.config, args.set)
+            out = Path(args.out) if args.out else default_output(cfg)
+            refuse_special(out, "--out")
+            if args.dry_run:
+                return _dry_run(cfg, out, args, log)
+            if ahead is not None and not cfg.charts:
+                ahead.close()
+            signals.enter_context(deferred_signals(on_second=_stop_at_once))
+            prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
+        with _progress(cfg.n_designs, args.quiet) as bar:
+            sweep_file(cfg, out, resume=args.resume, workers=args.workers,
+                       scheduler=args.scheduler, progress=bar.update, log=log,
+                       overwrite=args.overwrite)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if ahead is None or not cfg.charts:
         return 0
@@ -98,6 +106,11 @@ def _run(args, ahead) -> int:
     for path in paths:
         print(path)
     return 0
+
+
+def _stop_at_once():
+    """A second Ctrl-C while the sweep starts: stop now."""
+    raise KeyboardInterrupt
 
 
 class _collect_after_start:
