@@ -201,8 +201,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[6, ia, it, il, ic, ip] = v[7]
                     out_design[7, ia, it, il, ic, ip] = v[8]
                     th = _thermal_values_at(length[il], pitch, perimeter, cos_wrap, voltage,
-                                            temps[0], temps[2], t_amb, r_per_len, c_per_len,
-                                            loss_per_len, cooling)
+                                            temps[0], temps[2], t_amb, r_per_len,
+                                            loss_per_len, tau, cooling)
                     out_design[8, ia, it, il, ic, ip] = th[0]
                     out_design[9, ia, it, il, ic, ip] = th[1]
                     out_design[10, ia, it, il, ic, ip] = th[2]

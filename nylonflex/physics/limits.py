@@ -22,8 +22,8 @@ from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pres
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from .thermal import _cooling_time, _heating_power, _heating_time, _steady_temperature
-from .wrap import _muscle_length, _nylon_force_and_slope, _outer_perimeter, _pitch, \
-    _wrap_force
+from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
+    _outer_perimeter, _pitch, _wrap_force
 
 __all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "stroke_limit"]
 
@@ -326,28 +326,27 @@ def _thermal_values(length, pitch, radius, wall_thickness, base_thickness, wrap_
     At the working temperature T* (:func:`_working_temperatures`); heating_time is NaN
     without a supply (``voltage`` <= 0; docs/model.md s. 15).
     """
+    tau = c_per_len / loss_per_len
     return _thermal_values_at(length, pitch, _outer_perimeter(radius, wall_thickness,
                                                               base_thickness),
                               math.cos(wrap_angle), voltage, t_work, t_hot, t_amb, r_per_len,
-                              c_per_len, loss_per_len,
-                              _cooling_time(t_work, t_cool, t_amb, c_per_len / loss_per_len))
+                              loss_per_len, tau, _cooling_time(t_work, t_cool, t_amb, tau))
 
 
 @formula
 def _thermal_values_at(length, pitch, perimeter, cos_wrap, voltage, t_work, t_hot, t_amb,
-                       r_per_len, c_per_len, loss_per_len, cooling):
+                       r_per_len, loss_per_len, tau, cooling):
     """:func:`_thermal_values` from the parts that do not depend on the length: the outer
-    perimeter [m], cos psi [-] and the cooling time [s]. The grid kernel computes them once
-    for all lengths; l_m = L / pitch * P_out / cos psi as :func:`_muscle_length` has it
-    (the same operations, the same bits)."""
-    l_m = length / pitch * perimeter / cos_wrap
+    perimeter [m], cos psi [-], the time constant tau = c'/lambda' [s] and the cooling time
+    [s]. The grid kernel computes them once for all lengths (the same operations, the same
+    bits)."""
+    l_m = _muscle_length_at(length, pitch, perimeter, cos_wrap)
     r = r_per_len * l_m
     power = _heating_power(t_work, l_m, t_amb, loss_per_len)
     heating = math.nan
     if voltage > 0.0:
         heating = _heating_time(t_hot, _steady_temperature(voltage, l_m, t_amb, r_per_len,
-                                                           loss_per_len), t_amb,
-                                c_per_len / loss_per_len)
+                                                           loss_per_len), t_amb, tau)
     return l_m, r, power, math.sqrt(r * power), cooling, heating
 
 

@@ -45,8 +45,16 @@ def _pitch(radius, wall_thickness, base_thickness, wrap_angle, width):
 @formula
 def _muscle_length(length, pitch, radius, wall_thickness, base_thickness, wrap_angle):
     """Muscle in the wrap l_m = n P_out / cos psi with n = L / pitch turns [m]."""
-    return length / pitch * _outer_perimeter(radius, wall_thickness, base_thickness) \
-        / math.cos(wrap_angle)
+    return _muscle_length_at(length, pitch,
+                             _outer_perimeter(radius, wall_thickness, base_thickness),
+                             math.cos(wrap_angle))
+
+
+@formula
+def _muscle_length_at(length, pitch, perimeter, cos_wrap):
+    """:func:`_muscle_length` from the outer perimeter P_out [m] and cos psi [-], which do
+    not depend on the length (the grid kernel computes them once for all lengths)."""
+    return length / pitch * perimeter / cos_wrap
 
 
 @formula
