@@ -39,17 +39,18 @@ class Codec:
 #: the speed; the level does not matter to a reader.
 ZSTD_LEVEL = -1
 
-_compressors = threading.local()
+#: Each compression thread's own zstd compressor and shuffle buffer.
+_per_thread = threading.local()
 
 
 def _zstd(raw: bytes) -> bytes:
     """zstd frame of ``raw``, by this thread's own compressor (a context is not shared
     between threads, and making one a chunk costs about 8 % of the compression)."""
-    compressor = getattr(_compressors, "zstd", None)
+    compressor = getattr(_per_thread, "zstd", None)
     if compressor is None:
         import zstandard
 
-        compressor = _compressors.zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
+        compressor = _per_thread.zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
     return compressor.compress(raw)
 
 
@@ -112,7 +113,8 @@ class _Layout:
 
 
 class CubeFile:
-    """Writes one cube file slab by slab (h5netcdf; by default gzip level 1 with shuffle)."""
+    """Writes one cube file slab by slab (h5netcdf; the codec of :data:`CODECS` it is given,
+    zstd by default, with the shuffle filter where the codec has it)."""
 
     def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
                  codec: str = DEFAULT_CODEC, variables: dict | None = None,
@@ -276,9 +278,9 @@ def _encode_chunk(block, chunks, codec: Codec):
 def _shuffle_buffer(nbytes: int) -> np.ndarray:
     """This thread's shuffle buffer, ``nbytes`` long: a fresh 2 MB array a chunk cost the
     zeroing of its pages every time (the arenas hand freed memory back)."""
-    buf = getattr(_compressors, "shuffle", None)
+    buf = getattr(_per_thread, "shuffle", None)
     if buf is None or buf.size < nbytes:
-        buf = _compressors.shuffle = np.empty(nbytes, dtype=np.uint8)
+        buf = _per_thread.shuffle = np.empty(nbytes, dtype=np.uint8)
     return buf[:nbytes]
 
 
