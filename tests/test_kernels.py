@@ -201,3 +201,26 @@ def test_section_moment_compiles_to_a_loop_without_calls_to_log_or_exp():
     assert not re.search(r"\$_*(log|exp)\b", asm)
     if platform.machine().lower() in ("x86_64", "amd64"):
         assert re.search(r"\bv?mulpd\b", asm)  # packed: the node loops are vectorised
+
+
+def test_loading_the_kernels_skips_numbas_scipy_linalg_probe():
+    # Numba's arraymath imports scipy.linalg only to set _HAVE_BLAS; the kernels' module
+    # makes that probe fail fast and sets the flag from the files scipy installed. Run in a
+    # fresh interpreter: this test process has scipy.linalg already.
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, importlib.util\n"
+        "from nylonflex.kernels import _compile\n"
+        "from numba.np import arraymath\n"
+        "assert 'scipy.linalg' not in sys.modules, 'scipy.linalg was imported'\n"
+        "assert 'scipy.linalg.cython_blas' not in sys.modules, 'the stand-in was left'\n"
+        "assert arraymath._HAVE_BLAS is (importlib.util.find_spec('scipy') is not None)\n"
+        "import scipy.linalg.cython_blas\n"  # still importable afterwards
+        "from scipy import linalg\n"
+        "assert abs(linalg.det([[2.0, 0.0], [0.0, 3.0]]) - 6.0) < 1e-12\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert _compile._scipy_blas_installed() is True  # scipy is a dependency

@@ -29,6 +29,53 @@ from llvmlite import ir
 from numba.core import types as nb_types
 from numba.extending import intrinsic, overload, register_jitable
 
+
+def _import_numba_arraymath():
+    """Import Numba's NumPy implementations without the scipy.linalg import of its BLAS probe.
+
+    Numba imports ``numba.np.arraymath`` the first time it compiles *or loads a cached
+    kernel*, and that module imports ``scipy.linalg`` at once only to learn whether BLAS is
+    there (``_HAVE_BLAS``, which chooses how ``np.convolve`` and ``np.correlate`` multiply).
+    scipy.linalg costs 0.1-0.3 s of every command that loads a kernel, and no kernel calls
+    BLAS. Here the probe's import fails fast, the flag is set from whether scipy's BLAS
+    module is installed (a file test, no import), and nothing else changes: np.dot and
+    np.linalg still import scipy.linalg when a kernel that uses them is compiled. Holding
+    the import lock keeps other threads' imports from seeing the probe's stand-in. Where
+    scipy.linalg or numba.np.arraymath is imported already, nothing is done.
+    """
+    import _imp
+    import sys
+
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return
+    probe = "scipy.linalg.cython_blas"
+    _imp.acquire_lock()
+    try:
+        sys.modules[probe] = None  # `import` of it raises ImportError at once
+        try:
+            from numba.np import arraymath
+        finally:
+            if sys.modules.get(probe, 0) is None:
+                del sys.modules[probe]
+    finally:
+        _imp.release_lock()
+    if hasattr(arraymath, "_HAVE_BLAS"):
+        arraymath._HAVE_BLAS = _scipy_blas_installed()
+
+
+def _scipy_blas_installed() -> bool:
+    """Whether ``scipy.linalg.cython_blas`` is installed (found on disk, not imported)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("scipy")
+    for folder in (spec.submodule_search_locations or []) if spec else []:
+        if any(Path(folder, "linalg").glob("cython_blas*")):
+            return True
+    return False
+
+
+_import_numba_arraymath()
+
 #: Options of every kernel. ``cache`` writes compiled code to a folder keyed on the model
 #: sources so a second run starts warm; ``fastmath`` stays off: the kernels must match the
 #: physics to 1e-9 and the sweep must be bit-reproducible.
