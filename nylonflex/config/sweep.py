@@ -15,6 +15,7 @@ import copy
 import hashlib
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
@@ -167,11 +168,13 @@ class ResolvedConfig:
     def n_designs(self) -> int:
         return int(np.prod(self.shape))
 
-    @property
+    # made once: a sweep asks for the hash about eight times, and the YAML dump costs 7 ms
+    # (the config is frozen, its arrays are never written)
+    @cached_property
     def text(self) -> str:
         return canonical_yaml(self)
 
-    @property
+    @cached_property
     def sha256(self) -> str:
         return hashlib.sha256(self.text.encode()).hexdigest()
 
