@@ -98,7 +98,7 @@ def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
     keep the start apart (the command line does, with the garbage collector paused).
     Parameters as :func:`run_sweep`'s.
     """
-    from . import storage  # noqa: F401 - h5py, h5netcdf, hdf5plugin
+    from . import storage  # noqa: F401 - h5py, hdf5plugin
 
     _warm_up(cfg, workers, scheduler, log)
 

@@ -48,3 +48,113 @@ def test_every_codec_stores_the_same_cube(tmp_path, codec):
 
     with h5py.File(tmp_path / f"{codec}.h5") as f:  # h5py reads it (hdf5plugin loaded)
         np.testing.assert_array_equal(f["tip_force_max"][...], ref["tip_force_max"].values)
+
+
+# ------------------------------------------------------------------ the netCDF-4 layout
+def _h5netcdf_cube(path, cfg, codec):
+    """The cube's skeleton as h5netcdf writes it (what CubeFile did before issue 17's
+    direct writer): the reference layout the h5py writer must reproduce."""
+    import h5netcdf
+
+    from nylonflex.engine.grid import coords, cube_variables, plan_slabs
+    from nylonflex.storage.cube import CODECS, _chunks
+    from nylonflex.variables import COORDS, MODEL, slab_done_attrs
+
+    _, chunk = plan_slabs(cfg)
+    with h5netcdf.File(path, "w") as f:
+        sizes = {name: len(v) for name, v in coords(cfg).items()}
+        if len(cfg.models) > 1:
+            sizes["model"] = len(cfg.models)
+        f.dimensions = sizes
+        for name, values in coords(cfg).items():
+            f.create_variable(name, (name,), "f8", data=values).attrs.update(
+                COORDS[name].attrs())
+        if len(cfg.models) > 1:
+            f.create_variable("model", ("model",), h5py.string_dtype(),
+                              data=np.array(cfg.models, dtype=object)).attrs.update(
+                MODEL.attrs())
+        for var, dims in cube_variables(cfg).values():
+            fill = None if var.dtype == "int8" else np.nan
+            f.create_variable(var.name, dims, var.dtype, fillvalue=fill,
+                              chunks=_chunks(dims, sizes, chunk),
+                              **CODECS[codec].filters).attrs.update(var.attrs())
+        f.create_variable("slab_done", ("radius",), "i1", fillvalue=None).attrs.update(
+            slab_done_attrs())
+        f.attrs.update({"name": cfg.name, "compression": codec})
+
+
+def _layout(path) -> dict:
+    """Everything of an HDF5 file that makes it netCDF-4 and this cube: every object's
+    type, shape, chunks, filters, fill value, creation-order flags and attributes (scale
+    references as names; the order of attributes and of reference lists aside)."""
+    def attr(ds, key):
+        value = ds.attrs[key]
+        if key == "DIMENSION_LIST":
+            return [ds.file[row[0]].name for row in value]
+        if key == "REFERENCE_LIST":
+            return sorted((ds.file[r[0]].name, int(r[1])) for r in value)
+        a = ds.attrs.get_id(key)
+        return (str(a.dtype), a.shape, value if isinstance(value, (str, bytes))
+                else repr(np.asarray(value).tolist()))  # repr: NaN equals NaN
+
+    out = {}
+    with h5py.File(path, "r") as f:
+        gcpl = f["/"].id.get_create_plist()
+        out["/"] = (gcpl.get_link_creation_order(), gcpl.get_attr_creation_order(),
+                    sorted(k for k in f.attrs if k != "_NCProperties"))
+        out["/names"] = list(f)  # links in creation order
+        for name, ds in f.items():
+            dcpl = ds.id.get_create_plist()
+            filters = [dcpl.get_filter(i)[:3] for i in range(dcpl.get_nfilters())]
+            fill = np.zeros((), ds.dtype) if ds.dtype.kind != "O" else None
+            if fill is not None:
+                dcpl.get_fill_value(fill)
+            out[name] = {"dtype": str(ds.dtype), "shape": ds.shape, "chunks": ds.chunks,
+                         "filters": filters, "layout": dcpl.get_layout(),
+                         "fill": None if fill is None else repr(fill.tolist()),
+                         "attr_order": dcpl.get_attr_creation_order(),
+                         "attrs": {k: attr(ds, k) for k in sorted(ds.attrs)}}
+    return out
+
+
+@pytest.mark.parametrize("case", ["plain", "models_and_supply", "uncertainty"])
+@pytest.mark.parametrize("codec", ["zstd", "gzip"])
+def test_the_cube_has_h5netcdfs_netcdf4_layout(tmp_path, case, codec):
+    # CubeFile writes the netCDF-4 layout with h5py alone (issue 17: h5netcdf's lookups
+    # cost 0.1 s a sweep): object for object it is the file h5netcdf writes
+    import netCDF4
+    import xarray as xr
+    import yaml
+    from pathlib import Path
+
+    from nylonflex.config import parse_config
+    from nylonflex.engine.grid import coords, cube_variables, plan_slabs
+    from nylonflex.storage.cube import CubeFile
+
+    raw = yaml.safe_load((Path(__file__).parent / "data" / "reference_cube.yaml").read_text())
+    raw["compression"] = codec
+    if case == "models_and_supply":
+        raw.update(model=["paper", "coupled_muscle", "cauchy_moment"],
+                   supply={"voltage": 12})
+    elif case == "uncertainty":
+        raw["uncertainty"] = {"samples": 16, "seed": 1,
+                              "parameters": {"silicone.mu": {"rel_sd": 0.1}}}
+    cfg = parse_config(raw)
+    _, chunk = plan_slabs(cfg)
+    ours, theirs = tmp_path / "ours.h5", tmp_path / "theirs.h5"
+    CubeFile(ours, coords(cfg), {"name": cfg.name}, chunk, codec, cube_variables(cfg),
+             cfg.models).close()
+    _h5netcdf_cube(theirs, cfg, codec)
+    assert _layout(ours) == _layout(theirs)
+    with h5py.File(ours, "r") as f:
+        assert f.attrs["_NCProperties"].decode().startswith("version=2,nylonflex=")
+    # and netCDF-C and xarray read the same dimensions, variables and attributes
+    with netCDF4.Dataset(ours) as a, netCDF4.Dataset(theirs) as b:
+        assert {k: len(v) for k, v in a.dimensions.items()} == \
+            {k: len(v) for k, v in b.dimensions.items()}
+        for name, var in b.variables.items():
+            assert a.variables[name].dimensions == var.dimensions, name
+            assert a.variables[name].ncattrs() == var.ncattrs(), name
+    with xr.open_dataset(ours, engine="h5netcdf") as a, \
+            xr.open_dataset(theirs, engine="h5netcdf") as b:
+        xr.testing.assert_identical(a, b)

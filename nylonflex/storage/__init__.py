@@ -1,6 +1,7 @@
-"""The design cube on disk: NetCDF4/HDF5 written through h5netcdf, read with xarray.
+"""The design cube on disk: netCDF-4/HDF5 written through h5py, read with xarray.
 
 - :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once;
+- :mod:`.netcdf4`: the netCDF-4 layout (dimensions, coordinates, attributes) in h5py;
 - :mod:`.journal`: the journal of finished slabs and the one-writer lock;
 - :mod:`.run`: a sweep into a file (the journaled sink of the engine's slab loop, resume);
 - :mod:`.reader`: :func:`open_cube` and friends.

@@ -1,4 +1,4 @@
-"""Writing the cube file: NetCDF4/HDF5 through h5netcdf, slab by slab, chunks compressed once."""
+"""Writing the cube file: netCDF-4/HDF5 through h5py, slab by slab, chunks compressed once."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..variables import COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
+from .netcdf4 import NetCDF4File
 
 __all__ = ["CODECS", "DEFAULT_CODEC", "Codec", "CubeFile"]
 
@@ -113,13 +114,13 @@ class _Layout:
 
 
 class CubeFile:
-    """Writes one cube file slab by slab (h5netcdf; the codec of :data:`CODECS` it is given,
-    zstd by default, with the shuffle filter where the codec has it)."""
+    """Writes one cube file slab by slab (netCDF-4 through h5py, :mod:`.netcdf4`; the codec
+    of :data:`CODECS` it is given, zstd by default, with the shuffle filter where the codec
+    has it)."""
 
     def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
                  codec: str = DEFAULT_CODEC, variables: dict | None = None,
                  models=("paper",)):
-        import h5netcdf
         import h5py
 
         self.codec = CODECS[codec]
@@ -129,36 +130,28 @@ class CubeFile:
         self.path = Path(path)
         # the caller holds the writer's lock on this file (storage.journal.exclusive), so
         # HDF5's own lock, which would conflict with it, is off
-        self.f = h5netcdf.File(self.path, "w", locking=False)
+        self.f = NetCDF4File(self.path)
         sizes = {name: len(values) for name, values in coords.items()}
-        if len(models) > 1:
-            sizes["model"] = len(models)
-        self.f.dimensions = sizes
         for name, values in coords.items():
-            v = self.f.create_variable(name, (name,), "f8", data=np.asarray(values, float))
-            v.attrs.update(COORDS[name].attrs())
+            self.f.coordinate(name, np.asarray(values, float), COORDS[name].attrs())
         if len(models) > 1:  # the string dimension of a cube of several model variants
-            v = self.f.create_variable("model", ("model",), h5py.string_dtype(),
-                                       data=np.array(models, dtype=object))
-            v.attrs.update(MODEL.attrs())
+            sizes["model"] = len(models)
+            self.f.coordinate("model", np.array(models, dtype=object), MODEL.attrs(),
+                              dtype=h5py.string_dtype())
         # the variables the config asks for, {name: (registry entry, dims)}; a plain
         # sweep's by default
         if variables is None:
             variables = {n: (v, v.dims) for n, v in {**DESIGN, **CURVES}.items()}
         for var, dims in variables.values():
             fill = None if var.dtype == "int8" else np.nan
-            v = self.f.create_variable(var.name, dims, var.dtype, fillvalue=fill,
-                                       chunks=_chunks(dims, sizes, radius_chunk),
-                                       **self.codec.filters)
-            v.attrs.update(var.attrs())
-        done = self.f.create_variable("slab_done", ("radius",), "i1", fillvalue=None)
-        done.attrs.update(slab_done_attrs())
-        self.f.attrs.update({**attrs, "compression": self.codec.name})
-        # each variable's HDF5 dataset and layout, looked up once: through h5netcdf and
-        # h5py a lookup costs about 0.1 ms with the GIL held, several a variable a slab
-        self._layout = {name: _Layout(v._h5ds, tuple(v.dimensions), v._h5ds.chunks,
-                                      v._h5ds.shape, v._h5ds.dtype)
-                        for name, v in self.f.variables.items()}
+            self.f.variable(var.name, dims, var.dtype, var.attrs(), fillvalue=fill,
+                            chunks=_chunks(dims, sizes, radius_chunk), **self.codec.filters)
+        self.f.variable("slab_done", ("radius",), "i1", slab_done_attrs())
+        self.f.set_attrs({**attrs, "compression": self.codec.name})
+        # each variable's dataset and layout, looked up once (an h5py lookup costs about
+        # 0.1 ms with the GIL held, several a variable a slab)
+        self._layout = {name: _Layout(ds, self.f.dims[name], ds.chunks, ds.shape, ds.dtype)
+                        for name, ds in self.f.datasets.items()}
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def write(self, i0: int, i1: int, arrays: dict):
@@ -221,7 +214,7 @@ class CubeFile:
             elif part:
                 continue  # sizes and bytes go with their offsets
             elif layout.dims and layout.dims[0] == "radius":
-                layout.dset[i0:i1] = value  # (h5netcdf writes plain types so too)
+                layout.dset[i0:i1] = value
             else:
                 layout.dset[...] = value
         self._layout["slab_done"].dset[i0:i1] = 1
@@ -238,22 +231,18 @@ class CubeFile:
             yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec)
 
     def abandon(self):
-        """Close after a failure (a full disk, an error) without raising, and without
-        leaving h5netcdf a second close to try (and print) at garbage collection."""
+        """Close after a failure (a full disk, an error) without raising."""
         import contextlib
 
         self._pool.shutdown(cancel_futures=True)
         with contextlib.suppress(Exception):
-            self.f.close()
-        if not self.f._closed:
-            with contextlib.suppress(Exception):
-                self.f._h5file.close()
-            self.f._closed = True
+            self.f.h5.close()
 
     def close(self, attrs: dict | None = None):
+        """Write the final root attributes ``attrs`` and close the file."""
         self._pool.shutdown()
         if attrs:
-            self.f.attrs.update(attrs)
+            self.f.set_attrs(attrs)
         self.f.close()
 
 
