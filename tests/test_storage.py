@@ -158,3 +158,19 @@ def test_the_cube_has_h5netcdfs_netcdf4_layout(tmp_path, case, codec):
     with xr.open_dataset(ours, engine="h5netcdf") as a, \
             xr.open_dataset(theirs, engine="h5netcdf") as b:
         xr.testing.assert_identical(a, b)
+
+
+@pytest.mark.parametrize("itemsize", [2, 4, 8])
+@pytest.mark.parametrize("n", [0, 1, 7, 8, 9, 64, 1000, 100_000])
+def test_shuffle_is_hdf5s_byte_transpose(itemsize, n):
+    # the compiled shuffle (the word loop for 8-byte elements, the byte loop otherwise)
+    # against NumPy's transpose, including buffers that are not 8-byte aligned
+    from nylonflex.kernels.bytes import shuffle_bytes
+
+    rng = np.random.default_rng(n + itemsize)
+    for offset in (0, 1):
+        buf = rng.integers(0, 256, n * itemsize + offset, dtype=np.uint8)
+        src = buf[offset:].reshape(n, itemsize)
+        out = np.empty(itemsize * n + offset, np.uint8)[offset:].reshape(itemsize, n)
+        shuffle_bytes(src, out)
+        np.testing.assert_array_equal(out, src.T)
