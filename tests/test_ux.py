@@ -246,3 +246,39 @@ def test_chart_slice_reaches_each_chart_and_progress(odd, tmp_path):
     seen = []
     charts.draw_charts(odd, ["fig4", "fig6"], tmp_path, progress=lambda d, n: seen.append(d))
     assert seen[-1] == 2
+
+
+def test_the_console_script_exits_fast_with_the_status_output_and_exit_handlers(tmp_path):
+    # run() ends the process with os._exit after main(): the status, the buffered output
+    # (a pipe here) and the atexit handlers must all survive it
+    import subprocess
+    import sys
+
+    code = ("import atexit, sys\n"
+            "atexit.register(lambda: print('exit handler ran'))\n"
+            "sys.argv = ['nylonflex', *sys.argv[1:]]\n"
+            "from nylonflex.cli import run\n"
+            "run()\n")
+    bad = subprocess.run([sys.executable, "-c", code, "sweep", "missing.yaml"],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert bad.returncode == 2, bad.stderr
+    assert "no such config file" in bad.stderr
+    assert "exit handler ran" in bad.stdout
+    ok = subprocess.run([sys.executable, "-m", "nylonflex", "--version"],
+                        capture_output=True, text=True, cwd=tmp_path)
+    assert ok.returncode == 0 and ok.stdout.startswith("nylonflex "), ok
+
+
+def test_the_console_script_waits_for_a_thread_left_running(tmp_path):
+    # a non-daemon thread still running: the usual exit, which waits for it
+    import subprocess
+    import sys
+
+    code = ("import sys, threading, time\n"
+            "threading.Thread(target=lambda: (time.sleep(0.3), print('thread done'))).start()\n"
+            "sys.argv = ['nylonflex', '--version']\n"
+            "from nylonflex.cli import run\n"
+            "run()\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       cwd=tmp_path)
+    assert r.returncode == 0 and "thread done" in r.stdout, r
