@@ -37,30 +37,33 @@ def _import_numba_arraymath():
     kernel*, and that module imports ``scipy.linalg`` at once only to learn whether BLAS is
     there (``_HAVE_BLAS``, which chooses how ``np.convolve`` and ``np.correlate`` multiply).
     scipy.linalg costs 0.1-0.3 s of every command that loads a kernel, and no kernel calls
-    BLAS. Here the probe's import fails fast, the flag is set from whether scipy's BLAS
-    module is installed (a file test, no import), and nothing else changes: np.dot and
-    np.linalg still import scipy.linalg when a kernel that uses them is compiled. Holding
-    the import lock keeps other threads' imports from seeing the probe's stand-in. Where
-    scipy.linalg or numba.np.arraymath is imported already, nothing is done.
+    BLAS. While arraymath is imported, the probe (``numba.np.linalg.ensure_blas``) asks
+    whether scipy's BLAS module is installed (a file test) instead of importing it; then
+    Numba's own probe is put back, so np.dot and np.linalg still import scipy.linalg (and
+    check its integer width) when something that uses them is compiled. Where scipy.linalg
+    or arraymath is imported already, nothing is done.
     """
-    import _imp
     import sys
 
     if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
         return
-    probe = "scipy.linalg.cython_blas"
-    _imp.acquire_lock()
+    from numba.np import linalg
+
+    numbas = linalg.ensure_blas
+    linalg.ensure_blas = _blas_probe
     try:
-        sys.modules[probe] = None  # `import` of it raises ImportError at once
-        try:
-            from numba.np import arraymath
-        finally:
-            if sys.modules.get(probe, 0) is None:
-                del sys.modules[probe]
+        from numba.np import arraymath
     finally:
-        _imp.release_lock()
-    if hasattr(arraymath, "_HAVE_BLAS"):
-        arraymath._HAVE_BLAS = _scipy_blas_installed()
+        linalg.ensure_blas = numbas
+    if getattr(arraymath, "ensure_blas", None) is _blas_probe:
+        arraymath.ensure_blas = numbas
+
+
+def _blas_probe():
+    """Numba's ``ensure_blas`` at arraymath's import: ImportError when scipy's BLAS module
+    is not installed (found on disk, not imported)."""
+    if not _scipy_blas_installed():
+        raise ImportError("scipy 0.16+ is required for linear algebra")
 
 
 def _scipy_blas_installed() -> bool:
