@@ -72,11 +72,6 @@ class NetCDF4File:
         self.dims: dict = {}
         self._dimid: dict = {}
 
-    @property
-    def attrs(self):
-        """The root group's attributes (h5py)."""
-        return self.h5.attrs
-
     def set_attrs(self, values: dict, name: str | None = None):
         """Write attributes of the root group, or of variable ``name``."""
         _set_attrs(self.h5.attrs if name is None else self.datasets[name].attrs, values)
