@@ -275,7 +275,7 @@ def warm_up():
     """Import what drawing needs, so that forked drawing processes inherit it.
 
     matplotlib (Agg); and xarray's duck-array modules: xarray imports ``dask.array``
-    (about 0.7 s) at a process's first indexing when dask is installed, which each
+    (0.3-0.5 s) at a process's first indexing when dask is installed, which each
     drawing process would otherwise do again.
     """
     import xarray as xr
