@@ -1,21 +1,34 @@
-"""Files the user owns: durable publishing renames, and refusing special files.
+"""Files the user owns: one way to create or replace a path, and refusing what is in the way.
 
-Used by every writer of an output (the sweep's cube and journal, a simulation): nothing is
-ever written over a device, fifo, socket or folder, and a rename that publishes a result is
-preceded by an fsync of the file and followed by one of its folder, so that after a crash
-the name points to whole data or to the old file.
+Every writer of nylonflex (the sweep's cube, building file, lock and journal; charts,
+material files, explorer pages, simulations, manifests) goes through this module:
+
+- a path is written only through a temporary created new beside it (``O_CREAT | O_EXCL |
+  O_NOFOLLOW``: never an existing file, never through a link) and renamed onto it once its
+  bytes are on disk (:func:`replacing`, :func:`write_atomic`); the rename is preceded by an
+  fsync of the file and followed by one of its folder, so that after a crash the name
+  points to whole data or to the old file;
+- nothing is written at a path that is a symbolic link, a device, fifo, socket or folder
+  (:func:`refuse_special`, which looks at the path itself with ``lstat``), nor onto a file
+  the same command reads (``inputs``): a run never writes outside the output's folder.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import secrets
 import stat
 from pathlib import Path
 
 from .units import InputError
 
-__all__ = ["OwnedFiles", "fsync_dir", "publish", "refuse_special"]
+__all__ = ["OwnedFiles", "create_new", "fsync_dir", "publish", "refuse_link",
+           "refuse_special", "replacing", "write_atomic"]
+
+#: The flags of a file nylonflex creates: a new file, never through a link at its path.
+NEW_FILE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | \
+    getattr(os, "O_CLOEXEC", 0)
 
 
 def fsync_dir(path):
@@ -30,27 +43,116 @@ def fsync_dir(path):
 
 def publish(tmp: Path, final: Path):
     """Rename ``tmp`` onto ``final`` durably: fsync the file, rename, fsync the folder."""
-    with open(tmp, "rb+") as fh:
-        os.fsync(fh.fileno())
+    fd = os.open(tmp, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
     os.replace(tmp, final)
     fsync_dir(final.parent)
 
 
-def refuse_special(path: Path, what: str):
-    """Refuse a path that exists and is not a regular file (a device, fifo, socket, link
-    to one, or folder): nothing is ever written over it."""
+def _link_error(path, what) -> InputError:
     try:
-        mode = os.stat(path).st_mode
+        target = f" (to {os.readlink(path)!s:.200})"
+    except OSError:
+        target = ""
+    return InputError(f"{what}: {path} is a symbolic link{target}; nylonflex never writes "
+                      "through a link: remove it or choose another path")
+
+
+def refuse_link(path, what: str):
+    """Refuse ``path`` when it is a symbolic link (dangling or not): one line naming it.
+
+    For the side paths of an output (``<out>.lock``, ``<out>.building``, ``<out>.parts``
+    and what is in it), where a link would carry a write out of the output's folder.
+    """
+    if os.path.islink(path):
+        raise _link_error(path, what)
+
+
+def refuse_special(path: Path, what: str, inputs=()):
+    """Refuse a path that exists and is not a regular file (a symbolic link, device, fifo,
+    socket, or folder), or that is one of ``inputs`` (files the same command reads):
+    nothing is ever written over it.
+
+    The path itself is looked at (``lstat``): a link is refused, not followed.
+    """
+    try:
+        st = os.lstat(path)
     except FileNotFoundError:
         return
     except OSError as exc:
         raise InputError(f"{what}: {path} cannot be read ({exc.strerror})") from None
+    mode = st.st_mode
+    if stat.S_ISLNK(mode):
+        raise _link_error(path, what)
     if stat.S_ISDIR(mode):
         raise InputError(f"{what}: {path} is a folder; give a file path such as "
                          f"{path}/cube.h5")
     if not stat.S_ISREG(mode):
         raise InputError(f"{what}: {path} is a special file (device, fifo or socket); "
                          "nylonflex writes only regular files")
+    for source in inputs:
+        try:
+            other = os.stat(source)
+        except (OSError, TypeError, ValueError):
+            continue
+        if (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
+            raise InputError(f"{what}: {path} is {source}, which this command reads; it is "
+                             "not replaced: choose another path")
+
+
+def create_new(path, mode: int = 0o666) -> int:
+    """Open ``path`` as a new regular file (an fd for writing): refused (FileExistsError)
+    when anything is at the path, a link included; the umask applies to ``mode``."""
+    return os.open(path, NEW_FILE, mode)
+
+
+def _temporary(path: Path) -> tuple[Path, int]:
+    """A new temporary file beside ``path``, created by this process: (its path, an fd)."""
+    for _ in range(100):
+        tmp = path.with_name(f".{path.name[:200]}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+        try:
+            return tmp, create_new(tmp)
+        except FileExistsError:
+            continue
+    raise InputError(f"{path.parent}: cannot create a temporary file there")
+
+
+@contextlib.contextmanager
+def replacing(path, what: str = "--out", inputs=()):
+    """Write ``path`` through a new temporary file: yields the temporary's path.
+
+    The caller writes the whole result into the yielded path (a library that takes a file
+    name: matplotlib, h5py). On a clean exit it is fsynced and renamed onto ``path``; on an
+    error it is removed and ``path`` is left as it was. ``path`` is refused first (see
+    :func:`refuse_special`) when it is a link, a special file, a folder or one of
+    ``inputs``; its folder is made when missing.
+    """
+    path = Path(path)
+    refuse_special(path, what, inputs)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp, fd = _temporary(path)
+    os.close(fd)
+    try:
+        yield tmp
+        refuse_special(path, what, inputs)  # nothing was put in the way meanwhile
+        publish(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+
+
+def write_atomic(path, data: bytes, what: str = "--out", inputs=()) -> Path:
+    """Write ``data`` [bytes] to ``path`` through a new temporary and a rename
+    (:func:`replacing`); returns ``path``."""
+    path = Path(path)
+    with replacing(path, what, inputs) as tmp:
+        fd = os.open(tmp, os.O_WRONLY | getattr(os, "O_NOFOLLOW", 0))
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+    return path
 
 
 class OwnedFiles:
@@ -79,6 +181,7 @@ class OwnedFiles:
     def _read(self) -> dict:
         import json
 
+        refuse_special(self.path, "--out")
         try:
             raw = self.path.read_bytes()
         except FileNotFoundError:
@@ -132,7 +235,5 @@ class OwnedFiles:
         for path in paths:
             path = Path(path)
             self.files[path.name] = {"source": self.owner, "sha256": self._digest(path)}
-        tmp = self.path.with_name(self.NAME + ".tmp")
-        tmp.write_text(json.dumps({"format": 1, "files": self.files}, indent=1,
-                                  sort_keys=True))
-        publish(tmp, self.path)
+        write_atomic(self.path, json.dumps({"format": 1, "files": self.files}, indent=1,
+                                           sort_keys=True).encode(), "--out")

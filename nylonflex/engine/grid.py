@@ -70,9 +70,36 @@ def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
     na = cfg.shape[0]
     per_slab = min(na, max(1, int(cfg.slab_megabytes * 2**20) // per))
     # chunks of about 2 MB of one variable, never longer than a slab
-    chunk = max(1, min(per_slab, (2 * 2**20) // max(1, per // 9)))
+    chunk = min(per_slab, _chunk_cap(per))
     per_slab = (per_slab // chunk) * chunk
-    return [(i, min(na, i + per_slab)) for i in range(0, na, per_slab)], chunk
+    return _uniform_slabs(na, per_slab), chunk
+
+
+def _chunk_cap(per_radius: int) -> int:
+    """The longest chunk along radius [radii]: about 2 MB of one variable."""
+    return max(1, (2 * 2**20) // max(1, per_radius // 9))
+
+
+def _uniform_slabs(na: int, per_slab: int) -> list[tuple[int, int]]:
+    return [(i, min(na, i + per_slab)) for i in range(0, na, per_slab)]
+
+
+def plan_is_implied(cfg: ResolvedConfig, slabs, chunk) -> bool:
+    """Whether ``(slabs, chunk)`` is a plan :func:`plan_slabs` gives this config for some
+    ``slab_megabytes`` (which may change between a run and its resume): slabs of one length
+    ``n`` from radius 0 to the last, and a chunk length of ``min(n, cap)``."""
+    na = cfg.shape[0]
+    try:
+        slabs = [(int(a), int(b)) for a, b in slabs]
+    except (TypeError, ValueError):
+        return False
+    if not slabs or not isinstance(chunk, int) or isinstance(chunk, bool):
+        return False
+    n = slabs[0][1] - slabs[0][0]
+    if not 1 <= n <= na:
+        return False
+    return slabs == _uniform_slabs(na, n) and \
+        chunk == min(n, _chunk_cap(_bytes_per_radius(cfg))) and n % chunk == 0
 
 
 def _coil_table(cfg: ResolvedConfig):

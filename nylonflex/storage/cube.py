@@ -154,6 +154,18 @@ class CubeFile:
                         for name, ds in self.f.datasets.items()}
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
+    def decoding(self) -> str:
+        """How this file's stored chunks decode: the codec, its filters and each variable's
+        dtype and chunk shape (what a journaled slab's digest covers, so that a journal
+        whose codec was edited is recomputed, never trusted) [-]."""
+        import json
+
+        return json.dumps({"codec": self.codec.name, "filters": self.codec.filters,
+                           "shuffle": self.codec.shuffle,
+                           "chunks": {name: [list(lay.chunks or ()), lay.dtype.str]
+                                      for name, lay in self._layout.items()}},
+                          sort_keys=True, default=str)
+
     def write(self, i0: int, i1: int, arrays: dict):
         """Write the variables of radii [i0, i1) (and those without a radius dim)."""
         self.write_encoded(i0, i1, self.encode(i0, arrays))

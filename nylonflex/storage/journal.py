@@ -6,11 +6,21 @@ still the one at that path, so the unlink-then-unlock race cannot admit two writ
 on ``<cube>.building`` itself, opened without truncation. Deleting a "stale" lock file
 therefore does not let a second writer in: the building file's lock refuses it before it
 touches any file. The cube writer opens the building file with HDF5's own locking off,
-since this process already holds the lock on it.
+since this process already holds the lock on it. Before the building file is renamed onto
+the cube, its lock is made a shared one (:func:`share_building`): a reader's HDF5 lock
+(shared) never meets the writer's on the published file, and a second writer's
+(exclusive) is still refused.
+
+No side path is followed: a symbolic link at ``<cube>.lock``, ``<cube>.building``,
+``<cube>.parts`` or inside it is refused with one line naming it, and every file there is
+created new (``O_EXCL | O_NOFOLLOW``) and renamed into place, so that a run never writes
+outside the output's folder.
 
 The journal verifies itself: the manifest records its format, the nylonflex version, the
-model digest and a digest of its own content; every slab file records its index, its
-radius range and a digest of its arrays (bound to the config's hash). A slab that fails
+model digest, the slab plan and the codec; the run checks each against what the config
+and the code imply (:mod:`.run`), not against the manifest itself. Every slab file records
+its index, its radius range and a digest of its arrays bound to the config's hash and to
+everything that decodes them (codec, filters, chunking: ``decoding``). A slab that fails
 verification is recomputed, never trusted.
 """
 
@@ -25,14 +35,18 @@ from pathlib import Path
 
 import numpy as np
 
-from ..files import fsync_dir, publish, refuse_special
+import stat
+
+from ..files import create_new, fsync_dir, publish, refuse_link, refuse_special
 from ..units import InputError
 
 __all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "exclusive", "fsync_dir",
-           "publish", "refuse_special"]
+           "publish", "refuse_special", "share_building"]
 
-#: Version of the journal's layout (manifest keys, slab metadata).
-JOURNAL_FORMAT = 2
+#: Version of the journal's layout (manifest keys, slab metadata). 3: a slab's digest
+#: covers how its chunks decode (codec, filters, chunking).
+JOURNAL_FORMAT = 3
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _MANIFEST_KEYS = ("format", "name", "config_sha256", "slabs", "radius_chunk",
                   "nylonflex_version", "model_digest", "replaces")
 _LOCK_TEXT = b"nylonflex sweep lock\n"
@@ -42,8 +56,8 @@ class SlabInvalid(Exception):
     """A journaled slab that fails verification (its message says why)."""
 
 
-def _digest(config_sha, k, i0, i1, arrays: dict) -> str:
-    h = hashlib.sha256(f"{config_sha}:{k}:{i0}:{i1}".encode())
+def _digest(config_sha, k, i0, i1, arrays: dict, decoding: str = "") -> str:
+    h = hashlib.sha256(f"{config_sha}:{k}:{i0}:{i1}:{decoding}".encode())
     for name in sorted(arrays):
         a = np.ascontiguousarray(arrays[name])
         h.update(f"|{name}|{a.dtype.str}|{a.shape}|".encode())
@@ -65,37 +79,49 @@ class Journal:
         self.manifest = self.dir / "manifest.json"
 
     def exists(self) -> bool:
-        return self.manifest.is_file()
+        """Whether the folder holds a manifest (a regular file, never a link's target)."""
+        return _regular(self.manifest) and _regular(self.dir, stat.S_ISDIR)
 
     def read_manifest(self) -> dict:
+        """The manifest's content; {} when it cannot be read or is not a JSON object."""
         try:
-            data = json.loads(self.manifest.read_text())
+            fd = os.open(self.manifest, os.O_RDONLY | _NOFOLLOW)
+            with os.fdopen(fd, "rb") as fh:
+                data = json.loads(fh.read(10_000_000).decode("utf-8"))
         except (OSError, ValueError):
             return {}
         return data if isinstance(data, dict) else {}
 
+    def refuse_links(self):
+        """Refuse a symbolic link at ``<cube>.parts`` or inside it, with one line naming
+        it (a link there would carry the journal's writes out of the output's folder)."""
+        refuse_link(self.dir, "--out")
+        if _regular(self.dir, stat.S_ISDIR):
+            for p in self.dir.iterdir():
+                refuse_link(p, "--out")
+
     def foreign(self) -> bool:
         """True when ``<cube>.parts`` exists but is not a journal nylonflex wrote: a
         non-folder, or a folder with anything but a manifest, slab files and their
-        temporaries in it."""
+        temporaries in it (regular files, never links)."""
         if not os.path.lexists(self.dir):
             return False
-        if self.dir.is_symlink() or not self.dir.is_dir():
+        if not _regular(self.dir, stat.S_ISDIR):
             return True
         for p in self.dir.iterdir():
-            if p.name in ("manifest.json", "manifest.json.tmp"):
-                continue
-            if p.name.startswith("slab-") and p.suffix in (".npz", ".tmp") and p.is_file():
-                continue
-            return True
+            ours = p.name in ("manifest.json", "manifest.json.tmp") or \
+                (p.name.startswith("slab-") and p.suffix in (".npz", ".tmp"))
+            if not (ours and _regular(p)):
+                return True
         return False
 
     def start(self, manifest: dict):
         """Begin a journal (the folder must be absent, empty or a nylonflex journal)."""
+        self.refuse_links()
         if self.foreign():
             raise InputError(f"{self.dir} exists and was not written by nylonflex; it is "
                              "not deleted: move it or choose another --out")
-        if self.dir.exists():
+        if os.path.lexists(self.dir):
             shutil.rmtree(self.dir)
         self.dir.mkdir(parents=True)
         manifest = {"format": JOURNAL_FORMAT, **manifest}
@@ -113,13 +139,15 @@ class Journal:
                 out.add(int(p.stem.split("-")[1]))
         return out
 
-    def save(self, k: int, arrays: dict, *, slab=(0, 0), config_sha: str = ""):
-        """Journal slab ``k`` (radii ``slab``) with its index, range and digest."""
+    def save(self, k: int, arrays: dict, *, slab=(0, 0), config_sha: str = "",
+             decoding: str = ""):
+        """Journal slab ``k`` (radii ``slab``) with its index, range and digest (of the
+        arrays, the config's hash and ``decoding``: how its chunks decode)."""
         i0, i1 = (int(x) for x in slab)
         meta = {"index": int(k), "slab": [i0, i1], "config_sha256": config_sha,
-                "digest": _digest(config_sha, k, i0, i1, arrays)}
+                "digest": _digest(config_sha, k, i0, i1, arrays, decoding)}
         tmp = self._slab_path(k).with_suffix(".tmp")
-        with open(tmp, "wb") as fh:
+        with _new_file(tmp) as fh:
             np.savez(fh, **arrays, __meta__=np.frombuffer(json.dumps(meta).encode(),
                                                           np.uint8))
             fh.flush()
@@ -127,12 +155,15 @@ class Journal:
         os.replace(tmp, self._slab_path(k))
         fsync_dir(self.dir)
 
-    def load(self, k: int, *, slab=None, config_sha: str | None = None) -> dict:
+    def load(self, k: int, *, slab=None, config_sha: str | None = None,
+             decoding: str = "") -> dict:
         """Slab ``k``'s arrays, verified against its index, radius range ``slab`` and
-        digest; :class:`SlabInvalid` when anything does not match or cannot be read."""
+        digest (which covers ``decoding``); :class:`SlabInvalid` when anything does not
+        match or cannot be read."""
         path = self._slab_path(k)
         try:
-            with np.load(path, allow_pickle=False) as z:
+            fd = os.open(path, os.O_RDONLY | _NOFOLLOW)
+            with os.fdopen(fd, "rb") as fh, np.load(fh, allow_pickle=False) as z:
                 arrays = {name: z[name] for name in z.files}
         except Exception as exc:  # noqa: BLE001 - zip, zlib, format: all mean "unreadable"
             raise SlabInvalid(f"{path.name} is unreadable ({type(exc).__name__})") from None
@@ -150,7 +181,7 @@ class Journal:
             raise SlabInvalid(f"{path.name} holds radii {i0}..{i1}, not "
                               f"{slab[0]}..{slab[1]}")
         sha = meta.get("config_sha256", "") if config_sha is None else config_sha
-        if _digest(sha, k, i0, i1, arrays) != digest:
+        if _digest(sha, k, i0, i1, arrays, decoding) != digest:
             raise SlabInvalid(f"{path.name} fails its digest")
         return arrays
 
@@ -164,9 +195,25 @@ class Journal:
         fsync_dir(self.dir.parent)
 
 
+def _regular(path, kind=stat.S_ISREG) -> bool:
+    """Whether ``path`` itself (not a link's target) is of ``kind`` (a regular file)."""
+    try:
+        return kind(os.lstat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _new_file(tmp: Path):
+    """``tmp`` created new for writing (a leftover temporary of a killed run is removed
+    first; a link there is removed, never followed)."""
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(tmp)
+    return os.fdopen(create_new(tmp), "wb")
+
+
 def _atomic_write(path: Path, data: bytes):
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
+    with _new_file(tmp) as fh:
         fh.write(data)
         fh.flush()
         os.fsync(fh.fileno())
@@ -184,19 +231,21 @@ def _lock_file(lock: Path):
     import fcntl
 
     refuse_special(lock, "--out")
-    if lock.is_file() and lock.stat().st_size and \
-            not lock.read_bytes()[:64].startswith(_LOCK_TEXT.strip()):
-        raise InputError(f"{lock} exists and is not a nylonflex lock; it is not replaced: "
-                         "move it or choose another --out")
+    if _regular(lock):
+        with os.fdopen(os.open(lock, os.O_RDONLY | _NOFOLLOW), "rb") as fh:
+            head = fh.read(64)
+        if head and not head.startswith(_LOCK_TEXT.strip()):
+            raise InputError(f"{lock} exists and is not a nylonflex lock; it is not "
+                             "replaced: move it or choose another --out")
     while True:
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        fd = _open_side(lock)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             os.close(fd)
             return None
         try:
-            same = os.stat(lock).st_ino == os.fstat(fd).st_ino
+            same = os.lstat(lock).st_ino == os.fstat(fd).st_ino
         except FileNotFoundError:
             same = False
         if same:
@@ -204,6 +253,49 @@ def _lock_file(lock: Path):
             os.write(fd, _LOCK_TEXT + f"pid {os.getpid()}\n".encode())
             return fd
         os.close(fd)  # a releasing writer unlinked it after we opened it: take the new one
+
+
+def _open_side(path: Path) -> int:
+    """An fd of the side file ``path`` for reading and writing, made if missing, never
+    truncated and never through a link (one placed there meanwhile is refused)."""
+    try:
+        return os.open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW, 0o644)
+    except OSError as exc:
+        if os.path.islink(path):
+            refuse_link(path, "--out")
+        raise InputError(f"--out: {path} cannot be opened ({exc.strerror})") from None
+
+
+#: The building files this process holds: path -> the fd that holds its lock.
+_HELD: dict = {}
+
+
+def share_building(building):
+    """Make this process's lock on ``building`` a shared one, before it is published.
+
+    A reader's HDF5 lock is a shared ``flock``: an exclusive lock on the published inode
+    made it fail ("unable to lock file") until the journal was removed. A second writer's
+    exclusive lock is still refused (and the lock file is still held).
+    """
+    import fcntl
+
+    fd = _HELD.get(str(building))
+    if fd is not None:
+        fcntl.flock(fd, fcntl.LOCK_SH)
+
+
+def check_building(building):
+    """Raise RuntimeError unless ``building`` is still the file this process locked (not
+    replaced, nor by a link, since the lock was taken)."""
+    fd = _HELD.get(str(building))
+    try:
+        same = fd is not None and os.lstat(building).st_ino == os.fstat(fd).st_ino and \
+            _regular(building)
+    except OSError:
+        same = False
+    if not same:
+        raise RuntimeError(f"{building} was replaced while this run held it; nothing is "
+                           "published: run again")
 
 
 def building_path(cube_path) -> Path:
@@ -216,8 +308,10 @@ def building_is_ours(building: Path, journal: Journal) -> bool:
     building cube), or accompanied by this output's journal."""
     import h5py
 
-    if not building.exists():
+    if not os.path.lexists(building):
         return True
+    if not _regular(building):
+        return False
     if building.stat().st_size == 0 or journal.exists():
         return True
     try:
@@ -241,6 +335,7 @@ def exclusive(cube_path):
     building = building_path(cube_path)
     lock.parent.mkdir(parents=True, exist_ok=True)
     refuse_special(building, "--out")
+    Journal(cube_path).refuse_links()
     fd = _lock_file(lock)
     if fd is None:
         raise _busy(cube_path, lock.name)
@@ -249,18 +344,20 @@ def exclusive(cube_path):
         if not building_is_ours(building, Journal(cube_path)):
             raise InputError(f"{building} exists and was not written by nylonflex; it is "
                              "not replaced: move it or choose another --out")
-        created = not building.exists()
-        bfd = os.open(building, os.O_RDWR | os.O_CREAT, 0o644)  # never truncating
+        created = not os.path.lexists(building)
+        bfd = _open_side(building)  # never truncating
         try:
             fcntl.flock(bfd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             raise _busy(cube_path, building.name) from None
+        _HELD[str(building)] = bfd
         yield building
     finally:
+        _HELD.pop(str(building), None)
         if bfd is not None:
             # an unused building file this run created is not left behind
             with contextlib.suppress(OSError):
-                st = os.stat(building)
+                st = os.lstat(building)
                 if created and st.st_ino == os.fstat(bfd).st_ino and st.st_size == 0:
                     building.unlink()
             os.close(bfd)

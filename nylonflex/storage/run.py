@@ -20,13 +20,13 @@ from pathlib import Path
 
 from .. import __version__
 from ..config import ResolvedConfig
-from ..engine.grid import coords, cube_variables, global_arrays, plan_slabs
+from ..engine.grid import coords, cube_variables, global_arrays, plan_is_implied, plan_slabs
 from ..engine.provenance import provenance
 from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
 from ..units import InputError
-from .cube import CubeFile
-from .journal import JOURNAL_FORMAT, Journal, SlabInvalid, exclusive, manifest_digest, \
-    publish, refuse_special
+from .cube import CODECS, CubeFile
+from .journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
+    manifest_digest, publish, refuse_special, share_building
 from .reader import cube_attrs
 
 __all__ = ["CubeSink", "DiskFull", "Interrupted", "sweep_to_file"]
@@ -58,6 +58,7 @@ class CubeSink:
         self.cube = cube
         self.journal = journal
         self.config_sha = config_sha
+        self.decoding = cube.decoding()  # what each slab's digest covers besides its bytes
         self._journaling = ThreadPoolExecutor(1, thread_name_prefix="nylonflex-journal")
         self._saving = None  # the last slab's journal save, not yet waited for
 
@@ -69,7 +70,8 @@ class CubeSink:
         encoded = self.cube.encode_finish(arrays.started) if isinstance(arrays, _Started) \
             else self.cube.encode(i0, arrays)
         saving = self._journaling.submit(self.journal.save, k, encoded, slab=(i0, i1),
-                                         config_sha=self.config_sha)
+                                         config_sha=self.config_sha,
+                                         decoding=self.decoding)
         previous, self._saving = self._saving, saving
         try:
             self.cube.write_encoded(i0, i1, encoded)
@@ -147,6 +149,7 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
     if out.exists() and attrs is None:
         raise InputError(f"--out: {out} exists and is not a nylonflex cube; it is not "
                          "replaced: choose another --out or move it")
+    journal.refuse_links()
     if journal.foreign():
         raise InputError(f"{journal.dir} exists and was not written by nylonflex; it is "
                          "not deleted: move it or choose another --out")
@@ -162,25 +165,28 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
         if resume:
             log("nothing to resume; starting the sweep")
         return [], None, set(), replaces, cfg.compression
+    damaged = InputError(f"--resume: {journal.manifest} is damaged or was edited; delete "
+                         f"{journal.dir} to start over")
+    if not isinstance(manifest.get("config_sha256"), str):  # not JSON, or not a manifest
+        raise damaged
     if manifest.get("config_sha256") != cfg.sha256:
         raise InputError(f"--resume: the config changed since the interrupted run "
                          f"(sha256 {str(manifest.get('config_sha256', '?'))[:12]} vs "
                          f"{cfg.sha256[:12]}); delete {journal.dir} to start over")
     # the journal's own slab plan and chunking: slab_megabytes may differ now (it is not in
-    # the hash), and journaled slabs hold compressed chunks of the recorded shape
+    # the hash), and journaled slabs hold compressed chunks of the recorded shape. The plan
+    # must be one the config implies (for some slab_megabytes), the codec one nylonflex
+    # has: a manifest's digest of itself is no seal (an edit can recompute it), and each
+    # slab's digest covers the codec and chunking it is decoded with
     try:
         slabs = [tuple(int(i) for i in s) for s in manifest.get("slabs", [])]
     except (TypeError, ValueError):
         slabs = []
-    edges = [i for s in slabs for i in s]
     chunk = manifest.get("radius_chunk")
-    if not slabs or any(len(s) != 2 for s in slabs) or edges[0] != 0 or \
-            edges[-1] != cfg.shape[0] or \
-            any(a != b for a, b in zip(edges[1:-1:2], edges[2::2])) or \
-            any(a >= b for a, b in slabs) or not isinstance(chunk, int) or chunk < 1 or \
+    if any(len(s) != 2 for s in slabs) or not plan_is_implied(cfg, slabs, chunk) or \
+            manifest.get("compression", "gzip") not in CODECS or \
             manifest.get("digest") != manifest_digest(manifest):
-        raise InputError(f"--resume: {journal.manifest} is damaged or was edited; delete "
-                         f"{journal.dir} to start over")
+        raise damaged
     now = _versions()
     differs = [f"{key} {_short(manifest.get(key))} (now {value})" for key, value in now.items()
                if manifest.get(key) != value]
@@ -188,7 +194,9 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
         raise InputError(f"--resume: the journal in {journal.dir} was written with "
                          f"{'; '.join(differs)}; its slabs would mix two models: delete "
                          f"{journal.dir} and run again without --resume")
-    replaces = bool(manifest.get("replaces")) and attrs is not None
+    # what the cube at out implies, not what the manifest says: a finished cube there is
+    # kept until this run completes
+    replaces = attrs is not None and attrs.get("complete") == "true"
     codec = manifest.get("compression", "gzip")  # journaled chunks are in this codec
     if codec != cfg.compression:
         log(f"resuming with the journal's compression, {codec} (the config now says "
@@ -272,6 +280,7 @@ def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, pro
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
                     cfg.models)
     try:
+        check_building(building)  # HDF5 opened it by name: still the file this run locked
         _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
               replaces)
     except BaseException:
@@ -287,7 +296,8 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
     for k in sorted(keep):
         i0, i1 = slabs[k]
         try:
-            arrays = journal.load(k, slab=(i0, i1), config_sha=cfg.sha256)
+            arrays = journal.load(k, slab=(i0, i1), config_sha=cfg.sha256,
+                                  decoding=cube.decoding())
         except SlabInvalid as why:
             log(f"journal: {why}; recomputing that slab")
             journal.discard(k)
@@ -319,6 +329,10 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
     with deferred_signals():  # the publishing steps run to their end
         cube.close(final)
         if complete or not replaces:
+            # readers open the published cube with a shared lock: this run's lock is made
+            # shared first (docs/reliability.md), so that no reader meets it
+            share_building(building)
+            refuse_special(out, "--out")
             publish(building, out)
         if complete:
             journal.remove()
