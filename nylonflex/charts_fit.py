@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .files import save_figure
+
 __all__ = ["fit_chart", "validate_chart"]
 
 #: quantity -> (label, display unit, factor from SI, offset from SI)
@@ -68,7 +70,7 @@ def fit_chart(result, path) -> Path:
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -94,6 +96,6 @@ def validate_chart(comparisons, path, title="") -> Path:
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path

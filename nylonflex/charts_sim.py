@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .files import save_figure
+
 __all__ = ["draw_simulation_charts", "figure9", "figure10a"]
 
 
@@ -105,7 +107,7 @@ def figure9(ds, path):
     axp.set_ylim(0, max(float(ds["power"].max()) * 1.5, 0.1))  # room for the legend
     axp.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path, dpi=130)
     plt.close(fig)
     return Path(path)
 
@@ -154,7 +156,7 @@ def figure10a(ds, path):
     axw.set_ylim(0, max(float(total.max()) * 1.15, 0.1))
     axw.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path, dpi=130)
     plt.close(fig)
     return Path(path)
 

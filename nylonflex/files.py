@@ -24,7 +24,7 @@ from pathlib import Path
 from .units import InputError
 
 __all__ = ["OwnedFiles", "create_new", "fsync_dir", "publish", "refuse_link",
-           "refuse_special", "replacing", "write_atomic"]
+           "refuse_special", "replacing", "save_figure", "write_atomic"]
 
 #: The flags of a file nylonflex creates: a new file, never through a link at its path.
 NEW_FILE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | \
@@ -99,8 +99,8 @@ def refuse_special(path: Path, what: str, inputs=()):
         except (OSError, TypeError, ValueError):
             continue
         if (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
-            raise InputError(f"{what}: {path} is {source}, which this command reads; it is "
-                             "not replaced: choose another path")
+            raise InputError(f"{what}: {path} is also an input of this command ({source}); "
+                             "it is not replaced: choose another path")
 
 
 def create_new(path, mode: int = 0o666) -> int:
@@ -142,6 +142,16 @@ def replacing(path, what: str = "--out", inputs=()):
     finally:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+
+
+def save_figure(fig, path, what: str = "--out", inputs=(), **kwargs) -> Path:
+    """``fig.savefig`` into ``path`` through a new temporary and a rename (:func:`replacing`);
+    the format is the suffix's unless ``format`` is given. Returns ``path``."""
+    path = Path(path)
+    kwargs.setdefault("format", path.suffix.lstrip(".").lower() or "png")
+    with replacing(path, what, inputs) as tmp:
+        fig.savefig(tmp, **kwargs)
+    return path
 
 
 def write_atomic(path, data: bytes, what: str = "--out", inputs=()) -> Path:

@@ -12,6 +12,7 @@ relative path is taken from the config file's folder.
 from __future__ import annotations
 
 import datetime
+import os
 from pathlib import Path
 
 import numpy as np
@@ -83,22 +84,30 @@ def material_document(result, name=None, fields=None) -> dict:
     return _plain(doc)
 
 
-def write_material_file(result, path, name=None, overwrite=False, fields=None) -> Path:
+def write_material_file(result, path, name=None, overwrite=False, fields=None,
+                        inputs=()) -> Path:
     """Write a fit's material file (YAML); refuses to replace a file unless ``overwrite``.
+
+    Written through a new temporary and a rename (:func:`nylonflex.files.replacing`):
+    never through a link, onto a special file, or onto the fit's data file or one of
+    ``inputs``.
 
     Raises
     ------
     InputError
-        The file exists and ``overwrite`` is false.
+        The file exists and ``overwrite`` is false, or it may not be written (see above).
     """
+    from .files import refuse_special, write_atomic
+
     path = Path(path)
-    if path.exists() and not overwrite:
+    inputs = (result.data.get("path", ""), *inputs)
+    refuse_special(path, "--out", inputs)
+    if os.path.lexists(path) and not overwrite:
         raise InputError(f"{path}: exists; give --overwrite to replace it")
     doc = material_document(result, name, fields)
-    path.parent.mkdir(parents=True, exist_ok=True)
     header = f"# nylonflex {doc['kind']} set fitted by 'nylonflex fit {result.kind}'\n"
-    path.write_text(header + yaml.safe_dump(doc, sort_keys=False, width=100))
-    return path
+    text = header + yaml.safe_dump(doc, sort_keys=False, width=100)
+    return write_atomic(path, text.encode("utf-8"), "--out", inputs)
 
 
 def read_material_file(path) -> dict:

@@ -320,31 +320,24 @@ def run_simulation(cfg: SimConfig):
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def write_simulation(ds, path) -> Path:
+def write_simulation(ds, path, inputs=()) -> Path:
     """Write a simulation Dataset to NetCDF4/HDF5 (h5netcdf engine) at ``path``.
 
-    Atomic: written to a temporary file beside it, fsynced, then renamed. Only an earlier
-    simulation is replaced; anything else at ``path`` (a cube, a config, a special file) is
+    Atomic: written to a new temporary file beside it, fsynced, then renamed
+    (:func:`nylonflex.files.replacing`). Only an earlier simulation is replaced; anything
+    else at ``path`` (a cube, a config, a link, a special file, one of ``inputs``) is
     refused with an InputError.
     """
-    import os
-
-    from .files import publish, refuse_special
+    from .files import refuse_special, replacing
     from .units import InputError
 
     path = Path(path)
-    refuse_special(path, "--out")
+    refuse_special(path, "--out", inputs)
     if path.exists() and not _is_simulation(path):
         raise InputError(f"--out: {path} exists and is not a nylonflex simulation; it is not "
                          "replaced: choose another --out or move it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
+    with replacing(path, "--out", inputs) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
-        publish(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
     return path
 
 

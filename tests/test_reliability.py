@@ -892,3 +892,227 @@ def test_a_simulation_over_its_budget_says_its_size_and_how_to_raise_it():
     for bad in (0, True, float("nan")):
         with pytest.raises(InputError, match="limits.samples"):
             parse_sim_config({**raw, "limits": {"samples": bad}})
+
+
+# --------------------------------------------------------------------------- issue 26: links
+
+def _plant_building_to_another_cube(tmp_path, out, small_cfg):
+    raw, cfg = small_cfg
+    other = write_config(tmp_path, {**raw, "name": "victim"}, "victim.yaml")
+    victim = tmp_path / "elsewhere" / "victim.h5"
+    assert sweep(other, victim) == 0
+    out.with_name(out.name + ".building").symlink_to(victim)
+    return victim, []
+
+
+def _plant_dangling(suffix):
+    def plant(tmp_path, out, small_cfg):
+        target = tmp_path / "elsewhere" / f"landed{suffix}"
+        target.parent.mkdir(exist_ok=True)
+        out.with_name(out.name + suffix).symlink_to(target)
+        return None, []
+    return plant
+
+
+def _plant_manifest_and_building_link(tmp_path, out, small_cfg):
+    victim = tmp_path / "elsewhere" / "thesis.tex"
+    victim.parent.mkdir(exist_ok=True)
+    victim.write_text("precious")
+    parts = Journal(out).dir
+    parts.mkdir()
+    (parts / "manifest.json").write_text('{"name": "planted"}')
+    out.with_name(out.name + ".building").symlink_to(victim)
+    return victim, ["--overwrite"]
+
+
+def _plant_manifest_link(tmp_path, out, small_cfg):
+    victim = tmp_path / "elsewhere" / "notes.json"
+    victim.parent.mkdir(exist_ok=True)
+    victim.write_text('{"precious": true}')
+    Journal(out).dir.mkdir()
+    Journal(out).manifest.symlink_to(victim)
+    return victim, ["--overwrite"]
+
+
+def _plant_parts_link(tmp_path, out, small_cfg):
+    victim = tmp_path / "elsewhere" / "project"
+    victim.mkdir(parents=True)
+    (victim / "thesis.tex").write_text("precious")
+    Journal(out).dir.symlink_to(victim)
+    return victim / "thesis.tex", ["--overwrite"]
+
+
+@pytest.mark.parametrize("plant", [
+    _plant_building_to_another_cube, _plant_dangling(".lock"), _plant_dangling(".building"),
+    _plant_manifest_and_building_link, _plant_manifest_link, _plant_parts_link,
+], ids=["building_to_a_cube", "dangling_lock", "dangling_building",
+        "manifest_and_building", "manifest", "parts"])
+def test_a_link_at_a_side_path_is_refused_naming_it(tmp_path, small_cfg, capsys, plant):
+    # a link at <out>.building once made a plain sweep write its cube into another
+    # config's finished cube (exit 0, <out> a link to it); a dangling one put the lock or
+    # the cube outside the output folder; a planted manifest let --overwrite replace any
+    # file the building link named
+    raw, cfg = small_cfg
+    out = tmp_path / "run" / "cube.h5"
+    out.parent.mkdir()
+    victim, extra = plant(tmp_path, out, small_cfg)
+    before = victim.read_bytes() if victim is not None else None
+    capsys.readouterr()
+    assert sweep(cfg, out, *extra) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "symbolic link" in err, err
+    link = next(p for p in out.parent.rglob("*") if p.is_symlink())
+    assert str(link) in err
+    if victim is not None:
+        assert victim.read_bytes() == before
+    else:
+        assert not any((tmp_path / "elsewhere").iterdir())  # nothing landed outside
+    assert not os.path.lexists(out)
+
+
+def test_a_slab_temporary_link_is_refused_on_resume(tmp_path, capsys):
+    # after an interrupted run, <out>.parts/slab-000004.tmp -> victim.txt once made
+    # --resume write the slab into victim.txt
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=2)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    tmp = Journal(out).dir / "slab-000004.tmp"
+    tmp.symlink_to(victim)
+    cfg = write_config(tmp_path, MULTI)
+    assert sweep(cfg, out, "--resume") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "symbolic link" in err and str(tmp) in err
+    assert victim.read_text() == "precious"
+
+
+def test_a_link_at_the_output_itself_is_refused(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    victim = tmp_path / "victim.h5"
+    victim.write_bytes(b"precious")
+    out = tmp_path / "cube.h5"
+    out.symlink_to(victim)
+    assert sweep(cfg, out, "--overwrite") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "symbolic link" in err and str(out) in err
+    assert victim.read_bytes() == b"precious" and out.is_symlink()
+
+
+def test_the_journal_is_written_only_through_new_files(tmp_path, small_cfg, monkeypatch):
+    # every file in <out>.parts is created new (O_EXCL | O_NOFOLLOW), never opened as it is
+    raw, cfg = small_cfg
+    out = tmp_path / "cube.h5"
+    real_open, opened = os.open, []
+
+    def spy(path, flags, *args, **kwargs):
+        if ".parts" in str(path) and flags & (os.O_WRONLY | os.O_RDWR):
+            opened.append((Path(path).name, flags))
+        return real_open(path, flags, *args, **kwargs)
+
+    monkeypatch.setattr(os, "open", spy)
+    assert sweep(cfg, out) == 0
+    assert opened and any(name.startswith("slab-") for name, _ in opened)
+    for name, flags in opened:
+        assert flags & os.O_EXCL and flags & os.O_NOFOLLOW, name
+
+
+# --------------------------------------------------------------------------- issue 26: writers
+
+def _fit(tmp_path, *extra):
+    data = tmp_path / "data.csv"
+    if not data.exists():
+        shutil.copy(Path(__file__).parent / "data" / "ecoflex_0050.csv", data)
+    # in a child with a time limit: the old code blocked forever opening a fifo
+    return subprocess.run([sys.executable, "-m", "nylonflex", "fit", "silicone", str(data),
+                           "--max-stretch", "2", *extra], capture_output=True, text=True,
+                          timeout=120, env={**os.environ,
+                                            "PYTHONPATH": os.pathsep.join(sys.path)})
+
+
+def test_fit_never_writes_onto_a_fifo_its_data_or_through_a_link(tmp_path):
+    data = tmp_path / "data.csv"
+    fifo = tmp_path / "fifo.yaml"
+    os.mkfifo(fifo)
+    proc = _fit(tmp_path, "--out", str(fifo), "--overwrite")
+    assert proc.returncode == 2 and "special file" in proc.stderr, proc.stderr
+    before = data.read_bytes()
+    proc = _fit(tmp_path, "--out", str(data), "--overwrite")
+    assert proc.returncode == 2 and "input of this command" in proc.stderr, proc.stderr
+    assert data.read_bytes() == before
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    link = tmp_path / "link.yaml"
+    link.symlink_to(victim)
+    proc = _fit(tmp_path, "--out", str(link), "--overwrite")
+    assert proc.returncode == 2 and "symbolic link" in proc.stderr and str(link) in proc.stderr
+    assert victim.read_text() == "precious"
+    # a plain --out is written whole, through a temporary that does not stay behind
+    good = tmp_path / "fit.yaml"
+    assert _fit(tmp_path, "--out", str(good)).returncode == 0
+    assert yaml.safe_load(good.read_text())["kind"] == "silicone"
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_explore_html_never_replaces_the_cube_it_reads(tmp_path, small_cfg, capsys):
+    raw, cfg = small_cfg
+    cube = tmp_path / "cube.h5"
+    assert sweep(cfg, cube) == 0
+    before = cube.read_bytes()
+    assert main(["explore", str(cube), "--html", str(cube), "--overwrite"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "input of this command" in err
+    assert cube.read_bytes() == before
+
+
+# --------------------------------------------------------------------------- issue 26: publish
+
+_POLL = """
+import os, sys, time
+import h5py
+path, stop = sys.argv[1], sys.argv[2]
+reads = failures = 0
+names = set()
+end = time.monotonic() + 300  # bounded: the test creates ``stop`` when it is done
+while time.monotonic() < end and not os.path.exists(stop):
+    try:
+        with h5py.File(path, "r") as f:  # plain h5py: HDF5's own (shared) file lock
+            names.add((f.attrs["name"].decode() if isinstance(f.attrs["name"], bytes)
+                       else str(f.attrs["name"]), str(f.attrs["complete"])))
+        reads += 1
+    except BlockingIOError as exc:
+        failures += 1
+        print("locked", exc, file=sys.stderr)
+    except OSError as exc:
+        failures += 1
+        print("failed", exc, file=sys.stderr)
+print(reads, failures, sorted(names))
+"""
+
+
+def test_readers_never_meet_the_writers_lock_during_overwrite(tmp_path, small_cfg):
+    # the writer kept its exclusive lock on the published inode until the journal was
+    # removed: 2-8 % of plain h5py reads failed with "unable to lock file" during
+    # --overwrite. Each read must succeed and see a complete old or new cube.
+    raw, cfg = small_cfg
+    out = tmp_path / "cube.h5"
+    assert sweep(cfg, out) == 0
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    configs = [write_config(tmp_path, {**raw, "name": f"n{i}"}, f"n{i}.yaml")
+               for i in range(2)]
+    stop = tmp_path / "stop"
+    poll = subprocess.Popen([sys.executable, "-c", _POLL, str(out), str(stop)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env)
+    try:
+        for i in range(4):
+            assert subprocess.run([sys.executable, "-m", "nylonflex", "sweep",
+                                   str(configs[i % 2]), "--out", str(out), "--overwrite",
+                                   "--quiet", "--no-charts"], env=env, timeout=120,
+                                  capture_output=True).returncode == 0
+    finally:
+        stop.touch()
+        stdout, stderr = poll.communicate(timeout=60)
+    reads, failures, names = stdout.split(" ", 2)
+    assert int(failures) == 0, stderr[:2000]
+    assert int(reads) > 100
+    assert set(eval(names)) <= {("tiny", "true"), ("n0", "true"), ("n1", "true")}

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import CHARTS as _CHART_NAMES
+from ..files import save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
 # _figure, _plt and _RC are shared with the uncertainty and design charts
@@ -302,6 +303,6 @@ def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
         meta = {"png": {"Software": "nylonflex"}, "pdf": {"CreationDate": None},
                 "svg": {"Date": None}}[fmt]
         extra = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
-        fig.savefig(path, format=fmt, metadata=meta, **extra)
+        save_figure(fig, path, format=fmt, metadata=meta, **extra)
         plt.close(fig)
     return path

@@ -37,14 +37,18 @@ def port_free(port: int, host: str = "127.0.0.1") -> bool:
 
 
 def run(args) -> int:
+    import os
     from pathlib import Path
 
     from ..units import InputError
     from ._common import open_cube_for
 
     if args.html:
+        from ..files import refuse_special
+
         out = Path(args.html)
-        if out.exists() and not args.overwrite:
+        refuse_special(out, "--html", inputs=[args.cube])
+        if os.path.lexists(out) and not args.overwrite:
             raise InputError(f"--html {out}: the file exists; pass --overwrite to replace it")
         if not out.parent.is_dir():
             raise InputError(f"--html {out}: no such folder {out.parent}")
@@ -58,10 +62,10 @@ def run(args) -> int:
     if args.html:
         from ..explore_html import build_html
 
+        from ..files import write_atomic
+
         text = build_html(ds, source=str(args.cube))
-        tmp = out.with_name(out.name + ".part")
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(out)
+        write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
 

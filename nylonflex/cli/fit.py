@@ -105,21 +105,27 @@ def run(args) -> int:
     from ..units import InputError
     from . import warn
 
-    if args.out and not args.overwrite:
-        from pathlib import Path
+    import os
+    from pathlib import Path
 
-        if Path(args.out).exists():  # refuse before the work, and never overwrite silently
+    from ..files import refuse_special
+
+    # refused before the work: a link, a special file, the data file itself, or (without
+    # --overwrite) any file
+    inputs = [args.data, *([args.nylon] if args.nylon.endswith((".yaml", ".yml")) else [])]
+    if args.out:
+        refuse_special(Path(args.out), "--out", inputs)
+        if os.path.lexists(args.out) and not args.overwrite:
             raise InputError(f"--out {args.out}: exists; give --overwrite to replace it")
     res = fit(args)
     if args.out:
-        write_material_file(res, args.out, name=args.name or None, overwrite=args.overwrite)
+        write_material_file(res, args.out, name=args.name or None, overwrite=args.overwrite,
+                            inputs=inputs)
     if args.chart:
-        from pathlib import Path
-
         from ..charts_fit import fit_chart
 
-        stem = Path(args.data).stem
-        fit_chart(res, Path(args.chart) / f"fit_{args.kind}_{stem}_{res.model}.png")
+        fit_chart(res, Path(args.chart) / f"fit_{args.kind}_{Path(args.data).stem}_"
+                  f"{res.model}.png")
     if args.format == "json":
         sys.stdout.write(json.dumps(res.to_json(), indent=2) + "\n")
     else:

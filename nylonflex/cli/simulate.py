@@ -18,8 +18,11 @@ def run(args) -> int:
 
     cfg = load_sim_config(args.config)
     out = Path(args.out) if args.out else Path("sweeps") / cfg.name / "sim.h5"
+    from ..files import refuse_special
+
+    refuse_special(out, "--out", inputs=[args.config])  # before the work
     ds = run_simulation(cfg)
-    write_simulation(ds, out)
+    write_simulation(ds, out, inputs=[args.config])
     written = [str(out)]
     if not getattr(args, "no_charts", False):
         from ..charts_sim import draw_simulation_charts

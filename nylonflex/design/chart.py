@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import save_figure
 from ..variables import AXES, display_label, to_display
 
 __all__ = ["draw_front"]
@@ -81,6 +82,6 @@ def draw_front(res, out_dir) -> Path:
             ax.text(0.99, 0.02, text, transform=ax.transAxes, ha="right", va="bottom",
                     fontsize=7.5, color="0.3")
         ax.legend(loc="upper left")
-        fig.savefig(path)
+        save_figure(fig, path)
         plt.close(fig)
     return path

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import save_figure
 from ..variables import display_label
 
 __all__ = ["sensitivity_chart"]
@@ -57,6 +58,6 @@ def sensitivity_chart(result, path) -> Path:
                      "design; bars: 95 % intervals)", fontsize=_RC["figure.titlesize"])
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, bbox_inches="tight", pad_inches=0.08)
+        save_figure(fig, path, bbox_inches="tight", pad_inches=0.08)
         plt.close(fig)
     return path
