@@ -703,7 +703,7 @@ def test_a_signal_in_a_finaliser_is_never_swallowed(tmp_path, where, sig):
     proc = subprocess.run([sys.executable, "-c", _FINALISER_SIGNAL, where, str(int(sig)),
                            "sweep", str(cfg), "--out", str(out), "--no-charts"],
                           capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 130, (proc.returncode, proc.stderr)
+    assert proc.returncode == 128 + sig, (proc.returncode, proc.stderr)  # 143 for SIGTERM
     assert "Traceback" not in proc.stderr and "ignored" not in proc.stderr, proc.stderr
     assert "--resume" in proc.stderr
     ds = open_cube(out, quiet=True)
@@ -734,7 +734,7 @@ def test_signals_at_random_points_stop_cleanly_and_resume_identical(tmp_path, wh
                                "sweep", str(cfg), "--out", str(out), "--quiet",
                                "--no-charts"], capture_output=True, text=True, timeout=300)
         assert "Traceback" not in proc.stderr, proc.stderr
-        assert proc.returncode in (0, 130, -signal.SIGTERM), (proc.returncode, proc.stderr)
+        assert proc.returncode in (0, 128 + sig, -sig), (proc.returncode, proc.stderr)
         if proc.returncode == 0:
             continue  # finished before the signal
         assert sweep(cfg, out, "--resume") == 0
@@ -1116,3 +1116,59 @@ def test_readers_never_meet_the_writers_lock_during_overwrite(tmp_path, small_cf
     assert int(failures) == 0, stderr[:2000]
     assert int(reads) > 100
     assert set(eval(names)) <= {("tiny", "true"), ("n0", "true"), ("n1", "true")}
+
+
+# --------------------------------------------------------------------------- issue 26: journal
+
+def test_a_forged_codec_in_the_manifest_never_makes_an_unreadable_cube(tmp_path, whole):
+    # the manifest's digest hashes only the manifest: switching its codec from zstd to
+    # gzip and recomputing it once resumed to a cube marked complete whose journaled
+    # chunks (zstd frames in a gzip dataset) could not be read. A slab's digest now covers
+    # the codec it decodes with: every journaled slab is recomputed.
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    journal = Journal(out)
+    doc = journal.read_manifest()
+    assert doc["compression"] == parse_config(MULTI).compression == "zstd"
+    doc["compression"] = "gzip"
+    doc["digest"] = journal_mod.manifest_digest(doc)
+    journal.manifest.write_text(json.dumps(doc))
+    messages = []
+    ds = resume(out, log=messages.append)
+    assert sum("recomputing" in m for m in messages) == 3, messages
+    assert ds.attrs["complete"] == "true" and ds.attrs["compression"] == "gzip"
+    ds.close()
+    from nylonflex.storage import check_cube
+
+    assert check_cube(out) == []
+    got, want = stable(open_cube(out).load()), stable(whole.load())
+    got.attrs.pop("compression"), want.attrs.pop("compression")  # the one difference
+    xr.testing.assert_identical(got, want)
+
+
+@pytest.mark.parametrize("edit", [
+    # a plan of equal slabs from 0 to the end, but with a chunk length no plan gives
+    lambda doc: doc.update(slabs=[[i, i + 3] for i in range(0, 18, 3)]),
+    lambda doc: doc.update(compression="brotli"),
+], ids=["plan_the_config_cannot_give", "unknown_codec"])
+def test_a_manifest_that_recomputes_its_digest_is_checked_against_the_config(tmp_path, edit):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    journal = Journal(out)
+    doc = journal.read_manifest()
+    edit(doc)
+    doc["digest"] = journal_mod.manifest_digest(doc)  # the forger recomputes it
+    journal.manifest.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="damaged or was edited"):
+        resume(out)
+
+
+@pytest.mark.parametrize("garbage", [b"\x00\xff garbage", b"[1, 2, 3]", b'{"name": "x"}'])
+def test_a_garbage_manifest_is_damaged_not_a_changed_config(tmp_path, capsys, garbage):
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=2)
+    Journal(out).manifest.write_bytes(garbage)
+    cfg = write_config(tmp_path, MULTI)
+    assert sweep(cfg, out, "--resume") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "damaged" in err and "config changed" not in err, err

@@ -3,7 +3,7 @@
 Each command is a module of this package with ``HELP`` (one line), ``add_arguments(parser)``
 and ``run(args) -> int``; it calls library functions that return values and prints them. No
 science lives here. Exit status: 0 done, 2 bad input (one line naming the field), 1 other
-failure. A traceback is printed only with ``--debug``.
+failure, 128 + the signal for a run a signal stopped (130 Ctrl-C, 143 SIGTERM). A traceback is printed only with ``--debug``.
 
 Command modules import nothing heavy at module level, so ``nylonflex --help`` stays light.
 """
@@ -124,7 +124,17 @@ def main(argv=None) -> int:
         return _main(argv)
     except KeyboardInterrupt:  # Ctrl-C while the parser's modules are imported
         print("nylonflex: interrupted", file=sys.stderr)
-        return 130
+        return interrupted_status()
+
+
+def interrupted_status() -> int:
+    """The exit status of a command a signal stopped: 128 + the signal's number, the shell's
+    convention (130 for Ctrl-C, 143 for SIGTERM)."""
+    import signal
+
+    slabs = sys.modules.get("nylonflex.engine.slabs")  # only it records signals
+    sig = slabs.stopping_signal() if slabs is not None else None
+    return 128 + int(sig or signal.SIGINT)
 
 
 def _lighten_process():
@@ -151,7 +161,7 @@ def _main(argv=None) -> int:
         return _module(args.command).run(args) or EXIT_OK
     except KeyboardInterrupt:
         print("nylonflex: interrupted", file=sys.stderr)
-        return 130
+        return interrupted_status()
     except ValueError as exc:  # InputError and the physics' range checks: bad input
         if args.debug:
             raise

@@ -53,6 +53,16 @@ class _Stop(Exception):
 #: action of each open scope (innermost last); None outside any scope.
 _SCOPE: dict | None = None
 
+#: The first signal any scope recorded in this process (its number), or None: the exit
+#: status of a stopped command is 128 + it (130 for Ctrl-C, 143 for SIGTERM).
+_FIRST_SIGNAL: list = []
+
+
+def stopping_signal() -> int | None:
+    """The number of the first SIGINT or SIGTERM a :func:`deferred_signals` scope recorded
+    in this process, or None."""
+    return _FIRST_SIGNAL[0] if _FIRST_SIGNAL else None
+
 
 @contextlib.contextmanager
 def deferred_signals(on_second=None):
@@ -80,6 +90,8 @@ def deferred_signals(on_second=None):
 
     def handler(signum, frame):
         scope["seen"].append(signum)
+        if not _FIRST_SIGNAL:
+            _FIRST_SIGNAL.append(int(signum))
         action = scope["actions"][-1]
         if len(scope["seen"]) > 1 and action is not None:
             action()
