@@ -54,6 +54,9 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     nylonflex.storage.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
+    from .engine.grid import check_physics
+
+    check_physics(cfg)
     if out is None:
         from .engine.slabs import deferred_signals
 
@@ -74,9 +77,11 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
     The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
     command line uses it: a sweep without charts never imports xarray.
     """
+    from .engine.grid import check_physics
     from .engine.slabs import deferred_signals
     from .storage import sweep_to_file
 
+    check_physics(cfg)  # before any file
     # from here on Ctrl-C and SIGTERM are recorded, never raised inside a finaliser (where
     # Python would print and drop them): the slab loop stops on them, before or after a slab
     with deferred_signals(on_second=_interrupt):
@@ -99,7 +104,9 @@ def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
     Parameters as :func:`run_sweep`'s.
     """
     from . import storage  # noqa: F401 - h5py, hdf5plugin
+    from .engine.grid import check_physics
 
+    check_physics(cfg)
     _warm_up(cfg, workers, scheduler, log)
 
 
@@ -202,6 +209,9 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         (compute), ``compress_seconds`` [s] and ``seconds`` [s] (estimated wall time,
         compute plus compression; they partly overlap, so a bound), ``compile_seconds`` [s].
     """
+    from .engine.grid import check_physics
+
+    check_physics(cfg)  # what a sweep would refuse, a dry run refuses
     import time
 
     import numpy as np

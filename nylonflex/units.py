@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 import re
 
-__all__ = ["UNITS", "InputError", "parse_quantity", "short", "to_si", "from_si", "unit_kind"]
+__all__ = ["UNITS", "InputError", "json_text", "parse_quantity", "short", "to_si", "from_si",
+           "unit_kind"]
 
 
 class InputError(ValueError):
@@ -97,6 +98,29 @@ def from_si(value, unit: str):
 
 def _units_of(kind):
     return [u for u, (k, _, _) in UNITS.items() if k == kind]
+
+
+def _finite(obj):
+    """``obj`` with every non-finite float (NaN, inf) as None, numpy scalars as Python's."""
+    import math
+
+    if isinstance(obj, dict):
+        return {str(k): _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if hasattr(obj, "tolist") and not isinstance(obj, (str, bytes)):  # numpy values
+        return _finite(obj.tolist())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def json_text(obj, indent=2) -> str:
+    """``obj`` as valid JSON text (RFC 8259, a newline at the end): NaN and infinities,
+    which ``json.dumps`` writes as the invalid ``NaN``/``Infinity``, become null."""
+    import json
+
+    return json.dumps(_finite(obj), indent=indent, allow_nan=False) + "\n"
 
 
 def short(value, limit: int = 60) -> str:

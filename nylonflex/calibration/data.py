@@ -11,6 +11,10 @@ Two layouts are read as they are:
 
 Every column is converted to SI once, here. A column name is snake_case of the header
 without its unit (``Engineering Stress (MPa)`` -> ``engineering_stress``).
+
+A file is bounded before it is parsed (:data:`MAX_BYTES`, :data:`MAX_ROWS`,
+:data:`MAX_COLUMNS`, :data:`MAX_CELL`; docs/calibration.md): a bench recording is far
+smaller, and a 20,000-column header took 47 s to refuse.
 """
 
 from __future__ import annotations
@@ -26,7 +30,17 @@ import numpy as np
 
 from ..units import InputError, UNITS, to_si, unit_kind
 
-__all__ = ["Table", "read_table", "file_sha256"]
+__all__ = ["MAX_BYTES", "MAX_CELL", "MAX_COLUMNS", "MAX_ROWS", "Table", "file_sha256",
+           "read_table"]
+
+#: The largest data file read [bytes].
+MAX_BYTES = 200_000_000
+#: The most lines (header and rows) of a data file [-].
+MAX_ROWS = 2_000_000
+#: The most columns of a data file's header [-].
+MAX_COLUMNS = 1_000
+#: The longest cell [characters] (a header name or a number; the ``csv`` module's limit).
+MAX_CELL = 10_000
 
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(]\s*(?P<unit>[^\]\)]*?)\s*[\]\)])?\s*$")
 
@@ -115,6 +129,10 @@ def read_table(path) -> Table:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such data file")
+    size = p.stat().st_size
+    if size > MAX_BYTES:
+        raise InputError(f"{path}: {size:,} bytes, over the {MAX_BYTES:,} a data file may "
+                         "hold; thin it (every n-th row) or fit a part of it")
     try:
         text = p.read_text(encoding="utf-8-sig")
     except (UnicodeDecodeError, OSError):
@@ -122,9 +140,12 @@ def read_table(path) -> Table:
     lines = text.splitlines()
     if not lines:
         raise InputError(f"{path}: empty file")
+    if len(lines) > MAX_ROWS:
+        raise InputError(f"{path}: {len(lines):,} lines, over the {MAX_ROWS:,} a data file "
+                         "may hold; thin it (every n-th row) or fit a part of it")
     delim = ";" if lines[0].count(";") > lines[0].count(",") else (
         "\t" if "\t" in lines[0] and "," not in lines[0] else ",")
-    rows = list(csv.reader(io.StringIO(text), delimiter=delim))
+    rows = _rows(path, text, delim)
     metadata = {}
     start = 0
     if rows and rows[0] and rows[0][0].strip().upper() == "PARAMETER":  # database header
@@ -141,17 +162,21 @@ def read_table(path) -> Table:
     header = [c for c in rows[start]]
     while header and not header[-1].strip():
         header.pop()
+    if len(header) > MAX_COLUMNS:
+        raise InputError(f"{path}: {len(header):,} columns in the header, over the "
+                         f"{MAX_COLUMNS:,} a data file may have")
     if not header or all(_number(c) is not None for c in header if c.strip()):
         raise InputError(f"{path}: the first line must name the columns, with units, e.g. "
                          "'stretch,stress [kPa]'")
-    names, units, factors = [], [], []
+    names, units, factors, seen = [], [], [], set()
     for cell in header:
         m = _HEADER.match(cell)
         name, unit = _snake(m.group("name")), (m.group("unit") or "").strip()
         if not name:
             raise InputError(f"{path}: a column has no name in the header line")
-        if name in names:
-            raise InputError(f"{path}: column {name!r} appears twice")
+        if name in seen:
+            raise InputError(f"{path}: column {name[:80]!r} appears twice")
+        seen.add(name)
         names.append(name)
         units.append(unit)
         factors.append(_factor(unit, cell.strip(), path) if unit else (1.0, 0.0))
@@ -171,6 +196,24 @@ def read_table(path) -> Table:
     cols = {n: arr[:, i] * f + o for i, (n, (f, o)) in enumerate(zip(names, factors))}
     return Table(path=str(path), sha256=file_sha256(p), columns=cols,
                  units=dict(zip(names, units)), metadata=metadata)
+
+
+def _rows(path, text: str, delim: str) -> list:
+    """The cells of every line; a cell over :data:`MAX_CELL` characters is refused with
+    the file and line named (the ``csv`` module said only "field larger than field
+    limit")."""
+    reader = csv.reader(io.StringIO(text), delimiter=delim)
+    limit = csv.field_size_limit()
+    try:
+        csv.field_size_limit(MAX_CELL)
+        return list(reader)
+    except csv.Error as exc:
+        if "field limit" not in str(exc):
+            raise InputError(f"{path}: line {reader.line_num}: not CSV ({exc})") from None
+        raise InputError(f"{path}: line {reader.line_num}: a cell longer than "
+                         f"{MAX_CELL:,} characters; not a data table") from None
+    finally:
+        csv.field_size_limit(limit)
 
 
 def column(table: Table, names, what: str, kind: str, required_unit: bool = True):

@@ -27,8 +27,12 @@ import numpy as np
 from ..units import InputError, parse_quantity
 from .data import Table, column, read_table
 from ..material_files import anchor_material_files
+from ..variables import VARIABLES
 
 __all__ = ["Comparison", "validate_design", "design_from_config"]
+
+#: The highest pressure compared [Pa]: the model's (the ``pressure`` axis, docs/model.md s. 3).
+_PRESSURE_MAX = VARIABLES["pressure"].hi
 
 #: measured quantity -> (x name, error name as the paper reports it, unit)
 CHECKS = {
@@ -122,6 +126,9 @@ def validate_design(config, data) -> list[Comparison]:
     table = data if isinstance(data, Table) else read_table(data)
     a, t, L, b = (design[k] for k in ("radius", "wall_thickness", "length", "base_thickness"))
     found = []
+    if table.has("pressure"):  # the model's range (docs/model.md s. 3): 1e300 kPa gave inf
+        _, p = column(table, ["pressure"], "pressure", "pressure")
+        _check_range(table.path, "pressure", p, 0.0, _PRESSURE_MAX, closed=True)
     if table.has("stroke", "pressure"):
         _, s = column(table, ["stroke"], "stroke", "dimensionless")
         _, p = column(table, ["pressure"], "pressure", "pressure")
@@ -152,6 +159,12 @@ def validate_design(config, data) -> list[Comparison]:
     return out
 
 
-def _check_range(path, name, v, lo, hi):
-    if np.any(v < lo) or np.any(v >= hi):
-        raise InputError(f"{path}: column {name!r} must be in [{lo:g}, {hi:g})")
+def _check_range(path, name, v, lo, hi, closed=False):
+    bad = ~np.isfinite(v) | (v < lo) | ((v > hi) if closed else (v >= hi))
+    if np.any(bad):
+        if name == "pressure":
+            raise InputError(f"{path}: column 'pressure' must be in [{lo / 1e3:g}, "
+                             f"{hi / 1e3:g}] kPa (the model's range), got "
+                             f"{v[bad][0] / 1e3:g} kPa")
+        raise InputError(f"{path}: column {name!r} must be in [{lo:g}, {hi:g}"
+                         f"{']' if closed else ')'}")

@@ -25,7 +25,10 @@ def run(args) -> int:
     from ..design.report import format_csv, format_json, format_table, summary
     from . import warn
 
-    res = run_design(args.spec, cube=args.cube)
+    from ._common import progress_bar
+
+    with progress_bar("refine", unit="start") as bar:
+        res = run_design(args.spec, cube=args.cube, progress=bar)
     fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
     sys.stdout.write(fmt(res))
     if not res.designs and args.format != "table":

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 HELP = "fit a silicone or nylon muscle set to bench data"
@@ -102,7 +101,7 @@ def format_table(res) -> str:
 
 def run(args) -> int:
     from ..calibration import write_material_file
-    from ..units import InputError
+    from ..units import InputError, json_text
     from . import warn
 
     import os
@@ -127,7 +126,7 @@ def run(args) -> int:
         fit_chart(res, Path(args.chart) / f"fit_{args.kind}_{Path(args.data).stem}_"
                   f"{res.model}.png")
     if args.format == "json":
-        sys.stdout.write(json.dumps(res.to_json(), indent=2) + "\n")
+        sys.stdout.write(json_text(res.to_json(), indent=2))
     else:
         sys.stdout.write(format_table(res))
         if args.out:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
@@ -36,7 +35,7 @@ def run(args) -> int:
     from ..config import load_config
     from ..query import parse_at
     from ..uncertainty import sobol_indices
-    from ..units import InputError
+    from ..units import InputError, json_text
     from ..variables import AXES
 
     cfg = load_config(args.config, args.set)
@@ -52,7 +51,7 @@ def run(args) -> int:
         sensitivity_chart(res, path)
         print(f"wrote {path}", file=sys.stderr)
     if args.format == "json":
-        sys.stdout.write(json.dumps(res.to_json(), indent=1) + "\n")
+        sys.stdout.write(json_text(res.to_json(), indent=1))
         return 0
     where = ("one design" if len(at) == len(AXES) else
              f"mean over {res.designs} grid designs")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 HELP = "compare a design's model with actuator measurements"
@@ -25,6 +24,7 @@ def run(args) -> int:
 
     from ..calibration.data import read_table
     from ..calibration.validate import validate_design
+    from ..units import json_text
 
     table = read_table(args.data)
     comps = validate_design(args.config, table)
@@ -36,7 +36,7 @@ def run(args) -> int:
     if args.format == "json":
         out = {"config": str(args.config), "data": {"path": table.path, "sha256": table.sha256},
                "checks": [c.to_json() for c in comps]}
-        sys.stdout.write(json.dumps(out, indent=2) + "\n")
+        sys.stdout.write(json_text(out, indent=2))
         return 0
     print(f"{args.config} against {table.path} ({len(table)} rows)")
     for c in comps:

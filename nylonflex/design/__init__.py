@@ -112,7 +112,7 @@ def _records(rows, source) -> list:
             for i in range(n)]
 
 
-def run_design(spec, cube=None) -> DesignResult:
+def run_design(spec, cube=None, progress=None) -> DesignResult:
     """Answer a design spec.
 
     Parameters
@@ -121,6 +121,8 @@ def run_design(spec, cube=None) -> DesignResult:
         The spec, its mapping or its YAML file.
     cube : path or xarray.Dataset, optional
         Overrides the spec's start (a cube file or an opened cube).
+    progress : callable, optional
+        Called as ``progress(done, total)`` [refinement starts] as refinement goes.
 
     Returns
     -------
@@ -144,7 +146,7 @@ def run_design(spec, cube=None) -> DesignResult:
     finally:
         if own:
             ds.close()
-    refined = refine(model, spec, scan) if spec.refine and scan.feasible else []
+    refined = refine(model, spec, scan, progress) if spec.refine and scan.feasible else []
 
     # every reported design, exactly, once more; drop any that breaks a constraint
     grid = evaluate_rows(model, scan.best)

@@ -258,7 +258,7 @@ def _take1(rows, k) -> dict:
     return {key: float(np.asarray(v)[k]) for key, v in rows.items()}
 
 
-def refine(model, spec, scan) -> list:
+def refine(model, spec, scan, progress=None) -> list:
     """Refined designs (row dicts) from the grid stage's best rows or front.
 
     Parameters
@@ -267,6 +267,8 @@ def refine(model, spec, scan) -> list:
         The exact model.
     spec : DesignSpec
     scan : GridScan
+    progress : callable, optional
+        Called as ``progress(done, total)`` [starts] after each start.
 
     Returns
     -------
@@ -285,7 +287,9 @@ def refine(model, spec, scan) -> list:
     else:
         pick = np.arange(min(spec.starts, n))
     out = []
-    for i in pick:
+    for done, i in enumerate(pick):
+        if progress is not None:
+            progress(done, len(pick))
         seed = _take1(seeds, int(i))
         if not meets(spec, {k: np.array([v]) for k, v in seed.items()}, scan.fixed)[0]:
             continue
@@ -293,6 +297,8 @@ def refine(model, spec, scan) -> list:
         row = _improve(model, spec, bounds, scan.fixed, seed, primary, eps, spec.maxiter)
         if row is not None:
             out.append(row)
+    if progress is not None:
+        progress(len(pick), len(pick))
     if not others and out:
         out = [min(out, key=lambda r: primary.sign * r[primary.name])]
     return out

@@ -36,6 +36,10 @@ MODELS = ("paper",)
 #: SLSQP iterations per start.
 DEFAULT_STARTS = {"single": 4, "multi": 40}
 DEFAULT_MAXITER = 60
+#: The most SLSQP iterations of one design run, starts x maxiter [-]: 8 times the default
+#: budget of several objectives (40 x 60); the accepted maximum of each (1000 x 10,000) ran
+#: past 120 s on a 128,000-design cube.
+MAX_REFINE_ITERATIONS = 20_000
 _OBJECTIVE_NAMES = tuple(n for n in COLUMNS if n != "limit")
 
 
@@ -133,6 +137,11 @@ def _refine(value, multi):
         if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= hi:
             raise InputError(f"refine.{key}: must be an integer in [1, {hi}], got {v!r}")
         out.append(v)
+    if out[0] * out[1] > MAX_REFINE_ITERATIONS:  # checked before any work
+        raise InputError(f"refine: starts x maxiter = {out[0]:,} x {out[1]:,} = "
+                         f"{out[0] * out[1]:,} SLSQP iterations, over the "
+                         f"{MAX_REFINE_ITERATIONS:,} one design run may take; lower "
+                         "refine.starts or refine.maxiter")
     return True, out[0], out[1]
 
 

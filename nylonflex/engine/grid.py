@@ -75,6 +75,34 @@ def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
     return _uniform_slabs(na, per_slab), chunk
 
 
+def check_physics(cfg: ResolvedConfig):
+    """Cross-checks of an accepted config that its fields' ranges cannot make: the muscle's
+    stroke shape rises to T_max (:func:`~nylonflex.physics.nylon.check_stroke_shape`), and
+    the supply heats the grid's longest muscle at least
+    :data:`~nylonflex.physics.thermal.MIN_SUPPLY_RISE` above ambient. Checked before any
+    file is made or kernel run (ValueError, one line).
+
+    The longest muscle: l_m = L P_out / (pitch cos psi) with pitch = max(P_out tan psi,
+    w / cos psi) is L min(1 / sin psi, P_out / w), and psi is independent of P_out and w, so
+    its largest value over the grid is L_max min(1 / sin psi_min, P_max / w_min).
+    """
+    from ..physics.nylon import check_stroke_shape
+    from ..physics.thermal import check_supply_rise
+    from ..physics.wrap import muscle_width, outer_perimeter
+
+    ny = cfg.nylon
+    check_stroke_shape(ny.t_max, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    if cfg.supply_voltage is None:
+        return
+    ax = cfg.axes
+    p_max = float(outer_perimeter(ax["radius"][-1], ax["wall_thickness"][-1],
+                                  cfg.base_thickness))
+    w_min = float(np.min(muscle_width(ax["coil_index"], ny)))
+    l_max = ax["length"][-1] * min(1.0 / np.sin(ax["wrap_angle"][0]), p_max / w_min)
+    check_supply_rise(cfg.supply_voltage, l_max, ny.resistance_per_length,
+                      ny.heat_loss_per_length)
+
+
 def _chunk_cap(per_radius: int) -> int:
     """The longest chunk along radius [radii]: about 2 MB of one variable."""
     return max(1, (2 * 2**20) // max(1, per_radius // 9))

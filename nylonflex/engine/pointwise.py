@@ -23,6 +23,8 @@ from ..physics._formula import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
+from ..physics.nylon import check_stroke_shape
+from ..physics.thermal import check_supply_rise
 from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
@@ -96,6 +98,8 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     ogden = _silicone_arrays(silicone)
     stretch_max = _stretch_max(silicone)
     ny = _nylon_arrays(nylon)
+    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
+                                          "sigma_g")))
     c = check_input("coil_index", coil_index, -np.inf, np.inf)
     table = ny["coil_index_table"]
     bad = ~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])
@@ -124,8 +128,11 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     width = d_f * (c_flat + 1.0)
     muscle = [flat(ny[k]) for k in _MUSCLE_FIELDS]
     options = (MODELS.index(model), voltage, stretch_max)
-    return _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
-                (s_max, force_limit, width), ogden, muscle, options)
+    out = _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
+               (s_max, force_limit, width), ogden, muscle, options)
+    check_supply_rise(voltage, out["muscle_length"], ny["resistance_per_length"],
+                      ny["heat_loss_per_length"], "supply_voltage")
+    return out
 
 
 def _stretch_max(silicone) -> float:

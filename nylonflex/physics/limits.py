@@ -19,9 +19,10 @@ from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvatur
                       quadrature_nodes)
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
-from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke
+from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
-from .thermal import _cooling_time, _heating_power, _heating_time, _steady_temperature
+from .thermal import _cooling_time, _heating_power, _heating_time, _steady_temperature, \
+    check_supply_rise
 from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
     _outer_perimeter, _pitch, _wrap_force
 
@@ -522,6 +523,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     voltage = 0.0 if supply_voltage is None else float(
         check_input("supply_voltage", supply_voltage))
     ny = nylon_parameters(nylon)
+    check_stroke_shape(ny.t_max, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
     sil = silicone_parameters(silicone)
     mu, alpha = sil.arrays()
     stretch_max = float(sil.stretch_range[1])
@@ -554,5 +556,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         flags = _validity(values[5], state[4], ai, ti, bi, stretch_max, Li / pitch, closes)
         for name, v in zip(DESIGN_VARIABLES, (*values, *thermal, flags)):
             out[name][idx] = v
+    check_supply_rise(voltage, out["muscle_length"], ny.resistance_per_length,
+                      ny.heat_loss_per_length, "supply_voltage")
     return {name: (int(v) if name in ("limit", "validity") and v.ndim == 0
                    else scalar_or_array(v)) for name, v in out.items()}

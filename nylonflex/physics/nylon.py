@@ -13,6 +13,7 @@ from ..materials import nylon_parameters
 from ._formula import ZERO_CELSIUS, check, formula, scalar_or_array
 
 __all__ = [
+    "check_stroke_shape",
     "free_strain",
     "nylon_force_limit",
     "stroke",
@@ -110,6 +111,34 @@ def _temperature_for_stroke(stroke_value, scale, t_amb, t_max, gamma, beta, t_g,
 
 def _nylon(nylon):
     return nylon_parameters(nylon)
+
+
+def check_stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g):
+    """Refuse a muscle whose eq. (2) stroke shape does not rise from T_amb to T_max.
+
+    The shape at T_max, gamma (T_max - T_amb) + beta (erf((T_max - T_g) c) - erf((T_amb -
+    T_g) c)), scales s_max(C) to the stroke curve (docs/model.md s. 9): at 0 (``gamma =
+    beta = 0``, each in range) the curve is zero everywhere while the usable stroke still
+    came from the coil table, and every thermal value was NaN. Arguments [K], [1/K], [-]
+    (arrays broadcast).
+
+    Raises
+    ------
+    ValueError
+        One line naming nylon.gamma and nylon.beta and the shape's value.
+    """
+    args = np.broadcast_arrays(*(np.asarray(x, float) for x in
+                                 (t_max, t_amb, gamma, beta, t_g, sigma_g)))
+    top = np.vectorize(_stroke_shape, otypes=[float])(*args)
+    # relative to the size of its two terms: a cancellation to rounding is 0 too
+    size = np.abs(args[2]) * np.abs(args[0] - args[1]) + 2.0 * np.abs(args[3])
+    bad = ~(top > 1e-9 * size)
+    if np.any(bad):
+        j = np.flatnonzero(bad.reshape(-1))[0]
+        g, b, v = (x.reshape(-1)[j] for x in (args[2], args[3], top))
+        raise ValueError(f"nylon.gamma, nylon.beta: the stroke shape of eq. (2) is {v:g} at "
+                         f"t_max (gamma {g:g} 1/K, beta {b:g}); it must be > 0, a muscle "
+                         "that contracts when heated")
 
 
 def _coil_index(coil_index, ny):

@@ -14,6 +14,8 @@ from ..materials import nylon_parameters
 from ._formula import check, formula, scalar_or_array
 
 __all__ = [
+    "MIN_SUPPLY_RISE",
+    "check_supply_rise",
     "muscle_resistance",
     "steady_temperature",
     "temperature_rate",
@@ -62,6 +64,46 @@ def _heating_time(t_end, t_ss, t_amb, tau):
     if t_end >= t_ss:
         return math.inf
     return -tau * math.log(1.0 - (t_end - t_amb) / (t_ss - t_amb))
+
+
+#: The least steady temperature rise a supply must give every muscle, T_ss - T_amb [K].
+#: Below about 1e-10 K the working, cooling and heating temperatures are not resolved next
+#: to T_amb in float64 (1e-9 V: cooling_time NaN and heating_time inf in every design;
+#: 1e-6 V on a 2 m muscle: inf); 1 mK keeps ten orders of magnitude from that.
+MIN_SUPPLY_RISE = 1e-3
+
+
+def check_supply_rise(voltage, muscle_length, r_per_len, loss_per_len,
+                      field="supply.voltage"):
+    """Refuse a supply that cannot heat every muscle at least :data:`MIN_SUPPLY_RISE`
+    above ambient: T_ss - T_amb = V^2 / (r' lambda' l_m^2) (eq. 3).
+
+    Parameters
+    ----------
+    voltage : float
+        Supply voltage [V] (<= 0: no supply, nothing checked).
+    muscle_length : float or ndarray
+        Muscle lengths [m]; the longest is checked.
+    r_per_len, loss_per_len : float or ndarray
+        r' [ohm/m] and lambda' [W/(K m)], broadcast with ``muscle_length``.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``field``, the rise and the least voltage that gives it.
+    """
+    if not voltage > 0.0:
+        return
+    l_m, r, loss = np.broadcast_arrays(*(np.asarray(x, float) for x in
+                                         (muscle_length, r_per_len, loss_per_len)))
+    rise = voltage * voltage / (r * loss * l_m * l_m)
+    bad = ~(rise >= MIN_SUPPLY_RISE)
+    if np.any(bad):
+        j = int(np.argmin(np.where(np.isnan(rise), -np.inf, rise)))
+        need = l_m.flat[j] * math.sqrt(MIN_SUPPLY_RISE * r.flat[j] * loss.flat[j])
+        raise ValueError(f"{field}: {voltage:g} V heats a {l_m.flat[j]:.3g} m muscle only "
+                         f"{rise.flat[j]:.3g} K above ambient; a supply must heat every "
+                         f"muscle at least {MIN_SUPPLY_RISE:g} K (here at least {need:.3g} V)")
 
 
 def _lengths(muscle_length):

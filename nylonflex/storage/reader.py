@@ -12,7 +12,14 @@ from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
 from .cube import load_filter_plugins
 from .journal import Journal
 
-__all__ = ["check_cube", "cube_attrs", "cube_summary", "open_cube"]
+__all__ = ["MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_cube", "check_chunk_sizes",
+           "cube_attrs", "cube_summary", "open_cube"]
+
+#: The largest chunk of a cube read [bytes]: a chunk is decoded whole, and nylonflex writes
+#: chunks of about 2 MB (a crafted 2^29-element chunk made ``info`` allocate 4 GiB).
+MAX_CHUNK_BYTES = 64 * 2**20
+#: The most values of a cube's coordinate (a grid axis) read [-].
+MAX_AXIS_VALUES = 1_000_000
 
 
 def cube_attrs(path) -> dict | None:
@@ -28,6 +35,29 @@ def cube_attrs(path) -> dict | None:
     except OSError:
         return None
     return attrs if attrs.get("nylonflex_cube") else None
+
+
+def check_chunk_sizes(path):
+    """Refuse a cube with a chunk over :data:`MAX_CHUNK_BYTES` or a coordinate over
+    :data:`MAX_AXIS_VALUES` values, before anything is decoded (InputError naming the
+    variable and its size)."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        for name, obj in f.items():
+            if not isinstance(obj, h5py.Dataset):
+                continue
+            if obj.chunks is not None:
+                nbytes = int(np.prod(obj.chunks, dtype=np.float64)) * obj.dtype.itemsize
+                if nbytes > MAX_CHUNK_BYTES:
+                    raise InputError(
+                        f"{path}: variable {name[:80]} is stored in chunks of "
+                        f"{nbytes / 2**20:,.0f} MiB ({' x '.join(map(str, obj.chunks))}), over "
+                        f"the {MAX_CHUNK_BYTES // 2**20} MiB nylonflex decodes at once; not a "
+                        "cube nylonflex wrote (its chunks are about 2 MB)")
+            if obj.ndim == 1 and name in AXES and obj.size > MAX_AXIS_VALUES:
+                raise InputError(f"{path}: axis {name} has {obj.size:,} values, over the "
+                                 f"{MAX_AXIS_VALUES:,} nylonflex reads")
 
 
 def _attr(v):
@@ -61,6 +91,7 @@ def open_cube(path, *, quiet: bool = False):
     if attrs is None:
         raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
                          "written by 'nylonflex sweep')")
+    check_chunk_sizes(path)
     load_filter_plugins()  # zstd and lz4 cubes need hdf5plugin's filters registered
     ds = xr.open_dataset(path, engine="h5netcdf")
     if attrs.get("complete") != "true":
@@ -167,6 +198,7 @@ def check_cube(path, *, full: bool = True, progress=None) -> list[str]:
     """
     import h5py
 
+    check_chunk_sizes(path)
     load_filter_plugins()
     problems = []
     with h5py.File(path, "r") as f:

@@ -28,6 +28,14 @@ __all__ = ["SensitivityResult", "sobol_indices"]
 
 _KEYS = ("first", "total", "first_conf", "total_conf")
 
+#: Saltelli's largest base sample N [-] (a power of 2).
+MAX_BASE_SAMPLES = 2**20
+#: The most grid designs averaged over [-].
+MAX_DESIGNS = 10_000
+#: The most model runs of one analysis, N (factors + 2) x designs [-]: about 0.4 GB of
+#: memory (2^24 base samples of one factor, 5 x 10^7 runs, held 1.2 GB).
+MAX_RUNS = 2**24
+
 
 @dataclass
 class SensitivityResult:
@@ -105,11 +113,25 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     if bad or not outputs:
         raise InputError(f"--output: unknown {', '.join(bad) or 'none given'}; accepted: "
                          f"{', '.join(FLOAT_NAMES)}")
-    if base_samples < 8 or base_samples & (base_samples - 1):
-        raise InputError(f"base_samples: must be a power of 2 >= 8, got {base_samples}")
+    if base_samples < 8 or base_samples & (base_samples - 1) or \
+            base_samples > MAX_BASE_SAMPLES:
+        raise InputError(f"--samples: must be a power of 2 in [8, {MAX_BASE_SAMPLES:,}], got "
+                         f"{base_samples:,}")
+    if not 1 <= max_designs <= MAX_DESIGNS:
+        raise InputError(f"--designs: must be in [1, {MAX_DESIGNS:,}], got {max_designs:,}")
     seed = spec.seed if seed is None else seed
     names = [p.name for p in spec.parameters]
     groups = [p.name for p in spec.parameters for _ in range(p.dims)]
+    at_ = dict(at or {})
+    n_designs = min(max_designs, int(np.prod([1 if a in at_ else len(cfg.axes[a])
+                                              for a in AXES])))
+    groups_n = len(set(groups)) if any(p.dims > 1 for p in spec.parameters) else len(groups)
+    runs = base_samples * (groups_n + 2) * n_designs
+    if runs > MAX_RUNS:  # checked before any sample is drawn
+        raise InputError(f"--samples: {base_samples:,} x {groups_n + 2} (factors + 2) x "
+                         f"{n_designs:,} design{'s' if n_designs != 1 else ''} = {runs:,} "
+                         f"model runs, over the {MAX_RUNS:,} one analysis may make; lower "
+                         "--samples or --designs (or fix more axes with --at)")
     d = len(groups)
     problem = {"num_vars": d, "names": [f"{g}[{i}]" for i, g in enumerate(groups)],
                "bounds": [[0.0, 1.0]] * d}
