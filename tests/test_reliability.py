@@ -1172,3 +1172,235 @@ def test_a_garbage_manifest_is_damaged_not_a_changed_config(tmp_path, capsys, ga
     assert sweep(cfg, out, "--resume") == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "damaged" in err and "config changed" not in err, err
+
+
+# --------------------------------------------------------------------------- issue 26: bounds
+
+def _timed_main(argv):
+    """``main(argv)`` and its wall time [s] (a bound checked before the work is quick)."""
+    t = time.perf_counter()
+    rc = main(argv)
+    return rc, time.perf_counter() - t
+
+
+@pytest.mark.parametrize("columns", [20_000, 100_000])
+def test_a_wide_csv_header_is_refused_before_the_fit(tmp_path, capsys, columns):
+    # 20,000 columns took 47 s to refuse (a quadratic duplicate check), 100,000 ran past
+    # 120 s; the header holds at most MAX_COLUMNS
+    from nylonflex.calibration.data import MAX_COLUMNS
+
+    data = tmp_path / "wide.csv"
+    data.write_text(",".join(f"c{i} [kPa]" for i in range(columns)) + "\n" +
+                    ",".join(["1"] * columns) + "\n")
+    rc, seconds = _timed_main(["fit", "silicone", str(data)])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert f"{columns:,} columns" in err and f"{MAX_COLUMNS:,}" in err and str(data) in err
+    assert seconds < 20  # generous: the refusal itself is a few milliseconds of parsing
+
+
+def test_duplicate_columns_are_found_by_a_set(tmp_path, capsys):
+    data = tmp_path / "dup.csv"
+    data.write_text("stretch,stress [kPa],stretch\n1,0,1\n")
+    assert main(["fit", "silicone", str(data)]) == 2
+    assert "'stretch' appears twice" in capsys.readouterr().err
+
+
+def test_a_huge_csv_cell_names_the_file_and_line(tmp_path, capsys):
+    # the csv module said only "field larger than field limit (131072)"
+    from nylonflex.calibration.data import MAX_CELL
+
+    data = tmp_path / "cell.csv"
+    data.write_text("stretch,stress [kPa]\n1,0\n1.5," + "9" * 20_000_000 + "\n")
+    assert main(["fit", "silicone", str(data)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(data) in err and "line 3" in err
+    assert f"{MAX_CELL:,} characters" in err and "field limit" not in err
+
+
+def test_too_many_csv_lines_are_refused(tmp_path, capsys, monkeypatch):
+    import nylonflex.calibration.data as data_mod
+
+    monkeypatch.setattr(data_mod, "MAX_ROWS", 10)  # the bound, not its size, is tested
+    data = tmp_path / "long.csv"
+    data.write_text("stretch,stress [kPa]\n" + "".join(f"{1 + i / 100},{i}\n"
+                                                       for i in range(20)))
+    assert main(["fit", "silicone", str(data)]) == 2
+    err = capsys.readouterr().err
+    assert "21 lines" in err and "10 a data file" in err and str(data) in err
+
+
+@pytest.mark.parametrize("samples,designs,match", [
+    (2**30, 16, r"--samples: must be a power of 2 in \[8, 1,048,576\], got 1,073,741,824"),
+    (2**20, 16, r"1,048,576 x 3 \(factors \+ 2\) x 16 designs = 50,331,648 model runs"),
+    (512, 10**6, r"--designs: must be in \[1, 10,000\]"),
+])
+def test_sensitivity_work_is_bounded_before_any_sample(tmp_path, capsys, samples, designs,
+                                                        match):
+    # 2^24 samples ran at 1.2 GB, 2^30 tried 32 GiB: refused before sampling
+    raw = {**MULTI, "uncertainty": {"samples": 64, "parameters": {
+        "wall_thickness": {"sd": 0.1, "units": "mm"}}}}
+    cfg = write_config(tmp_path, raw)
+    rc, seconds = _timed_main(["sensitivity", str(cfg), "--samples", str(samples),
+                               "--designs", str(designs)])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert __import__("re").search(match, err), err
+    assert seconds < 20
+
+
+def test_a_design_refine_budget_past_the_bound_is_refused():
+    from nylonflex.design.spec import MAX_REFINE_ITERATIONS, parse_spec
+
+    raw = {"cube": "c.h5", "objectives": [{"max": "tip_force_max"}],
+           "refine": {"starts": 1000, "maxiter": 10_000}}  # each in its own range
+    with pytest.raises(InputError, match=r"refine: starts x maxiter = 1,000 x 10,000 = "
+                                         r"10,000,000 SLSQP iterations, over the 20,000"):
+        parse_spec(raw)
+    raw["refine"] = {"starts": 4, "maxiter": MAX_REFINE_ITERATIONS // 4}
+    assert parse_spec(raw).maxiter == MAX_REFINE_ITERATIONS // 4
+
+
+def test_design_refinement_reports_its_progress(tmp_path, small_cfg):
+    from nylonflex.design import run_design
+
+    raw, cfg = small_cfg
+    cube = tmp_path / "cube.h5"
+    assert sweep(cfg, cube) == 0
+    seen = []
+    run_design({"cube": str(cube), "objectives": [{"max": "tip_force_max"}],
+                "refine": {"starts": 3, "maxiter": 5}},
+               progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1][0] == seen[-1][1] and seen[0][0] == 0
+
+
+def test_info_refuses_a_crafted_huge_chunk_before_reading_it(tmp_path, small_cfg, capsys):
+    # one 2^29-element chunk made info allocate 4 GiB
+    raw, cfg = small_cfg
+    cube = tmp_path / "cube.h5"
+    assert sweep(cfg, cube) == 0
+    with h5py.File(cube, "a") as f:
+        del f["tip_force_max"]
+        f.create_dataset("tip_force_max", shape=(2**15, 2**14), chunks=(2**15, 2**14),
+                         dtype="f8", compression="gzip")  # nothing stored: no disk used
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    capsys.readouterr()
+    for argv in (["info", str(cube)], ["info", str(cube), "--check"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "tip_force_max" in err and "4,096 MiB" in err, err
+    # ru_maxrss [KiB]: well under the 4 GiB the chunk would have taken
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak < 2**20
+
+
+# --------------------------------------------------------------------------- issue 26: nonsense
+
+def test_a_stroke_shape_zero_everywhere_is_refused(tmp_path, capsys):
+    # gamma = beta = 0 (each in range) gave a zero stroke curve, usable_stroke up to 0.054
+    # and NaN cooling times, marked complete
+    import nylonflex as nf
+
+    raw = {**MULTI, "nylon": {"set": "silver_nylon66", "gamma": 0, "beta": 0}}
+    cfg = write_config(tmp_path, raw)
+    out = tmp_path / "run" / "cube.h5"
+    assert sweep(cfg, out) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "nylon.gamma, nylon.beta" in err and "> 0" in err
+    assert not (tmp_path / "run").exists()
+    with pytest.raises(ValueError, match="nylon.gamma, nylon.beta"):
+        nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.7, 0.14,
+                    nylon={"set": "silver_nylon66", "gamma": 0.0, "beta": 0.0})
+    with pytest.raises(ValueError, match="nylon.gamma, nylon.beta"):
+        nf.design_limits(7.5e-3, 2e-3, 70e-3, 1.7, 0.14,
+                         nylon={"set": "silver_nylon66", "gamma": 0.0, "beta": 0.0})
+
+
+def test_a_supply_that_cannot_heat_the_muscle_is_refused(tmp_path, capsys):
+    # 1e-9 V gave cooling_time NaN and heating_time inf in every design
+    import nylonflex as nf
+    from nylonflex.physics.thermal import MIN_SUPPLY_RISE
+
+    raw = {**MULTI, "supply": {"voltage": 1e-9}}
+    cfg = write_config(tmp_path, raw)
+    out = tmp_path / "run" / "cube.h5"
+    assert sweep(cfg, out) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "supply.voltage" in err and "K above ambient" in err
+    assert not (tmp_path / "run").exists()
+    with pytest.raises(ValueError, match="supply_voltage: 1e-09 V"):
+        nf.evaluate(7.5e-3, 2e-3, 70e-3, 1.7, 0.14, supply_voltage=1e-9)
+    # the least voltage the message names is accepted, and its designs have no NaN
+    need = float(err.split("at least ")[-1].split(" V")[0]) * 1.01
+    ds = run_sweep(parse_config({**MULTI, "supply": {"voltage": need}}))
+    for name in ("cooling_time", "heating_time", "usable_stroke", "heating_power"):
+        assert np.all(np.isfinite(ds[name].values)), name
+    assert MIN_SUPPLY_RISE == 1e-3
+
+
+def test_validate_with_absurd_pressures_is_refused_and_json_is_valid(tmp_path, capsys):
+    config = Path(__file__).parents[1] / "configs" / "control.yaml"
+    data = tmp_path / "p.csv"
+    data.write_text("pressure [kPa],bend_angle [deg]\n1e300,10\n2,20\n")
+    assert main(["validate", str(config), str(data), "--format", "json"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "[0, 100] kPa" in err and "1e+300" in err
+    data.write_text("pressure [kPa],bend_angle [deg]\n1,1\n20,30\n")
+    assert main(["validate", str(config), str(data), "--format", "json"]) == 0
+    text = capsys.readouterr().out
+    json.loads(text, parse_constant=lambda name: pytest.fail(f"{name} in the JSON"))
+
+
+def test_json_text_writes_null_for_nan_and_infinity():
+    from nylonflex.units import json_text
+
+    doc = {"a": float("nan"), "b": [np.float64("inf"), 1.5], "c": np.array([-np.inf, 2.0])}
+    text = json_text(doc)
+    assert json.loads(text) == {"a": None, "b": [None, 1.5], "c": [None, 2.0]}
+    assert "NaN" not in text and "Infinity" not in text
+
+
+# --------------------------------------------------------------------------- issue 26: messages
+
+def test_a_listener_answering_garbage_as_scheduler_names_the_option(tmp_path, small_cfg,
+                                                                    capsys):
+    # it said "Maximum allowed dimension exceeded" (naming no option)
+    pytest.importorskip("distributed")
+    raw, cfg = small_cfg
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(4)
+    srv.settimeout(20)  # bounded: closes itself
+    rng = random.Random(26)
+    garbage = bytes(rng.randrange(256) for _ in range(4096)) * 4
+
+    def serve():
+        try:
+            while True:
+                c = srv.accept()[0]
+                with c:
+                    c.recv(65536)
+                    c.sendall(garbage)
+        except OSError:
+            pass
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        rc = sweep(cfg, tmp_path / "c.h5", "--scheduler",
+                   f"tcp://127.0.0.1:{srv.getsockname()[1]}")
+    finally:
+        srv.close()
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert "--scheduler" in err and "not a Dask scheduler" in err
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_sigterm_exits_143(tmp_path):
+    # the shell's convention, 128 + 15 (it exited 130 as for Ctrl-C)
+    cfg = write_config(tmp_path, MULTI)
+    out = tmp_path / "cube.h5"
+    script = _FINALISER_SIGNAL
+    proc = subprocess.run([sys.executable, "-c", script, "loop", str(int(signal.SIGTERM)),
+                           "sweep", str(cfg), "--out", str(out), "--no-charts"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 143, (proc.returncode, proc.stderr)

@@ -97,6 +97,7 @@ def _connect(client_class, address, timeout):
             box["client"] = client_class(address, timeout=timeout, set_as_default=False)
         except BaseException as exc:  # noqa: BLE001 - handed to the caller's thread
             box["error"] = exc
+            _disarm(exc, client_class)
 
     thread = threading.Thread(target=connect, name="nylonflex-connect", daemon=True)
     thread.start()
@@ -106,6 +107,24 @@ def _connect(client_class, address, timeout):
     if "error" in box:
         raise box["error"]
     return box["client"]
+
+
+def _disarm(exc, client_class):
+    """Close the half-made client a failed connection left in ``exc``'s traceback (a
+    listener that answered garbage), so that its finaliser does not wait 10 s at exit and
+    print "Exception ignored ... TimeoutError" after the one line of the error."""
+    import contextlib
+
+    tb = exc.__traceback__
+    while tb is not None:
+        obj = tb.tb_frame.f_locals.get("self")
+        if isinstance(obj, client_class):
+            with contextlib.suppress(Exception):
+                obj.close(timeout=1)
+            with contextlib.suppress(Exception):
+                obj._Client__loop = None  # what its __del__ checks before closing again
+            return
+        tb = tb.tb_next
 
 
 def _quiet_dask_logs() -> dict:
@@ -199,6 +218,12 @@ class DaskExecutor:
                              f"within {timeout:g} s ({type(exc).__name__}); start one with "
                              "'dask scheduler' (its default port is 8786; 8787 is the "
                              "dashboard)") from None
+        except Exception as exc:  # noqa: BLE001 - garbage from whatever listens there
+            reason = " ".join(str(exc).split())[:100] or type(exc).__name__
+            raise InputError(f"--scheduler: what answers at {self.address} is not a Dask "
+                             f"scheduler ({type(exc).__name__}: {reason}); give the "
+                             "address of 'dask scheduler' (its default port is 8786)"
+                             ) from None
         self._quiet = _quiet_dask_logs()  # its reconnect tracebacks on scheduler loss
         self._pending: set = set()
         self._used: set[str] = set()
