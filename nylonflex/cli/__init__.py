@@ -3,7 +3,8 @@
 Each command is a module of this package with ``HELP`` (one line), ``add_arguments(parser)``
 and ``run(args) -> int``; it calls library functions that return values and prints them. No
 science lives here. Exit status: 0 done, 2 bad input (one line naming the field), 1 other
-failure, 128 + the signal for a run a signal stopped (130 Ctrl-C, 143 SIGTERM). A traceback is printed only with ``--debug``.
+failure, 128 + the signal for a run a signal stopped (130 Ctrl-C, 143 SIGTERM). A
+traceback is printed only with ``--debug``.
 
 Command modules import nothing heavy at module level, so ``nylonflex --help`` stays light.
 """

@@ -5,8 +5,9 @@ Durability: every finished slab of radii is journaled as its own ``.npz`` file i
 absent; it holds the slab's compressed chunks, see :meth:`CubeFile.encode`) and written
 into ``<cube>.building``. Only a finished run renames the building file to ``<cube>``: a
 killed run never leaves a file that reads as complete. ``--resume`` keeps the journal's
-slabs (if the config hash, the nylonflex version and the model digest match, and each slab
-passes its own verification; a slab that fails is recomputed) and computes the rest. A run
+slabs (if the config hash, the nylonflex version and the model digest match, the slab plan
+and codec are ones the config implies, and each slab passes its own verification, which
+covers the codec it decodes with; a slab that fails is recomputed) and computes the rest. A run
 stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete = "false"`` and a ``slab_done`` mask, so the part
 already done can be queried.
 """
