@@ -23,7 +23,8 @@ __all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONL
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.
-MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment")
+MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment",
+          "lateral_pressure")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
@@ -204,8 +205,8 @@ CURVES = {v.name: v for v in [
        "gauge pressure p(s), Boyle (docs/model.md s. 3)", "kPa", "pressure"),
     _m("bend_angle", ["radius", "wall_thickness", "length", "pressure"], "rad", "bend angle",
        "free bending angle theta(p) = kappa(p) L (docs/model.md s. 6)", "deg", "angle"),
-    _v("tip_force", ["radius", "wall_thickness", "length", "pressure"], "N", "tip force",
-       "blocked tip force M_P(p)/L (docs/model.md s. 7)", "N", "force"),
+    _m("tip_force", ["radius", "wall_thickness", "length", "pressure"], "N", "tip force",
+       "blocked tip force M(p)/L, the model's moment (docs/model.md s. 7, 18)", "N", "force"),
 ]}
 
 

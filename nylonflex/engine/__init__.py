@@ -10,6 +10,7 @@ Imports point down: the engine imports the kernels, the physics, the registry, t
 materials and the config, never storage, charts, query or the CLI.
 """
 
+from ..physics.limits import model_bend_angle as bend_angle
 from .pointwise import MODELS, design_limits, evaluate
 
-__all__ = ["MODELS", "design_limits", "evaluate"]
+__all__ = ["MODELS", "bend_angle", "design_limits", "evaluate"]

@@ -32,7 +32,8 @@ from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _node_count, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _design_state, _design_values, _model_state_nodes,
+                              _design_state, _design_values, _model_moment,
+                              _model_state_nodes,
                               _nylon_force_model, _reach,
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
                               _validity, _working_temperatures)
@@ -120,9 +121,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         kappa_curve = np.empty(npr)
         rate_curve = np.empty(npr)
         rate2_curve = np.empty(npr)
-        lever_p = _pressure_moment(1.0, a, b)  # dM_P/dp
+        lever_p = _model_moment(model, 1.0, a, t, b)  # dM/dp: linear in p in every model
         for jp in range(npr):
-            moment = _pressure_moment(pressure[jp], a, b)
+            moment = _model_moment(model, pressure[jp], a, t, b)
             kappa, dm, d2m = _curvature_solve(
                 moment, y_nodes, wy_nodes, wyy_nodes, work, mu, alpha,
                 _curvature_start(pressure[jp], pressure, kappa_curve, rate_curve, rate2_curve,

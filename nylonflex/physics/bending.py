@@ -84,6 +84,32 @@ def _pressure_moment(pressure, radius, base_thickness):
     return pressure * (4.0 * a * a * a + 3.0 * math.pi * a * a * base_thickness) / 6.0
 
 
+@formula
+def _lateral_lever(radius, wall_thickness, base_thickness):
+    """dM_L/dp [m^3]: the moment per pascal of the chamber pressure on the wall and floor
+    (``lateral_pressure``, docs/model.md s. 18).
+
+    The pressure compresses the silicone through its thickness, the through-thickness
+    stress falling linearly from -p on the chamber's surface to 0 on the outer one
+    (after Cacucciolo et al., arXiv:1605.00949). In an incompressible solid that stress
+    lowers the axial stress at a given stretch by as much, so the balance M_S = M_P gains
+    ``p int (confining fraction) y dA`` over the wall and the floor under the chamber::
+
+        wall:  (1/t) int_0^pi int_a^R (R - r) (b + r sin phi) r dr dphi
+               = (pi b J1 + 2 J2) / t,  J1 = R (R^2 - a^2)/2 - (R^3 - a^3)/3,
+                                        J2 = R (R^3 - a^3)/3 - (R^4 - a^4)/4,  R = a + t
+        floor: int_-a^a int_0^b (y/b) y dy dx = 2 a b^2 / 3
+    """
+    a = radius
+    t = wall_thickness
+    b = base_thickness
+    # J1, J2 in powers of t (no cancellation for thin walls): J1 = a t^2/2 + t^3/6,
+    # J2 = a^2 t^2/2 + a t^3/3 + t^4/12
+    j1 = t * t * (0.5 * a + t / 6.0)
+    j2 = t * t * (0.5 * a * a + a * t / 3.0 + t * t / 12.0)
+    return (math.pi * b * j1 + 2.0 * j2) / t + 2.0 * a * b * b / 3.0
+
+
 #: The node table's length is a multiple of this [-]: the SIMD loops of
 #: :func:`_section_moment` then end without a scalar remainder (8 doubles fill an AVX-512
 #: register, two AVX2 ones). 55 nodes measured 570 ns an evaluation, padded to 56 400 ns.

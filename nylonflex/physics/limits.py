@@ -13,10 +13,11 @@ import math
 import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
-from ._formula import check_input, check_section, check_wrap_angle, formula, scalar_or_array
+from ._formula import (check, check_input, check_section, check_wrap_angle, formula,
+                       scalar_or_array)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
-                      _curvature_start, _node_table, _pressure_moment, _taylor_start,
-                      quadrature_nodes)
+                      _curvature_start, _lateral_lever, _node_table, _pressure_moment,
+                      _taylor_start, quadrature_nodes)
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
@@ -26,10 +27,12 @@ from .thermal import _cooling_time, _heating_power, _heating_time, _steady_tempe
 from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
     _outer_perimeter, _pitch, _wrap_force
 
-__all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "stroke_limit"]
+__all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "model_bend_angle",
+           "stroke_limit"]
 
 from ..variables import MODELS  # noqa: E402  (the registry holds the names)
-PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT = range(5)
+PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE = \
+    range(6)
 
 #: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
@@ -168,6 +171,21 @@ def _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, al
 
 
 @formula
+def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
+    """The moment that bends the section at chamber pressure p [N m] in a model variant.
+
+    The paper's end-cap moment M_P (eq. 16; every variant but ``lateral_pressure``, bit for
+    bit); ``lateral_pressure`` adds the pressure on the wall and floor, p times
+    :func:`~.bending._lateral_lever` (docs/model.md s. 18). Linear in p in every model:
+    ``_model_moment(model, 1, ...)`` is dM/dp.
+    """
+    m = _pressure_moment(pressure, radius, base_thickness)
+    if model == LATERAL_PRESSURE:
+        m += pressure * _lateral_lever(radius, wall_thickness, base_thickness)
+    return m
+
+
+@formula
 def _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
                  s_max, force_blocked, supply_limited, mu, alpha, x_base, w_base, phi_trig,
                  w_phi, p_atm):
@@ -214,10 +232,11 @@ def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, for
     else:
         p_full = _nylon_pressure(model, s_max, p_atm, solid)
         kappa_full, dm, d2m = _curvature_solve(
-            _pressure_moment(p_full, radius, base_thickness), y, wy, wyy, work, mu, alpha,
-            _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, cauchy)
-        rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
-                                                 dm, d2m)
+            _model_moment(model, p_full, radius, wall_thickness, base_thickness), y, wy, wyy,
+            work, mu, alpha, _curvature_start(p_full, pressures, kappas, rates, rates2, n),
+            NEWTON_RTOL, cauchy)
+        rate_full, rate2_full = _curvature_rates(
+            _model_moment(model, 1.0, radius, wall_thickness, base_thickness), dm, d2m)
     if model == COUPLED_MUSCLE:
         s_eq = _coupled_stroke(force_blocked, s_free, radius, wall_thickness, lever, mu, alpha,
                                p_atm, STROKE_RTOL)
@@ -235,7 +254,7 @@ def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, for
     else:
         limit = 0
     p = _nylon_pressure(model, s, p_atm, solid)
-    moment = _pressure_moment(p, radius, base_thickness)
+    moment = _model_moment(model, p, radius, wall_thickness, base_thickness)
     if limit == 0:
         kappa = kappa_full
     else:
@@ -560,3 +579,50 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
                       ny.heat_loss_per_length, "supply_voltage")
     return {name: (int(v) if name in ("limit", "validity") and v.ndim == 0
                    else scalar_or_array(v)) for name, v in out.items()}
+
+
+def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=None,
+                     silicone="tc5005", model="paper"):
+    """Free bend angle theta(p) = kappa(p) L of a model variant at a chamber pressure [rad].
+
+    The variants differ here by the moment that bends the section (``lateral_pressure``:
+    :func:`_model_moment`) or the stress it is balanced by
+    (``cauchy_moment``); ``coupled_muscle``, ``paper_eq10`` and ``incompressible_wall``
+    change the muscle's side only and give the paper's angle (docs/model.md s. 16, 18).
+
+    Parameters
+    ----------
+    pressure : float or array
+        Chamber gauge pressure p [Pa], >= 0.
+    radius, wall_thickness, length : float or array
+        a, t, L [m], > 0.
+    base_thickness : float or array, optional
+        b [m], > 0; b = t when None.
+    silicone : str, dict or Silicone
+        Material set.
+    model : str
+        One of :data:`MODELS`.
+
+    Returns
+    -------
+    float or array
+        theta [rad], of the broadcast shape of the inputs.
+    """
+    if model not in MODELS:
+        raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
+    code = MODELS.index(model)
+    p = check("pressure", pressure, 0.0, unit="Pa")
+    a, t, b = check_section(radius, wall_thickness, base_thickness)
+    L = check_input("length", length)
+    sil = silicone_parameters(silicone)
+    mu, alpha = sil.arrays()
+    nodes = quadrature_nodes()
+    cauchy = code == CAUCHY_MOMENT
+
+    def one(p_, a_, t_, b_, l_):
+        y, wy, wyy, work = _node_table(a_, t_, b_, *nodes)
+        moment = _model_moment(code, p_, a_, t_, b_)
+        return _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
+                                cauchy) * l_
+
+    return scalar_or_array(np.vectorize(one, otypes=[float])(p, a, t, b, L))
