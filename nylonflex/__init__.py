@@ -13,8 +13,10 @@ __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "__version__",
+    "bend_angle",
     "design_limits",
     "evaluate",
+    "fe_bend",
     "load_config",
     "nylon_parameters",
     "open_cube",
@@ -28,6 +30,7 @@ __all__ = [
 _LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
          "nylon_parameters": "materials", "silicone_parameters": "materials",
          "design_limits": "engine", "evaluate": "engine", "load_config": "config",
+         "bend_angle": "engine", "fe_bend": "fe",
          "run_sweep": "sweep", "open_cube": "storage", "run_design": "design"}
 
 

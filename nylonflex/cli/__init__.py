@@ -34,6 +34,7 @@ COMMANDS = {
     "list": "listing",
     "sensitivity": "sensitivity",
     "explore": "explore",
+    "fe": "fe",
 }
 
 

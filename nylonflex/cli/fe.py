@@ -1,0 +1,140 @@
+"""``nylonflex fe``: the FE twin's bend angle of one design, beside every variant's."""
+
+from __future__ import annotations
+
+import sys
+
+HELP = "bend angle of one design by the finite-element twin (needs the [fe] extra)"
+DESCRIPTION = """\
+Solve one design with the finite-element twin (FElupe; docs/fidelity.md) at a list of
+chamber pressures and print its bend angle beside every model variant's analytic angle.
+
+  nylonflex fe --at radius=20mm,wall_thickness=6mm,length=90mm --pressure 0:12:4kPa
+
+--pressure takes START:STOP:STEP (STOP included) or a comma list, with a unit
+(kPa when bare). --at takes radius, wall_thickness, length and optionally base_thickness
+(mm when bare) and silicone=NAME."""
+
+#: --at's names and the unit a bare number means.
+AT_NAMES = ("radius", "wall_thickness", "length", "base_thickness")
+
+
+def add_arguments(p):
+    p.add_argument("--at", required=True, metavar="NAME=VALUE,...",
+                   help="the design: radius, wall_thickness, length [, base_thickness] "
+                        "(mm when bare) [, silicone=NAME]")
+    p.add_argument("--pressure", required=True, metavar="START:STOP:STEP|P,P,...",
+                   help="chamber pressures (kPa when bare), e.g. 0:12:4kPa or 2,5,10")
+    p.add_argument("--mesh", default="default", metavar="coarse|default|fine",
+                   help="mesh level (default: default)")
+    p.add_argument("--format", choices=["table", "json"], default="table")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def parse_design(text):
+    """``radius=20mm,...`` -> (design dict in SI, silicone name or None)."""
+    from ..units import InputError, parse_quantity
+
+    design, silicone = {}, None
+    for part in [s for s in str(text).split(",") if s.strip()]:
+        if "=" not in part:
+            raise InputError(f"--at: expected NAME=VALUE, got {part.strip()!r}; names: "
+                             f"{', '.join(AT_NAMES)}, silicone")
+        name, value = (s.strip() for s in part.split("=", 1))
+        if name == "silicone":
+            silicone = value
+            continue
+        if name not in AT_NAMES:
+            raise InputError(f"--at: unknown name {name!r}; accepted: "
+                             f"{', '.join(AT_NAMES)}, silicone")
+        if name in design:
+            raise InputError(f"--at: {name} given twice")
+        design[name] = float(parse_quantity(value, f"--at {name}", "length", "mm"))
+    missing = [n for n in AT_NAMES[:3] if n not in design]
+    if missing:
+        raise InputError(f"--at: missing {', '.join(missing)} (radius, wall_thickness and "
+                         "length are needed)")
+    return design, silicone
+
+
+def parse_pressures(text):
+    """``0:12:4kPa`` or ``2,5,10`` (kPa when bare) -> pressures [Pa]."""
+    import re
+
+    import numpy as np
+
+    from ..units import InputError, parse_quantity
+
+    text = str(text).strip()
+    m = re.fullmatch(r"\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-z]+)?\s*", text)
+    if m:
+        unit = m.group(4) or "kPa"
+        start, stop, step = (parse_quantity(f"{v.strip()}{unit}", "--pressure", "pressure",
+                                            "kPa") for v in m.groups()[:3])
+        if not step > 0:
+            raise InputError(f"--pressure: STEP must be > 0, got {text!r}")
+        if stop < start:
+            raise InputError(f"--pressure: STOP must be >= START, got {text!r}")
+        n = int(np.floor((stop - start) / step * (1 + 1e-12))) + 1
+        if n > 100:
+            raise InputError(f"--pressure: at most 100 pressures, {text!r} gives {n}")
+        return start + step * np.arange(n)
+    parts = [s for s in text.split(",") if s.strip()]
+    if not parts:
+        raise InputError("--pressure: need at least one pressure, e.g. 0:12:4kPa or 2,5,10")
+    unit = re.search(r"[A-Za-z]+\s*$", parts[-1])
+    unit = unit.group(0).strip() if unit else "kPa"
+    out = []
+    for v in parts:
+        v = v.strip()
+        out.append(parse_quantity(v if re.search(r"[A-Za-z]", v) else f"{v}{unit}",
+                                  "--pressure", "pressure", "kPa"))
+    return np.array(out, dtype=float)
+
+
+def run(args) -> int:
+    import json
+
+    import numpy as np
+
+    from ..engine import bend_angle
+    from ..fe import fe_bend, require_felupe
+    from ..variables import MODELS
+    from ._common import progress_bar
+
+    design, silicone = parse_design(args.at)
+    pressures = parse_pressures(args.pressure)
+    require_felupe()
+    kw = {"base_thickness": design.get("base_thickness"), "silicone": silicone or "tc5005"}
+    with progress_bar("fe", unit="solve", quiet=args.quiet) as bar:
+        res = fe_bend(design["radius"], design["wall_thickness"], design["length"],
+                      pressures, mesh=args.mesh, progress=bar, **kw)
+    analytic = {m: np.asarray(bend_angle(res["pressure"], design["radius"],
+                                         design["wall_thickness"], design["length"],
+                                         model=m, **kw), dtype=float).reshape(-1)
+                for m in MODELS if m in ("paper", "cauchy_moment", "lateral_pressure")}
+    if args.format == "json":
+        out = {"design": design, "silicone": kw["silicone"], "mesh": args.mesh,
+               "pressure": res["pressure"].tolist(), "bend_angle": res["bend_angle"].tolist(),
+               "discretisation_error": res["discretisation_error"].tolist(),
+               "models": {m: v.tolist() for m, v in analytic.items()},
+               "units": {"design": "m", "pressure": "Pa", "bend_angle": "rad",
+                         "discretisation_error": "1", "models": "rad"}}
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 0
+    names = list(analytic)
+    head = f"{'pressure':>9} {'FE':>8} {'error':>6} " + " ".join(f"{n:>16}" for n in names)
+    print(f"FE twin, mesh {args.mesh}: bend angle [deg] (ratio FE / model in brackets)")
+    print(head)
+    print(f"{'[kPa]':>9} {'[deg]':>8} {'[%]':>6}")
+    for i, p in enumerate(res["pressure"]):
+        fe = np.degrees(res["bend_angle"][i])
+        cells = []
+        for n in names:
+            v = np.degrees(analytic[n][i])
+            ratio = f"({fe / v:.2f})" if v > 0 else "(-)"
+            cells.append(f"{v:9.2f} {ratio:>6}")
+        print(f"{p / 1e3:9.3f} {fe:8.2f} {100 * res['discretisation_error'][i]:6.2f} "
+              + " ".join(f"{c:>16}" for c in cells))
+    sys.stdout.flush()
+    return 0

@@ -1,0 +1,144 @@
+"""The finite-element twin of the actuator (the ``[fe]`` extra, built on FElupe).
+
+``fe_bend`` builds the 3-D silicone body of a design (docs/fidelity.md: the chamber, its
+wall and floor, the end caps of thickness t, the strain-limiting skin and the smeared hoop
+wrap), loads the chamber with its pressure as a follower load and returns the bend angle
+against pressure, with a Richardson estimate of the mesh's discretisation error.
+
+FElupe (pip-only, kept, a small readable API for hyperelastic solids with u-p-J elements and
+follower pressures) is imported only when a solve runs: everything else in nylonflex works
+without the extra.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import InputError
+
+__all__ = ["FE_RANGES", "MESH_NAMES", "fe_bend", "require_felupe"]
+
+#: The mesh levels a user may ask for, coarse to fine (:data:`.mesh.MESHES`).
+MESH_NAMES = ("coarse", "default", "fine")
+#: The level whose difference from each gives the Richardson estimate.
+_COARSER = {"coarse": "rough", "default": "coarse", "fine": "default"}
+#: Observed order of convergence of the bend angle in the mesh size (docs/fidelity.md).
+ORDER = 2.0
+
+#: The shapes the FE twin accepts, beyond the registry's ranges of each dimension: the
+#: mesh is sized for them (docs/fidelity.md).
+FE_RANGES = {"wall_ratio": (0.02, 2.0), "base_ratio": (0.02, 2.0), "slenderness": (0.5, 40.0)}
+#: At most this many pressures, each in [0, MAX_PRESSURE] Pa.
+MAX_PRESSURES = 100
+MAX_PRESSURE = 1e6
+
+INSTALL_HINT = "the FE twin needs FElupe: pip install 'nylonflex[fe]'"
+
+
+def require_felupe():
+    """Import FElupe, or raise :class:`InputError` saying how to install it."""
+    try:
+        import felupe  # noqa: F401
+        import tensortrax  # noqa: F401
+    except ImportError:
+        raise InputError(INSTALL_HINT) from None
+
+
+def _design(radius, wall_thickness, length, base_thickness):
+    from ..physics._formula import check_input
+
+    a = float(check_input("radius", radius))
+    t = float(check_input("wall_thickness", wall_thickness))
+    L = float(check_input("length", length))
+    b = t if base_thickness is None else float(check_input("base_thickness", base_thickness))
+    for name, value in (("wall_ratio", t / a), ("base_ratio", b / a),
+                        ("slenderness", L / (a + t + b))):
+        lo, hi = FE_RANGES[name]
+        if not lo <= value <= hi:
+            what = {"wall_ratio": "wall_thickness / radius", "base_ratio":
+                    "base_thickness / radius", "slenderness":
+                    "length / (radius + wall_thickness + base_thickness)"}[name]
+            raise InputError(f"{what}: the FE twin accepts {lo:g} to {hi:g}, got {value:.4g}")
+    return a, t, L, b
+
+
+def _pressures(pressures):
+    try:
+        p = np.atleast_1d(np.asarray(pressures, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError("pressures: must be numbers [Pa]") from None
+    if p.ndim != 1 or p.size == 0:
+        raise InputError("pressures: need at least one pressure [Pa]")
+    if p.size > MAX_PRESSURES:
+        raise InputError(f"pressures: at most {MAX_PRESSURES}, got {p.size}")
+    if not np.all(np.isfinite(p)) or np.any(p < 0) or np.any(p > MAX_PRESSURE):
+        bad = p[~(np.isfinite(p) & (p >= 0) & (p <= MAX_PRESSURE))][0]
+        raise InputError(f"pressures: each must be in [0, {MAX_PRESSURE:g}] Pa, got {bad:g}")
+    return p
+
+
+def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
+            silicone="tc5005", mesh="default", progress=None):
+    """Bend angle of a design against chamber pressure by the FE twin.
+
+    Parameters
+    ----------
+    radius, wall_thickness, length : float
+        a, t, L [m] (the registry's ranges; with t/a and b/a in [0.02, 2] and
+        L/(a + t + b) in [0.5, 40]).
+    pressures : float or sequence of float
+        Chamber gauge pressures [Pa], each in [0, 1e6], at most 100.
+    base_thickness : float, optional
+        b [m]; the wall thickness when None.
+    silicone : str, dict or Silicone
+        Any silicone set nylonflex knows (named, a fitted file ``{"file": ...}``, or with
+        fields overridden).
+    mesh : {"coarse", "default", "fine"}
+        Mesh level (docs/fidelity.md: the default's discretisation error is under 3 %).
+    progress : callable, optional
+        ``progress(done, total)`` in solved increments of both meshes (an estimate).
+
+    Returns
+    -------
+    dict
+        ``pressure`` [Pa], ``bend_angle`` [rad] and ``discretisation_error`` [1] (the
+        Richardson estimate |theta_h - theta_2h| / (r^p - 1) / |theta_h| against the next
+        coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given.
+
+    Raises
+    ------
+    InputError
+        A design outside the accepted range, no or negative pressures, an unknown mesh,
+        or FElupe not installed.
+    """
+    from ..materials import silicone_parameters
+    from .mesh import REFINEMENT, body_mesh
+    from .solve import solve_bend
+
+    if not isinstance(mesh, str) or mesh not in MESH_NAMES:
+        raise InputError(f"mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    a, t, L, b = _design(radius, wall_thickness, length, base_thickness)
+    p = _pressures(pressures)
+    try:
+        sil = silicone_parameters(silicone)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    require_felupe()
+    mu, alpha = sil.arrays()
+    span = float(p.max()) if p.max() > 0 else 1.0
+    share = 0.75  # of the work: the asked-for mesh; the rest the coarser one
+
+    def report(offset, weight):
+        def call(pressure, angle, iterations):
+            if progress is not None:
+                progress(offset + weight * pressure / span, 1.0)
+        return call
+
+    angles = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=mesh), mu, alpha, p,
+                        progress=report(0.0, share))
+    coarser = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=_COARSER[mesh]), mu,
+                         alpha, p, progress=report(share, 1.0 - share))
+    factor = REFINEMENT ** ORDER - 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        err = np.where(angles != 0, np.abs(angles - coarser) / factor / np.abs(angles), 0.0)
+    return {"pressure": p, "bend_angle": angles, "discretisation_error": err, "mesh": mesh}

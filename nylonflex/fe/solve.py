@@ -1,0 +1,134 @@
+"""The FE twin's solve: the bend angle of a body against the chamber pressure.
+
+The pressure is raised in increments (never more than :data:`MAX_STEP` mu0, halved when
+Newton's method fails, grown again after easy steps); each increment starts from the
+quadratic extrapolation of the last three converged states, and every requested pressure is
+landed on exactly. The bend angle is the rotation, about x, of the chamber's end section
+z = L against its base section z = 0, read from the line of nodes on the symmetry plane
+from the bottom face to the top of the wall (plane sections stay nearly plane: the two
+ends of the line give it), unwrapped over the increments so angles past pi are right.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mesh import BodyMesh
+from .model import build_model, felupe_ogden
+
+__all__ = ["MAX_STEP", "FESolveError", "solve_bend"]
+
+#: Largest pressure increment over the initial shear modulus [-].
+MAX_STEP = 0.1
+#: The first increment over the initial shear modulus [-]: small, so that the later ones
+#: start from a good extrapolation.
+FIRST_STEP = 0.02
+#: Smallest increment before the solve gives up, over the initial shear modulus [-].
+MIN_STEP = 1e-4
+#: Newton's tolerance (FElupe's relative residual norm) and iteration limit.
+NEWTON_TOL = 1e-7
+NEWTON_MAXITER = 25
+#: The increment grows by half after a step that took at most this many iterations, and
+#: shrinks by a third after one that took more than twice as many (measured: large steps
+#: cost more iterations than they save).
+EASY_STEP = 4
+
+
+class FESolveError(RuntimeError):
+    """The FE solve could not reach a pressure (the increment fell below :data:`MIN_STEP`)."""
+
+
+def _probes(body: BodyMesh):
+    pts = body.points
+    a, t, b, L = body.radius, body.wall_thickness, body.base_thickness, body.length
+    top = b + a + t
+
+    def node(y, z):
+        return int(np.argmin(np.hypot(pts[:, 0], pts[:, 1] - y) + np.abs(pts[:, 2] - z)))
+
+    return [(node(0.0, 0.0), node(top, 0.0)), (node(0.0, L), node(top, L))]
+
+
+def _section_angles(points, values, probes):
+    x = points + values
+    out = []
+    for i0, i1 in probes:
+        v = x[i1] - x[i0]
+        out.append(np.arctan2(v[2], v[1]))
+    return np.array(out)
+
+
+def _extrapolate(history, p):
+    """The predictor at pressure p: the Lagrange polynomial through the last (up to three)
+    converged states (p_i, u_i)."""
+    if len(history) == 1:
+        return history[0][1]
+    ps = [h[0] for h in history]
+    out = np.zeros_like(history[0][1])
+    for i, (pi, ui) in enumerate(history):
+        w = 1.0
+        for j, pj in enumerate(ps):
+            if j != i:
+                w *= (p - pj) / (pi - pj)
+        out += w * ui
+    return out
+
+
+def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None):
+    """Bend angles [rad] of ``body`` at each of ``pressures`` [Pa] (ascending, >= 0).
+
+    ``mu``, ``alpha``: the Ogden set (nylonflex's convention) [Pa], [-]. ``progress`` is
+    called as ``progress(p, angle, iterations)`` after every converged increment. Returns an array of
+    the angles, in the order of ``pressures``. Raises :class:`FESolveError` when an
+    increment cannot converge.
+    """
+    import felupe as fem
+
+    targets = np.asarray(pressures, dtype=float)
+    order = np.argsort(targets)
+    field, items, pressure, _, (dof0, dof1) = build_model(body, mu, alpha)
+    mu0 = float(sum(felupe_ogden(mu, alpha)[0]))
+    probes = _probes(body)
+    u = field[0]  # FElupe may replace u.values: always read it through the field
+    history = [(0.0, u.values.copy())]
+    last = _section_angles(body.points, u.values, probes)
+    unwrapped = np.zeros(2)
+    angles = np.empty(len(targets))
+    step = FIRST_STEP * mu0
+    p_now = 0.0
+    for idx in order:
+        target = targets[idx]
+        while p_now < target:
+            p_next = min(target, p_now + step)
+            if target - p_next < 0.25 * step:  # no sliver of a step before a target
+                p_next = target
+            u.values[:] = _extrapolate(history, p_next)
+            pressure.update(p_next)
+            try:
+                res = fem.newtonraphson(items=items + [pressure], dof1=dof1, dof0=dof0,
+                                        verbose=0, tol=NEWTON_TOL, maxiter=NEWTON_MAXITER,
+                                        plugins=[fem.LinesearchPlugin(residual=False)])
+                ok = bool(res.success) and np.all(np.isfinite(u.values))
+            except (ValueError, RuntimeError, FloatingPointError, np.linalg.LinAlgError):
+                # FElupe's NewtonConvergenceError is a ValueError; a NaN matrix fails
+                # SuperLU's factorisation with a RuntimeError
+                ok = False
+            if not ok:
+                u.values[:] = history[-1][1]
+                step *= 0.5
+                if step < MIN_STEP * mu0:
+                    raise FESolveError(f"the FE solve did not converge at {p_next:.4g} Pa")
+                continue
+            now = _section_angles(body.points, u.values, probes)
+            unwrapped += np.angle(np.exp(1j * (now - last)))
+            last = now
+            p_now = p_next
+            history = history[-2:] + [(p_now, u.values.copy())]
+            if res.iterations <= EASY_STEP:
+                step = min(step * 1.5, MAX_STEP * mu0)
+            elif res.iterations > 2 * EASY_STEP:
+                step *= 2.0 / 3.0
+            if progress is not None:
+                progress(p_now, float(unwrapped[1] - unwrapped[0]), res.iterations)
+        angles[idx] = unwrapped[1] - unwrapped[0] if target > 0 else 0.0
+    return angles

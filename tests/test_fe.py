@@ -1,0 +1,216 @@
+"""The FE twin (nylonflex.fe): its mesh, its input checks, and FElupe against closed forms.
+
+Coarse meshes only in the fast suite; the convergence study is slow-marked.
+Expected values: the Ogden closed forms of docs/model.md s. 5 (``physics.silicone``), the
+incompressible thick-walled tube (Ogden, 1984, ch. 5: p = int (sigma_theta - sigma_r)/r dr),
+and the body's own geometry.
+"""
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from nylonflex.fe import fe_bend
+from nylonflex.fe.mesh import MESHES, body_mesh
+from nylonflex.fe.model import felupe_ogden
+from nylonflex.materials import silicone_parameters
+from nylonflex.physics.silicone import bending_stress
+from nylonflex.units import InputError
+
+felupe = pytest.importorskip("felupe")
+pytest.importorskip("tensortrax")
+
+A, T, L = 20e-3, 6e-3, 90e-3
+
+
+def _volume(body):
+    region = felupe.RegionHexahedron(felupe.Mesh(body.points, body.cells, "hexahedron"))
+    assert np.all(region.dV > 0)
+    return float(region.dV.sum())
+
+
+@pytest.mark.parametrize("level", ["rough", "coarse", "default"])
+def test_body_volume_is_the_sections_times_the_length(level):
+    body = body_mesh(A, T, L, mesh=level)
+    r = A + T
+    exact = (math.pi * (r * r - A * A) / 4 + r * T) * (L + 2 * T) + math.pi * A * A / 4 * 2 * T
+    n_arc = MESHES[level].arc
+    # the arcs are polygons: the wall loses the segments between chord and arc
+    tol = 2 * (1 - math.sin(math.pi / 4 / n_arc * 2) / (math.pi / 2 / n_arc))
+    assert _volume(body) == pytest.approx(exact, rel=tol)
+
+
+def test_chamber_surface_and_layers():
+    body = body_mesh(A, T, L, mesh="coarse")
+    pts = body.points[body.chamber]
+    r = np.hypot(pts[:, 0], pts[:, 1] - T)
+    on_wall = np.isclose(r, A, rtol=1e-9)
+    on_floor = np.isclose(pts[:, 1], T, rtol=1e-9)
+    on_cap = np.isclose(pts[:, 2], 0.0, atol=1e-12) | np.isclose(pts[:, 2], L, rtol=1e-12)
+    assert np.all(on_wall | on_floor | on_cap)
+    # every skin cell lies below the skin's thickness, every wrap cell at the outer contour
+    assert np.all(body.points[body.cells[body.skin]][:, :, 1] <= body.skin_thickness * 1.000001)
+    assert np.allclose(np.linalg.norm(body.wrap_direction, axis=1), 1.0)
+    assert len(body.wrap) > 0 and len(body.skin) > 0
+
+
+def test_felupe_ogden_convention():
+    """W = sum mu_i/alpha_i (...) here, sum 2 mu_i'/alpha_i^2 (...) in FElupe: the same
+    energy, and sum mu_i' is mu0 (docs/model.md s. 5)."""
+    sil = silicone_parameters("tc5005")
+    mu_f, alpha_f = felupe_ogden(sil.mu, sil.alpha)
+    lam = np.array([1.3, 0.9, 1 / (1.3 * 0.9)])
+    w_here = sum(m / a * (np.sum(lam ** a) - 3) for m, a in zip(sil.mu, sil.alpha))
+    w_fe = sum(2 * m / a**2 * (np.sum(lam ** a) - 3) for m, a in zip(mu_f, alpha_f))
+    assert w_fe == pytest.approx(w_here, rel=1e-14)
+    assert sum(mu_f) == pytest.approx(sil.initial_shear_modulus, rel=1e-14)
+
+
+def _block(stretch, plane_strain, silicone):
+    """Nominal stress of a unit block of Ogden silicone stretched along x [Pa]."""
+    sil = silicone_parameters(silicone)
+    mu_f, alpha_f = felupe_ogden(sil.mu, sil.alpha)
+    mesh = felupe.Cube(n=2)
+    region = felupe.RegionHexahedron(mesh)
+    field = felupe.FieldContainer([felupe.Field(region, dim=3)])
+    x = mesh.points
+    umat = felupe.Hyperelastic(felupe.ogden, mu=mu_f, alpha=alpha_f)
+    solid = felupe.SolidBodyNearlyIncompressible(umat, field, bulk=5000 * sum(mu_f))
+    bounds = {"x0": felupe.Boundary(field[0], fx=0, skip=(0, 1, 1)),
+              "y0": felupe.Boundary(field[0], fy=0, skip=(1, 0, 1)),
+              "z0": felupe.Boundary(field[0], fz=0, skip=(1, 1, 0)),
+              "move": felupe.Boundary(field[0], fx=1, skip=(0, 1, 1), value=stretch - 1)}
+    if plane_strain:
+        bounds["z1"] = felupe.Boundary(field[0], fz=1, skip=(1, 1, 0))
+    dof0, dof1 = felupe.dof.partition(field, bounds)
+    ext0 = felupe.dof.apply(field, bounds, dof0)
+    for frac in np.linspace(0.25, 1, 4):
+        bounds["move"].value = frac * (stretch - 1)
+        ext0 = felupe.dof.apply(field, bounds, dof0)
+        felupe.newtonraphson(items=[solid], dof1=dof1, dof0=dof0, ext0=ext0, tol=1e-10)
+    r = np.asarray(solid.assemble.vector().todense()).reshape(-1, 3)
+    return float(r[bounds["move"].points, 0].sum())  # the unit cube's area is 1
+
+
+@pytest.mark.parametrize("silicone", ["tc5005", "ecoflex_00_30"])
+@pytest.mark.parametrize("stretch", [1.2, 1.6])
+def test_block_in_plane_strain_is_the_bending_stress(silicone, stretch):
+    """Plane-strain tension (l2 = 1, l3 = 1/l): the nominal stress S(l) the moment
+    balance integrates (docs/model.md s. 5)."""
+    fe = _block(stretch, True, silicone)
+    assert fe == pytest.approx(float(bending_stress(stretch, silicone)), rel=2e-3)
+
+
+@pytest.mark.parametrize("stretch", [1.2, 1.6])
+def test_block_in_uniaxial_tension(stretch):
+    """Uniaxial tension (l2 = l3 = l^-1/2): S = sum mu_i (l^(a-1) - l^(-a/2-1))."""
+    sil = silicone_parameters("tc5005")
+    closed = sum(m * (stretch ** (a - 1) - stretch ** (-a / 2 - 1))
+                 for m, a in zip(sil.mu, sil.alpha))
+    assert _block(stretch, False, "tc5005") == pytest.approx(closed, rel=2e-3)
+
+
+def _tube_pressure(inner_stretch, ratio, silicone="tc5005"):
+    """Internal pressure of an incompressible plane-strain Ogden tube (inner radius A,
+    outer ratio A) whose inner radius is stretched by ``inner_stretch`` [Pa]:
+    p = int_a^b sum mu_i (l^a_i - l^-a_i) / r dr, l(r) = r / R, R^2 = r^2 - a^2 + A^2."""
+    sil = silicone_parameters(silicone)
+    a_ref = 1.0
+    a = inner_stretch * a_ref
+    b = math.sqrt((ratio * a_ref) ** 2 + a * a - a_ref ** 2)
+
+    def integrand(r):
+        lam = r / math.sqrt(r * r - a * a + a_ref ** 2)
+        return sum(m * (lam ** al - lam ** -al) for m, al in zip(sil.mu, sil.alpha)) / r
+
+    return integrate.quad(integrand, a, b, epsrel=1e-12)[0]
+
+
+def test_thick_walled_tube_under_internal_pressure():
+    """A quarter of a plane-strain tube (outer/inner radius 1.5), pressurised inside
+    (follower load): the inner radius against the closed form's inverse."""
+    from nylonflex.fe.mesh import _ccw, _extrude, _grid
+
+    sil = silicone_parameters("tc5005")
+    mu_f, alpha_f = felupe_ogden(sil.mu, sil.alpha)
+    radii, phis = np.linspace(1.0, 1.5, 5), np.linspace(0, math.pi / 2, 9)
+    _, quads = _grid(radii, phis)
+    rr, pp = np.meshgrid(radii, phis, indexing="ij")
+    pts2 = np.stack([rr * np.cos(pp), rr * np.sin(pp)], -1).reshape(-1, 2)
+    pts, cells = _extrude(pts2, _ccw(pts2, quads), np.array([0.0, 0.1]))
+    mesh = felupe.Mesh(pts, cells, "hexahedron")
+    region = felupe.RegionHexahedron(mesh)
+    assert np.all(region.dV > 0)
+    field = felupe.FieldContainer([felupe.Field(region, dim=3)])
+    umat = felupe.Hyperelastic(felupe.ogden, mu=mu_f, alpha=alpha_f)
+    solid = felupe.SolidBodyNearlyIncompressible(umat, field, bulk=5000 * sum(mu_f))
+    inner = np.isclose(np.hypot(pts[:, 0], pts[:, 1]), 1.0)
+    face = felupe.RegionHexahedronBoundary(mesh, only_surface=True, mask=inner)
+    pressure = felupe.SolidBodyPressure(felupe.FieldContainer([felupe.Field(face, dim=3)]))
+    pressure.field.link(field)
+    bounds = {"x": felupe.Boundary(field[0], fx=0, skip=(0, 1, 1)),
+              "y": felupe.Boundary(field[0], fy=0, skip=(1, 0, 1)),
+              "z": felupe.Boundary(field[0], mask=np.ones(len(pts), bool), skip=(1, 1, 0))}
+    dof0, dof1 = felupe.dof.partition(field, bounds)
+    p_target = _tube_pressure(1.25, 1.5)
+    for frac in np.linspace(0.2, 1.0, 5):
+        pressure.update(frac * p_target)
+        felupe.newtonraphson(items=[solid, pressure], dof1=dof1, dof0=dof0, tol=1e-9)
+    moved = pts + field[0].values
+    r_inner = np.hypot(moved[inner, 0], moved[inner, 1])
+    assert r_inner.mean() == pytest.approx(1.25, rel=5e-3)
+
+
+def test_bad_input_is_refused_before_any_solve():
+    with pytest.raises(InputError, match="mesh: must be one of coarse, default, fine"):
+        fe_bend(A, T, L, [1e3], mesh="huge")
+    with pytest.raises(InputError, match="pressures: need at least one"):
+        fe_bend(A, T, L, [])
+    with pytest.raises(InputError, match=r"pressures: each must be in \[0"):
+        fe_bend(A, T, L, [1e3, -5.0])
+    with pytest.raises(ValueError, match="radius"):
+        fe_bend(-1.0, T, L, [1e3])
+    with pytest.raises(InputError, match="wall_thickness / radius"):
+        fe_bend(20e-3, 50e-3, L, [1e3])
+
+
+def test_coarse_body_bends_further_than_the_paper_and_near_the_lateral_model():
+    """One coarse solve at 1 kPa: the FE twin carries the pressure on the wall and floor,
+    so it bends further than the paper's balance (docs/fidelity.md)."""
+    import nylonflex as nf
+
+    res = fe_bend(A, T, L, [1e3], mesh="coarse")
+    paper = nf.bend_angle(1e3, A, T, L)
+    lateral = nf.bend_angle(1e3, A, T, L, model="lateral_pressure")
+    assert res["bend_angle"][0] > 1.3 * paper
+    assert res["bend_angle"][0] == pytest.approx(lateral, rel=0.25)
+    assert 0 <= res["discretisation_error"][0] < 0.2
+
+
+def test_cli_without_felupe_says_how_to_install(tmp_path):
+    code = ("import sys; sys.modules['felupe'] = None; from nylonflex.cli import main; "
+            "sys.exit(main(['fe', '--at', 'radius=20mm,wall_thickness=6mm,length=90mm', "
+            "'--pressure', '1,2']))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 2
+    assert out.stderr.strip().splitlines() == [
+        "nylonflex fe: error: the FE twin needs FElupe: pip install 'nylonflex[fe]'"]
+
+
+@pytest.mark.parametrize("args,match", [
+    (["--pressure", "1,2", "--mesh", "huge"], "mesh: must be one of"),
+    (["--pressure", ""], "--pressure: need at least one pressure"),
+    (["--pressure=-1,2"], r"pressures: each must be in \[0"),
+    (["--pressure", "0:12:0"], "STEP must be > 0"),
+])
+def test_cli_bad_input_is_one_line_and_exit_2(args, match, capsys):
+    from nylonflex.cli import main
+
+    code = main(["fe", "--at", "radius=20mm,wall_thickness=6mm,length=90mm", *args])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert err[0].startswith("nylonflex fe: error: ") and __import__("re").search(match, err[0])
