@@ -128,7 +128,7 @@ class SweepConfig(_Strict):
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
     slab_megabytes: Annotated[float, BeforeValidator(_no_bool)] = 16.0
     limits: Limits = Limits()
-    compression: Literal["gzip", "zstd", "lz4", "none"] = "zstd"
+    compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
     uncertainty: Uncertainty | None = None
     requirements: list[str] = []
     model: Union[str, list[str]] = "paper"
@@ -154,7 +154,7 @@ class ResolvedConfig:
     charts: tuple[str, ...]
     slab_megabytes: float
     raw: dict = field(compare=False, repr=False)
-    compression: str = "zstd"  # the cube's codec: not part of the design space or its hash
+    compression: str = "gzip"  # the cube's codec: not part of the design space or its hash
     uncertainty: "UncertaintySpec | None" = None
     requirements: tuple[str, ...] = ()
     models: tuple[str, ...] = ("paper",)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
-from .cube import load_filter_plugins
+from .cube import require_filters
 from .journal import Journal
 
 __all__ = ["check_cube", "cube_attrs", "cube_summary", "open_cube"]
@@ -61,8 +61,10 @@ def open_cube(path, *, quiet: bool = False):
     if attrs is None:
         raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
                          "written by 'nylonflex sweep')")
-    load_filter_plugins()  # zstd and lz4 cubes need hdf5plugin's filters registered
+    require_filters(attrs.get("compression"))  # zstd and lz4 need a filter plugin
     ds = xr.open_dataset(path, engine="h5netcdf")
+    for var in ds.variables.values():
+        var.encoding = portable_encoding(var.encoding)
     if attrs.get("complete") != "true":
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
@@ -72,6 +74,27 @@ def open_cube(path, *, quiet: bool = False):
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
+
+
+#: Encoding keys of codecs only HDF5 filter plugins know: h5py's filter id and options, and
+#: the netCDF4-style flags xarray reads them into (zstd; lz4 reads as blosc). Neither engine
+#: writes them again without the plugin (h5netcdf: 'Compression filter "zstd" is
+#: unavailable'; netcdf4: 'Unsupported value for compression kwarg').
+_PLUGIN_KEYS = ("compression", "compression_opts", "zstd", "blosc", "szip", "bzip2")
+
+
+def portable_encoding(encoding: dict) -> dict:
+    """A variable's encoding as both xarray engines (h5netcdf, netcdf4) write it again.
+
+    A chunk filter only a plugin decodes (zstd, lz4) becomes deflate level 1 with the
+    shuffle filter, the default cube's codec, which every reader decompresses; deflate,
+    chunking, dtype and fill value are kept as read.
+    """
+    out = dict(encoding)
+    filters = [out.pop(key, None) for key in _PLUGIN_KEYS]
+    if any(f not in (None, False, "gzip") for f in filters):
+        out.update(zlib=True, complevel=1, shuffle=True)
+    return out
 
 
 def _validity_lines(ds) -> list[str]:
@@ -167,7 +190,7 @@ def check_cube(path, *, full: bool = True, progress=None) -> list[str]:
     """
     import h5py
 
-    load_filter_plugins()
+    require_filters((cube_attrs(path) or {}).get("compression"))
     problems = []
     with h5py.File(path, "r") as f:
         names = [n for n, obj in f.items() if isinstance(obj, h5py.Dataset)]
