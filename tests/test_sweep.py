@@ -308,3 +308,44 @@ def test_version_and_help(capsys):
         main(["--version"])
     assert exc.value.code == 0 and "nylonflex 0." in capsys.readouterr().out
     assert main([]) == 0 and "sweep" in capsys.readouterr().out
+
+
+# ------------------------------------------------- coordinates at their decimals (issue 24)
+def test_grid_points_are_the_floats_nearest_their_decimal_values():
+    # {start: 5, stop: 25, num: 41, units: mm}: point i is the decimal 5 + 0.5 i mm, and its
+    # SI float is the one Python reads from that decimal in metres (float('0.0105')), not
+    # np.linspace's 0.010499999999999999; a values axis likewise (1.3 mm * 1e-3 is an ulp
+    # off 0.0013); degrees are math.radians' product, as np.radians gives
+    from fractions import Fraction
+
+    raw = {**SMALL, "grid": {**SMALL["grid"],
+                             "radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"},
+                             "wall_thickness": {"values": [1.3, 2.1, 4.2], "units": "mm"},
+                             "wrap_angle": {"start": 2, "stop": 30, "num": 15,
+                                            "units": "deg"}},
+           "curves": {**SMALL["curves"], "stroke": {"start": 0, "stop": 0.1, "num": 51}}}
+    cfg = parse_config(raw)
+    assert cfg.axes["radius"].tolist() == [float((5 + Fraction(1, 2) * i) / 1000)
+                                           for i in range(41)]
+    assert 0.0105 in cfg.axes["radius"].tolist()  # np.linspace: 0.010499999999999999
+    assert cfg.axes["wall_thickness"].tolist() == [0.0013, 0.0021, 0.0042]
+    assert cfg.axes["wrap_angle"].tolist() == np.radians(np.arange(2, 31, 2)).tolist()
+    assert cfg.curves["stroke"].tolist() == [float(Fraction(i, 500)) for i in range(51)]
+
+
+def test_sel_finds_grid_points_typed_in_si_or_with_units():
+    ds = run_sweep(parse_config({**SMALL, "grid": {
+        **SMALL["grid"], "radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"}}}))
+    for mm in np.arange(5, 25.01, 0.5):  # every grid point by its decimal, no 'nearest'
+        ds.sel(radius=float(f"{mm / 1000:.4g}"))
+    one = ds.nf.sel(radius="10.5 mm", wall_thickness=3, wrap_angle="20deg")
+    assert float(one["radius"]) == 0.0105 and float(one["wall_thickness"]) == 0.003
+    # the display-unit copy for plots: values and units attrs converted, SI cube untouched
+    shown = one["torque_max"].nf.display()
+    assert shown.attrs["units"] == VARIABLES["torque_max"].display == "N mm"
+    np.testing.assert_allclose(shown.values, one["torque_max"].values * 1e3, rtol=1e-15)
+    assert shown["length"].attrs["units"] == "mm" and ds["radius"].attrs["units"] == "m"
+    from nylonflex.units import InputError
+
+    with pytest.raises(InputError, match="stroke_max: not an axis"):
+        ds.nf.sel(stroke_max=1)

@@ -51,6 +51,8 @@ def open_cube(path, *, quiet: bool = False):
     """
     import xarray as xr
 
+    from . import accessor  # noqa: F401 - registers ds.nf
+
     path = Path(path)
     if not path.exists():
         parts = Journal(path)
