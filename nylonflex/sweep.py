@@ -57,7 +57,7 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     if out is None:
         from .engine.slabs import deferred_signals
 
-        from .storage import accessor  # noqa: F401 - registers ds.nf
+        from .storage.accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
         with deferred_signals(on_second=_interrupt):
             _warm_up(cfg, workers, scheduler, log)

@@ -51,7 +51,7 @@ def open_cube(path, *, quiet: bool = False):
     """
     import xarray as xr
 
-    from . import accessor  # noqa: F401 - registers ds.nf
+    from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
     path = Path(path)
     if not path.exists():
