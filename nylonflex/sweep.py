@@ -143,7 +143,12 @@ def _in_memory(cfg, workers, scheduler, progress):
         executor.close()
     if stats.stopped:
         raise KeyboardInterrupt
-    return sink.dataset({**provenance(cfg), **executor.info(), "complete": "true"})
+    import numpy as np
+
+    from .engine.provenance import typed_info
+
+    return sink.dataset({**provenance(cfg), **typed_info(executor.info()),
+                         "complete": np.int8(1)})
 
 
 def _resident_bytes() -> int:

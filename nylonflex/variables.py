@@ -76,6 +76,8 @@ class Variable:
         """The attributes written to the cube (CF flags for flag variables)."""
         out = {"units": self.units, "long_name": self.long_name,
                "description": self.description}
+        if self.name in STANDARD_NAMES:
+            out["standard_name"] = STANDARD_NAMES[self.name]
         if self.name in _FLAGS:
             values, meanings = _FLAGS[self.name]
             out["flag_values"] = np.array(values, dtype=np.int8)
@@ -103,6 +105,12 @@ _MASKS = {"validity": ((1, 2, 4, 8),
 
 #: Variables that are in a cube only when its config gives a supply.
 SUPPLY_ONLY = ("heating_time",)
+
+#: CF standard names (CF standard name table) where CF has one for a cube variable: the
+#: two flag variables say the status and the quality of each design's values. The design
+#: quantities themselves (radius, tip force, bend angle, ...) have no CF name: CF names
+#: geophysical quantities.
+STANDARD_NAMES = {"limit": "status_flag", "validity": "quality_flag"}
 
 
 def _v(name, dims, units, long_name, description, display, kind, dtype="float64", **rng):

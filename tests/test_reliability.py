@@ -215,7 +215,7 @@ def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
     messages = []
     ds = resume(out, log=messages.append)
     assert any("recomputing" in m for m in messages), messages
-    assert ds.attrs["complete"] == "true"
+    assert ds.attrs["complete"] == 1
     xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
 
 
@@ -265,7 +265,7 @@ def test_crash_safety_kill_at_random_points_resumes_identical(tmp_path, whole):
     interrupted(out, k=1)
     interrupted(out, k=2, resume=True)  # a resume stopped in its turn
     ds = resume(out)
-    assert ds.attrs["resumed_slabs"] == "3"
+    assert ds.attrs["resumed_slabs"] == 3
     xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
 
 
@@ -337,7 +337,7 @@ def test_an_interrupted_overwrite_keeps_the_old_cube(tmp_path, whole):
     run_sweep(parse_config(raw), out).close()
     interrupted(out, k=3, overwrite=True)
     old = open_cube(out)
-    assert old.attrs["name"] == "old" and old.attrs["complete"] == "true"
+    assert old.attrs["name"] == "old" and old.attrs["complete"] == 1
     old.close()
     ds = resume(out)  # the replacement, once complete, is published
     xr.testing.assert_identical(stable(ds.load()), stable(whole.load()))
@@ -707,7 +707,7 @@ def test_a_signal_in_a_finaliser_is_never_swallowed(tmp_path, where, sig):
     assert "Traceback" not in proc.stderr and "ignored" not in proc.stderr, proc.stderr
     assert "--resume" in proc.stderr
     ds = open_cube(out, quiet=True)
-    assert ds.attrs["complete"] == "false"
+    assert ds.attrs["complete"] == 0
     ds.close()
 
 

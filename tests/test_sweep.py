@@ -48,7 +48,7 @@ def test_round_trip_file_equals_memory(tmp_path):
     cfg = parse_config(SMALL)
     mem = run_sweep(cfg)
     disk = run_sweep(cfg, tmp_path / "cube.h5")
-    assert disk.attrs["complete"] == "true"
+    assert disk.attrs["complete"] == 1  # int8 (issue 24)
     xr.testing.assert_equal(mem, disk.load())
     for name in disk.variables:
         assert disk[name].attrs["units"] and disk[name].attrs["long_name"], name
@@ -127,7 +127,7 @@ def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
         # a stopped run leaves an incomplete cube that can be read where it is done
         with pytest.warns(UserWarning, match="incomplete"):
             part = open_cube(out)
-        assert part.attrs["complete"] == "false"
+        assert part.attrs["complete"] == 0
         assert 0 < int(part["slab_done"].sum()) < 160
         part.close()
     # without --resume the journal is protected
@@ -135,7 +135,7 @@ def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
     assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--resume",
                  "--no-charts"]) == 0
     resumed = open_cube(out)
-    assert resumed.attrs["resumed_slabs"] == str(done)
+    assert resumed.attrs["resumed_slabs"] == done  # typed (issue 24)
     whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")
     xr.testing.assert_identical(stable(resumed), stable(whole))
     assert not Journal(out).dir.exists()
@@ -233,7 +233,7 @@ def test_set_overrides_a_config_key(tmp_path):
                  "--workers", "1"]) == 0
     ds = open_cube(out)
     assert ds.sizes["radius"] == 3 and ds["length"].values.tolist() == [0.08]
-    assert ds.attrs["workers"] == "1"
+    assert ds.attrs["workers"] == 1  # typed (issue 24)
 
 
 def test_default_output_under_sweeps(tmp_path, monkeypatch):

@@ -8,13 +8,84 @@ from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
 
-__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "evaluate_settings", "provenance", "runnable_config"]
+__all__ = ["CUBE_FORMAT", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "evaluate_settings", "is_complete",
+           "provenance", "run_attrs", "runnable_config", "typed_info"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
 CUBE_FORMAT = "1"
 #: Attributes that differ between two runs of the same config (timing, host, when).
 VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "workers",
-                  "resumed_slabs", "python_version", "hostname")
+                  "resumed_slabs", "python_version", "hostname", "history")
+#: Set this environment variable (to anything but "" or "0") to record the host's name in
+#: a cube (``hostname``); by default a cube says nothing about the machine it came from.
+RECORD_HOST_ENV = "NYLONFLEX_RECORD_HOST"
+
+
+def is_complete(attrs) -> bool:
+    """Whether a cube's attributes mark it complete: ``complete`` 1 (an int8, as written
+    since issue 24), or the string ``"true"`` of earlier cubes."""
+    value = attrs.get("complete") if attrs is not None else None
+    if isinstance(value, (bytes, str)):
+        return (value.decode() if isinstance(value, bytes) else value) == "true"
+    try:
+        return int(np.asarray(value).reshape(-1)[0]) == 1
+    except (TypeError, ValueError, IndexError):
+        return False
+
+
+def typed_info(info: dict) -> dict:
+    """An executor's ``scheduler`` and ``workers`` with ``workers`` an integer."""
+    out = dict(info)
+    try:
+        out["workers"] = np.int64(int(out["workers"]))
+    except (KeyError, TypeError, ValueError):
+        pass
+    return out
+
+
+def run_attrs(info: dict, *, complete: bool, seconds: float, computed: int,
+              resumed: int) -> dict:
+    """The global attributes a finished (or stopped) run adds, typed: ``complete`` int8
+    1/0, ``run_seconds`` [s] and ``designs_per_second`` [1/s] as float64, counts as ints,
+    ``created`` and ``history`` (CF's audit line); the host name only when
+    :data:`RECORD_HOST_ENV` asks for it.
+
+    Parameters
+    ----------
+    info : dict
+        The executor's ``scheduler`` and ``workers``.
+    complete : bool
+        Every slab is in the cube.
+    seconds : float
+        The slab loop's wall time [s].
+    computed : int
+        Designs computed by this run (not restored from the journal) [-].
+    resumed : int
+        Slabs restored from the journal [-].
+    """
+    import datetime as dt
+    import os
+    import platform
+
+    from .. import __version__
+
+    created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+    out = typed_info(info)
+    out.update({
+        "complete": np.int8(1 if complete else 0),
+        "created": created,
+        "history": f"{created} nylonflex {__version__}: nylonflex sweep"
+                   f"{'' if complete else ' (stopped; resume with --resume)'}"
+                   f"{f' ({resumed} slabs resumed)' if resumed else ''}",
+        "run_seconds": np.float64(round(seconds, 3)),
+        "designs_per_second": np.float64(round(computed / seconds) if seconds > 0
+                                         else np.nan),
+        "resumed_slabs": np.int64(resumed),
+        "python_version": platform.python_version(),
+    })
+    if os.environ.get(RECORD_HOST_ENV, "") not in ("", "0"):
+        out["hostname"] = platform.node()
+    return out
 
 
 def provenance(cfg: ResolvedConfig) -> dict:
@@ -37,7 +108,8 @@ def provenance(cfg: ResolvedConfig) -> dict:
     return {
         "nylonflex_cube": CUBE_FORMAT,
         "title": f"nylonflex design cube '{cfg.name}'",
-        "Conventions": "CF-1.10",
+        # CF 1.8 is what the cube follows (nothing of 1.9-1.11 is used)
+        "Conventions": "CF-1.8",
         "name": cfg.name,
         "config_yaml": cfg.text,
         "config_sha256": cfg.sha256,
@@ -61,7 +133,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
                  "nylon artificial muscles' and Polygerinos et al. 2015",
         "models": " ".join(cfg.models),
         "supply_voltage": "none" if cfg.supply_voltage is None else f"{cfg.supply_voltage:g} V",
-        "complete": "false",
+        "complete": np.int8(0),
         **_sampling(cfg),
     }
 
@@ -141,8 +213,8 @@ def _sampling(cfg: ResolvedConfig) -> dict:
     if cfg.uncertainty is not None:
         spec = cfg.uncertainty
         out["uncertainty"] = yaml.safe_dump(spec.to_dict(), sort_keys=False, width=100)
-        out["uncertainty_samples"] = str(spec.samples)
-        out["uncertainty_seed"] = str(spec.seed)
+        out["uncertainty_samples"] = np.int64(spec.samples)
+        out["uncertainty_seed"] = np.int64(spec.seed)
         out["uncertainty_method"] = ("scrambled Sobol' points (scipy.stats.qmc.Sobol), "
                                      "normal or uniform quantile functions; a fit's "
                                      "covariance by its Cholesky factor")

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine.provenance import is_complete
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
 from .cube import require_filters
@@ -67,7 +68,7 @@ def open_cube(path, *, quiet: bool = False):
     ds = xr.open_dataset(path, engine="h5netcdf")
     for var in ds.variables.values():
         var.encoding = portable_encoding(var.encoding)
-    if attrs.get("complete") != "true":
+    if not is_complete(attrs):
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
@@ -237,7 +238,7 @@ def cube_summary(path) -> list[str]:
         ds = open_cube(path, quiet=True)
     a = ds.attrs
     out = []
-    complete = a.get("complete") == "true"
+    complete = is_complete(a)
     done = int(ds["slab_done"].sum())
     out.append(f"cube      {path}")
     # a spot check: the first chunk of each variable read ('info --check' reads all)
