@@ -250,6 +250,18 @@ SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
 VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN}
 
 
+def is_complete(attrs) -> bool:
+    """Whether a cube's attributes mark it complete: ``complete`` 1 (an int8, as written
+    since issue 24), or the string ``"true"`` of earlier cubes."""
+    value = attrs.get("complete") if attrs is not None else None
+    if isinstance(value, (bytes, str)):
+        return (value.decode() if isinstance(value, bytes) else value) == "true"
+    try:
+        return int(np.asarray(value).reshape(-1)[0]) == 1
+    except (TypeError, ValueError, IndexError):
+        return False
+
+
 def slab_done_attrs() -> dict:
     """Attributes of the ``slab_done`` mask, in-memory and on-disk cubes alike."""
     return SLAB_DONE.attrs()

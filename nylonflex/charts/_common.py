@@ -176,7 +176,7 @@ def _footer(fig, ds):
     version = ds.attrs.get("nylonflex_version", "?")
     note = f"cube '{name}' (nylonflex {version}, {ds.attrs.get('silicone', '?')} / " \
            f"{ds.attrs.get('nylon', '?')})"
-    from ..engine.provenance import is_complete
+    from ..variables import is_complete
 
     if not is_complete(ds.attrs):
         note += " - INCOMPLETE cube: missing radii are blank"

@@ -7,6 +7,7 @@ import numpy as np
 from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
+from ..variables import is_complete  # noqa: F401 - re-exported
 
 __all__ = ["CUBE_FORMAT", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "evaluate_settings", "is_complete",
            "provenance", "run_attrs", "runnable_config", "typed_info"]
@@ -19,18 +20,6 @@ VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "
 #: Set this environment variable (to anything but "" or "0") to record the host's name in
 #: a cube (``hostname``); by default a cube says nothing about the machine it came from.
 RECORD_HOST_ENV = "NYLONFLEX_RECORD_HOST"
-
-
-def is_complete(attrs) -> bool:
-    """Whether a cube's attributes mark it complete: ``complete`` 1 (an int8, as written
-    since issue 24), or the string ``"true"`` of earlier cubes."""
-    value = attrs.get("complete") if attrs is not None else None
-    if isinstance(value, (bytes, str)):
-        return (value.decode() if isinstance(value, bytes) else value) == "true"
-    try:
-        return int(np.asarray(value).reshape(-1)[0]) == 1
-    except (TypeError, ValueError, IndexError):
-        return False
 
 
 def typed_info(info: dict) -> dict:
