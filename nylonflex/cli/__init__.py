@@ -31,6 +31,7 @@ COMMANDS = {
     "validate": "validate",
     "init": "init",
     "list": "listing",
+    "schema": "schema",
     "sensitivity": "sensitivity",
     "explore": "explore",
 }
