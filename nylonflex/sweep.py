@@ -60,6 +60,8 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     if out is None:
         from .engine.slabs import deferred_signals
 
+        from .storage.accessor import CubeAccessor  # noqa: F401 - registers ds.nf
+
         with deferred_signals(on_second=_interrupt):
             _warm_up(cfg, workers, scheduler, log)
             return _in_memory(cfg, workers, scheduler, progress)
@@ -148,7 +150,12 @@ def _in_memory(cfg, workers, scheduler, progress):
         executor.close()
     if stats.stopped:
         raise KeyboardInterrupt
-    return sink.dataset({**provenance(cfg), **executor.info(), "complete": "true"})
+    import numpy as np
+
+    from .engine.provenance import typed_info
+
+    return sink.dataset({**provenance(cfg), **typed_info(executor.info()),
+                         "complete": np.int8(1)})
 
 
 def _resident_bytes() -> int:

@@ -71,8 +71,38 @@ def unit_kind(unit: str) -> str:
     return UNITS[unit][0]
 
 
+def _fraction(x: float):
+    """The decimal a float was typed as (its shortest repr), exactly."""
+    from fractions import Fraction
+
+    return Fraction(repr(float(x)))
+
+
+def decimal_to_si(value, unit: str) -> float:
+    """The SI float of a decimal ``value`` (a :class:`fractions.Fraction` or a float read
+    as the decimal it prints as) in ``unit``: the float nearest the exact SI value where
+    the unit's factor is a decimal (mm, kPa, degC, ...: ``10.5 mm`` is exactly the float
+    ``0.0105``, as typed), else ``value * factor`` (deg: ``math.radians``'s product).
+    """
+    from fractions import Fraction
+
+    _, factor, offset = UNITS[_canonical(unit)]
+    exact = value if isinstance(value, Fraction) else _fraction(value)
+    if factor in _IRRATIONAL:
+        return float(exact) * factor + offset
+    return float(exact * _fraction(factor) + _fraction(offset))
+
+
+#: Factors that are not decimals (a float times them is the best one can do).
+_IRRATIONAL = frozenset((math.pi / 180.0,))
+
+
 def to_si(value, unit: str, field: str = "value", kind: str | None = None):
     """Convert ``value`` (number or array) given in ``unit`` to SI.
+
+    A finite scalar converts exactly (:func:`decimal_to_si`: ``10.3 mm`` is the float
+    nearest 0.0103 m, where ``10.3 * 1e-3`` is an ulp off); arrays by ``value * factor +
+    offset``.
 
     Raises
     ------
@@ -87,6 +117,9 @@ def to_si(value, unit: str, field: str = "value", kind: str | None = None):
     if kind is not None and k != kind:
         raise InputError(f"{field}: unit {unit!r} is not a {kind}; accepted: "
                          f"{', '.join(_units_of(kind))}")
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and \
+            math.isfinite(value) and (factor != 1.0 or offset != 0.0):
+        return decimal_to_si(value, u)
     return value * factor + offset
 
 
@@ -136,6 +169,25 @@ def short(value, limit: int = 60) -> str:
     r.maxstring = r.maxother = r.maxlong = limit
     text = r.repr(value)
     return text if len(text) <= limit + 5 else text[:limit] + "..."
+
+
+def parse_decimal(text, field: str, kind: str, default_unit: str):
+    """``(decimal, unit)`` of ``"7.5mm"``, ``"8 deg"`` or a bare number (in
+    ``default_unit``): the number exactly as typed (:class:`fractions.Fraction`) and its
+    canonical unit, for grids whose points are decimals in that unit.
+
+    Raises
+    ------
+    InputError
+        As :func:`parse_quantity`.
+    """
+    from fractions import Fraction
+
+    parse_quantity(text, field, kind, default_unit)  # the same checks and messages
+    if isinstance(text, (int, float)):
+        return _fraction(text), _canonical(default_unit)
+    number, unit = _NUMBER.match(text).groups()
+    return Fraction(number), _canonical(unit or default_unit)
 
 
 def parse_quantity(text, field: str, kind: str, default_unit: str):

@@ -77,6 +77,8 @@ class Variable:
         """The attributes written to the cube (CF flags for flag variables)."""
         out = {"units": self.units, "long_name": self.long_name,
                "description": self.description}
+        if self.name in STANDARD_NAMES:
+            out["standard_name"] = STANDARD_NAMES[self.name]
         if self.name in _FLAGS:
             values, meanings = _FLAGS[self.name]
             out["flag_values"] = np.array(values, dtype=np.int8)
@@ -104,6 +106,12 @@ _MASKS = {"validity": ((1, 2, 4, 8),
 
 #: Variables that are in a cube only when its config gives a supply.
 SUPPLY_ONLY = ("heating_time",)
+
+#: CF standard names (CF standard name table) where CF has one for a cube variable: the
+#: two flag variables say the status and the quality of each design's values. The design
+#: quantities themselves (radius, tip force, bend angle, ...) have no CF name: CF names
+#: geophysical quantities.
+STANDARD_NAMES = {"limit": "status_flag", "validity": "quality_flag"}
 
 
 def _v(name, dims, units, long_name, description, display, kind, dtype="float64", **rng):
@@ -241,6 +249,18 @@ SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
                "1 where this radius's slab is in the cube", "1", "dimensionless", "int8")
 
 VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN}
+
+
+def is_complete(attrs) -> bool:
+    """Whether a cube's attributes mark it complete: ``complete`` 1 (an int8, as written
+    since issue 24), or the string ``"true"`` of earlier cubes."""
+    value = attrs.get("complete") if attrs is not None else None
+    if isinstance(value, (bytes, str)):
+        return (value.decode() if isinstance(value, bytes) else value) == "true"
+    try:
+        return int(np.asarray(value).reshape(-1)[0]) == 1
+    except (TypeError, ValueError, IndexError):
+        return False
 
 
 def slab_done_attrs() -> dict:

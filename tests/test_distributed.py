@@ -64,7 +64,7 @@ def local_cube(config_path, tmp_path_factory):
 
 def _assert_same_cube(path, reference):
     with nf.open_cube(path) as got, nf.open_cube(reference) as want:
-        assert got.attrs["complete"] == "true"
+        assert got.attrs["complete"] == 1
         assert set(got.variables) == set(want.variables)
         for name in want.variables:
             a, b = got[name].values, want[name].values
@@ -91,7 +91,7 @@ def test_cluster_cube_identical_to_local(cluster, config_path, local_cube, tmp_p
     _assert_same_cube(out, local_cube)
     with nf.open_cube(out) as ds:
         assert ds.attrs["scheduler"] == cluster.scheduler_address
-        assert ds.attrs["workers"] == "2"
+        assert ds.attrs["workers"] == 2  # typed (issue 24)
     # one level of parallelism: the workers never started Numba's thread pool
     with distributed.Client(cluster, set_as_default=False) as client:
         assert not any(client.run(_numba_threads_started).values())

@@ -48,7 +48,7 @@ def test_round_trip_file_equals_memory(tmp_path):
     cfg = parse_config(SMALL)
     mem = run_sweep(cfg)
     disk = run_sweep(cfg, tmp_path / "cube.h5")
-    assert disk.attrs["complete"] == "true"
+    assert disk.attrs["complete"] == 1  # int8 (issue 24)
     xr.testing.assert_equal(mem, disk.load())
     for name in disk.variables:
         assert disk[name].attrs["units"] and disk[name].attrs["long_name"], name
@@ -58,8 +58,9 @@ def test_round_trip_file_equals_memory(tmp_path):
 
 def test_cube_is_readable_by_h5py_and_netcdf4_with_units_and_provenance(tmp_path):
     netCDF4 = pytest.importorskip("netCDF4")
-    assert parse_config(SMALL).compression == "zstd"  # the default (issue 17)
-    cfg = parse_config({**SMALL, "compression": "gzip"})  # for readers without the plugin
+    # the default codec (issue 24): deflate with the shuffle filter, no plugin needed
+    assert parse_config(SMALL).compression == "gzip"
+    cfg = parse_config(SMALL)
     path = tmp_path / "cube.h5"
     run_sweep(cfg, path).close()
     with netCDF4.Dataset(path) as nc:
@@ -126,7 +127,7 @@ def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
         # a stopped run leaves an incomplete cube that can be read where it is done
         with pytest.warns(UserWarning, match="incomplete"):
             part = open_cube(out)
-        assert part.attrs["complete"] == "false"
+        assert part.attrs["complete"] == 0
         assert 0 < int(part["slab_done"].sum()) < 160
         part.close()
     # without --resume the journal is protected
@@ -134,7 +135,7 @@ def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
     assert main(["sweep", str(cfg_path), "--out", str(out), "--quiet", "--resume",
                  "--no-charts"]) == 0
     resumed = open_cube(out)
-    assert resumed.attrs["resumed_slabs"] == str(done)
+    assert resumed.attrs["resumed_slabs"] == done  # typed (issue 24)
     whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")
     xr.testing.assert_identical(stable(resumed), stable(whole))
     assert not Journal(out).dir.exists()
@@ -232,7 +233,7 @@ def test_set_overrides_a_config_key(tmp_path):
                  "--workers", "1"]) == 0
     ds = open_cube(out)
     assert ds.sizes["radius"] == 3 and ds["length"].values.tolist() == [0.08]
-    assert ds.attrs["workers"] == "1"
+    assert ds.attrs["workers"] == 1  # typed (issue 24)
 
 
 def test_default_output_under_sweeps(tmp_path, monkeypatch):
@@ -307,3 +308,44 @@ def test_version_and_help(capsys):
         main(["--version"])
     assert exc.value.code == 0 and "nylonflex 0." in capsys.readouterr().out
     assert main([]) == 0 and "sweep" in capsys.readouterr().out
+
+
+# ------------------------------------------------- coordinates at their decimals (issue 24)
+def test_grid_points_are_the_floats_nearest_their_decimal_values():
+    # {start: 5, stop: 25, num: 41, units: mm}: point i is the decimal 5 + 0.5 i mm, and its
+    # SI float is the one Python reads from that decimal in metres (float('0.0105')), not
+    # np.linspace's 0.010499999999999999; a values axis likewise (1.3 mm * 1e-3 is an ulp
+    # off 0.0013); degrees are math.radians' product, as np.radians gives
+    from fractions import Fraction
+
+    raw = {**SMALL, "grid": {**SMALL["grid"],
+                             "radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"},
+                             "wall_thickness": {"values": [1.3, 2.1, 4.2], "units": "mm"},
+                             "wrap_angle": {"start": 2, "stop": 30, "num": 15,
+                                            "units": "deg"}},
+           "curves": {**SMALL["curves"], "stroke": {"start": 0, "stop": 0.1, "num": 51}}}
+    cfg = parse_config(raw)
+    assert cfg.axes["radius"].tolist() == [float((5 + Fraction(1, 2) * i) / 1000)
+                                           for i in range(41)]
+    assert 0.0105 in cfg.axes["radius"].tolist()  # np.linspace: 0.010499999999999999
+    assert cfg.axes["wall_thickness"].tolist() == [0.0013, 0.0021, 0.0042]
+    assert cfg.axes["wrap_angle"].tolist() == np.radians(np.arange(2, 31, 2)).tolist()
+    assert cfg.curves["stroke"].tolist() == [float(Fraction(i, 500)) for i in range(51)]
+
+
+def test_sel_finds_grid_points_typed_in_si_or_with_units():
+    ds = run_sweep(parse_config({**SMALL, "grid": {
+        **SMALL["grid"], "radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"}}}))
+    for mm in np.arange(5, 25.01, 0.5):  # every grid point by its decimal, no 'nearest'
+        ds.sel(radius=float(f"{mm / 1000:.4g}"))
+    one = ds.nf.sel(radius="10.5 mm", wall_thickness=3, wrap_angle="20deg")
+    assert float(one["radius"]) == 0.0105 and float(one["wall_thickness"]) == 0.003
+    # the display-unit copy for plots: values and units attrs converted, SI cube untouched
+    shown = one["torque_max"].nf.display()
+    assert shown.attrs["units"] == VARIABLES["torque_max"].display == "N mm"
+    np.testing.assert_allclose(shown.values, one["torque_max"].values * 1e3, rtol=1e-15)
+    assert shown["length"].attrs["units"] == "mm" and ds["radius"].attrs["units"] == "m"
+    from nylonflex.units import InputError
+
+    with pytest.raises(InputError, match="stroke_max: not an axis"):
+        ds.nf.sel(stroke_max=1)

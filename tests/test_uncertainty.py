@@ -160,7 +160,7 @@ def test_cube_file_holds_quantiles_feasibility_and_provenance(sampled_cube):
     assert ds["feasibility"].attrs["units"] == "1"
     assert ds["tip_force_max_quantile"].attrs["units"] == "N"
     assert "tip force" in ds["tip_force_max_quantile"].attrs["long_name"]
-    assert ds.attrs["uncertainty_samples"] == "64" and ds.attrs["uncertainty_seed"] == "3"
+    assert ds.attrs["uncertainty_samples"] == 64 and ds.attrs["uncertainty_seed"] == 3
     assert "silicone.mu" in ds.attrs["uncertainty"] and "rel_sd: 0.1" in ds.attrs["uncertainty"]
     assert ds.attrs["requirements"] == "tip_force_max >= 0.3 N; range_fraction >= 1"
     q = ds["tip_force_max_quantile"].values
@@ -334,7 +334,7 @@ def test_sampled_sweep_on_dask_and_resumed_equals_local(tmp_path):
     assert kill_after_slabs(argv, 1, signal.SIGTERM) != 0  # stopped after its first slab
     assert main([*argv, "--resume"]) == 0
     resumed = nf.open_cube(out)
-    assert resumed.attrs["resumed_slabs"] != "0"
+    assert resumed.attrs["resumed_slabs"] != 0
     for which, ds in (("dask", got), ("resumed", resumed)):
         for name in ("tip_force_max_quantile", "feasibility", "tip_force_max"):
             np.testing.assert_allclose(ds[name].values, want[name].values, rtol=1e-12,

@@ -71,31 +71,45 @@ def test_warm_up_reports_and_notices_only_when_slow():
 
 
 # ---------------------------------------------------------------------------- init, list
-EXAMPLE_NAMES = ("fig12", "control", "step", "gripper")
-
-
 def test_init_writes_the_examples_and_never_overwrites(tmp_path, capsys):
     from pathlib import Path
 
     from nylonflex.config import load_config
+    from nylonflex.design import load_spec
+    from nylonflex.examples import EXAMPLES
     from nylonflex.simconfig import load_sim_config
 
     rc, out, _ = run(capsys, "init", tmp_path / "mine")
-    assert rc == 0 and len(out.strip().splitlines()) == 4
-    repo = Path(__file__).resolve().parents[1] / "configs"
-    for name in EXAMPLE_NAMES:  # the packaged files are the repository's configs
-        written = (tmp_path / "mine" / f"{name}.yaml").read_text()
-        assert written == (repo / f"{name}.yaml").read_text(), name
-    assert load_config(tmp_path / "mine" / "fig12.yaml").n_designs == 41 * 6 * 3 * 4 * 4
+    repo = Path(__file__).resolve().parents[1]
+    # every config of the repository's configs/ (the README's examples), the fitted
+    # material they read and the fit's bench data
+    assert sorted(EXAMPLES) == sorted(p.stem for p in (repo / "configs").glob("*.yaml"))
+    assert rc == 0 and len(out.strip().splitlines()) == len(EXAMPLES) + 3
+    mine = tmp_path / "mine"
+    for name in EXAMPLES:  # the packaged files are the repository's configs
+        written = (mine / "configs" / f"{name}.yaml").read_text()
+        assert written == (repo / "configs" / f"{name}.yaml").read_text(), name
+    fit = "fits/ecoflex_0050_ogden2.yaml"
+    assert (mine / "configs" / fit).read_text() == (repo / "configs" / fit).read_text()
+    assert (mine / "data" / "ecoflex_0050.csv").read_bytes() == \
+        (repo / "tests" / "data" / "ecoflex_0050.csv").read_bytes()
+    assert "ODbL" in (mine / "data" / "README.md").read_text()
+    assert load_config(mine / "configs" / "fig12.yaml").n_designs == 41 * 6 * 3 * 4 * 4
+    assert load_config(mine / "configs" / "fig12_fitted.yaml").silicone.mu[0] > 0
+    load_config(mine / "configs" / "fig12_uncertain.yaml")
     for name in ("control", "step", "gripper"):
-        load_sim_config(tmp_path / "mine" / f"{name}.yaml")
-    edited = tmp_path / "mine" / "step.yaml"
+        load_sim_config(mine / "configs" / f"{name}.yaml")
+    for name in ("design_force", "design_front"):
+        load_spec(mine / "configs" / f"{name}.yaml")
+    edited = mine / "configs" / "step.yaml"
     edited.write_text("# mine\n")
-    rc, _, err = run(capsys, "init", tmp_path / "mine")
+    rc, _, err = run(capsys, "init", mine)
     assert rc == 2 and "already exist" in err and "nothing written" in err
     assert edited.read_text() == "# mine\n"
-    rc, _, _ = run(capsys, "init", tmp_path / "other", "--example", "fig12")
-    assert rc == 0 and [p.name for p in (tmp_path / "other").iterdir()] == ["fig12.yaml"]
+    rc, _, _ = run(capsys, "init", tmp_path / "other", "--example", "fig12_fitted")
+    assert rc == 0 and sorted(str(p.relative_to(tmp_path / "other"))
+                              for p in (tmp_path / "other").rglob("*.yaml")) == \
+        ["configs/fig12_fitted.yaml", "configs/fits/ecoflex_0050_ogden2.yaml"]
 
 
 def test_list_materials_charts_variables(capsys):
@@ -282,3 +296,31 @@ def test_the_console_script_waits_for_a_thread_left_running(tmp_path):
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                        cwd=tmp_path)
     assert r.returncode == 0 and "thread done" in r.stdout, r
+
+
+# ------------------------------------------------------------------- schema (issue 24)
+SCHEMA_EXAMPLES = {"sweep": ("fig12", "fig12_uncertain", "fig12_fitted", "big20m"),
+                   "simulate": ("control", "step", "gripper"),
+                   "design": ("design_force", "design_front")}
+
+
+@pytest.mark.parametrize("kind", list(SCHEMA_EXAMPLES))
+def test_schema_prints_json_schema_every_example_meets(capsys, kind):
+    # the JSON Schema an editor's YAML language server reads: every example config of
+    # that kind validates, and an unknown key (which nylonflex refuses) is flagged too
+    import json
+    from pathlib import Path
+
+    import yaml
+
+    jsonschema = pytest.importorskip("jsonschema")
+    rc, out, _ = run(capsys, "schema", kind)
+    schema = json.loads(out)
+    assert rc == 0 and schema["$schema"].endswith("2020-12/schema")
+    jsonschema.Draft202012Validator.check_schema(schema)
+    validator = jsonschema.Draft202012Validator(schema)
+    configs = Path(__file__).resolve().parents[1] / "configs"
+    for name in SCHEMA_EXAMPLES[kind]:
+        doc = yaml.safe_load((configs / f"{name}.yaml").read_text())
+        assert not list(validator.iter_errors(doc)), name
+        assert list(validator.iter_errors({**doc, "colour": "red"})), name

@@ -176,7 +176,9 @@ def _footer(fig, ds):
     version = ds.attrs.get("nylonflex_version", "?")
     note = f"cube '{name}' (nylonflex {version}, {ds.attrs.get('silicone', '?')} / " \
            f"{ds.attrs.get('nylon', '?')})"
-    if ds.attrs.get("complete") != "true":
+    from ..variables import is_complete
+
+    if not is_complete(ds.attrs):
         note += " - INCOMPLETE cube: missing radii are blank"
     # above the canvas (savefig's tight bounding box takes it in): clear of titles,
     # axes and legends whatever the layout

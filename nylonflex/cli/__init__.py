@@ -32,6 +32,7 @@ COMMANDS = {
     "validate": "validate",
     "init": "init",
     "list": "listing",
+    "schema": "schema",
     "sensitivity": "sensitivity",
     "explore": "explore",
     "fe": "fe",

@@ -12,10 +12,25 @@ def add_arguments(i):
     i.add_argument("--check", action="store_true",
                    help="read every chunk of every variable (bounded memory) and list the "
                         "unreadable ones; exit 1 if any")
+    i.add_argument("--config", action="store_true",
+                   help="print the cube's config as a runnable YAML (nylonflex info CUBE "
+                        "--config > c.yaml && nylonflex sweep c.yaml recomputes it)")
 
 
 def run(args) -> int:
     from ..storage import check_cube, cube_summary
+
+    if args.config:
+        from ..engine.provenance import runnable_config
+        from ..storage import cube_attrs
+        from ..units import InputError
+
+        attrs = cube_attrs(args.cube)
+        if attrs is None:
+            raise InputError(f"{args.cube}: not a nylonflex cube (expected a NetCDF4/HDF5 "
+                             "file written by 'nylonflex sweep')")
+        print(runnable_config(attrs), end="")
+        return 0
 
     lines = cube_summary(args.cube)
     for line in lines:

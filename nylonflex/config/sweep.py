@@ -26,7 +26,7 @@ from pydantic import BeforeValidator, ValidationError, field_validator, model_va
 from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..requirements import parse_requirements
 from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
-from ..units import InputError, short, to_si
+from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import INPUTS, VARIABLES
 from .base import (
     Count,
@@ -128,7 +128,7 @@ class SweepConfig(_Strict):
     charts: list[Literal[CHARTS]] = []  # type: ignore[valid-type]
     slab_megabytes: Annotated[float, BeforeValidator(_no_bool)] = 16.0
     limits: Limits = Limits()
-    compression: Literal["gzip", "zstd", "lz4", "none"] = "zstd"
+    compression: Literal["gzip", "zstd", "lz4", "none"] = "gzip"
     uncertainty: Uncertainty | None = None
     requirements: list[str] = []
     model: Union[str, list[str]] = "paper"
@@ -154,7 +154,7 @@ class ResolvedConfig:
     charts: tuple[str, ...]
     slab_megabytes: float
     raw: dict = field(compare=False, repr=False)
-    compression: str = "zstd"  # the cube's codec: not part of the design space or its hash
+    compression: str = "gzip"  # the cube's codec: not part of the design space or its hash
     uncertainty: "UncertaintySpec | None" = None
     requirements: tuple[str, ...] = ()
     models: tuple[str, ...] = ("paper",)
@@ -223,9 +223,31 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
         if not 1 <= axis.num <= _MAX_POINTS:
             raise range_error(f"{path}.num", 1, _MAX_POINTS, "1", axis.num)
         start, stop = value(axis.start, f"{path}.start"), value(axis.stop, f"{path}.stop")
-        vals = np.linspace(start, stop, axis.num) if axis.num > 1 else np.array([start])
+        vals = _decimal_linspace(axis, units, kind, path, start, stop)
     if len(vals) > 1 and np.any(np.diff(vals) <= 0):
         raise InputError(f"{path}: values must be strictly increasing")
+    return vals
+
+
+def _decimal_linspace(axis: Axis, units: str, kind: str, path: str, start: float,
+                      stop: float) -> np.ndarray:
+    """The points of a ``start``/``stop``/``num`` axis, SI: each the float nearest its
+    decimal value (``{start: 5, stop: 25, num: 41, units: mm}`` gives exactly the floats
+    0.005, 0.0055, ..., 0.0105, ..., as typed; ``np.linspace`` in SI gave
+    0.010499999999999999), so ``ds.sel(radius=10.5e-3)`` finds the grid point.
+
+    ``start`` and ``stop`` [SI] are the checked (and clamped) ends; a start and stop typed
+    in different units fall back to ``np.linspace`` between them.
+    """
+    if axis.num == 1:
+        return np.array([start])
+    (a, ua), (b, ub) = (parse_decimal(x, f"{path}.{k}", kind, units)
+                        for k, x in (("start", axis.start), ("stop", axis.stop)))
+    if ua != ub:
+        return np.linspace(start, stop, axis.num)
+    step = (b - a) / (axis.num - 1)
+    vals = np.array([decimal_to_si(a + step * i, ua) for i in range(axis.num)])
+    vals[0], vals[-1] = start, stop
     return vals
 
 

@@ -7,14 +7,74 @@ import numpy as np
 from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
+from ..variables import is_complete  # noqa: F401 - re-exported
 
-__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "evaluate_settings", "provenance"]
+__all__ = ["CUBE_FORMAT", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "evaluate_settings", "is_complete",
+           "provenance", "run_attrs", "runnable_config", "typed_info"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
 CUBE_FORMAT = "1"
 #: Attributes that differ between two runs of the same config (timing, host, when).
 VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "workers",
-                  "resumed_slabs", "python_version", "hostname")
+                  "resumed_slabs", "python_version", "hostname", "history")
+#: Set this environment variable (to anything but "" or "0") to record the host's name in
+#: a cube (``hostname``); by default a cube says nothing about the machine it came from.
+RECORD_HOST_ENV = "NYLONFLEX_RECORD_HOST"
+
+
+def typed_info(info: dict) -> dict:
+    """An executor's ``scheduler`` and ``workers`` with ``workers`` an integer."""
+    out = dict(info)
+    try:
+        out["workers"] = np.int64(int(out["workers"]))
+    except (KeyError, TypeError, ValueError):
+        pass
+    return out
+
+
+def run_attrs(info: dict, *, complete: bool, seconds: float, computed: int,
+              resumed: int) -> dict:
+    """The global attributes a finished (or stopped) run adds, typed: ``complete`` int8
+    1/0, ``run_seconds`` [s] and ``designs_per_second`` [1/s] as float64, counts as ints,
+    ``created`` and ``history`` (CF's audit line); the host name only when
+    :data:`RECORD_HOST_ENV` asks for it.
+
+    Parameters
+    ----------
+    info : dict
+        The executor's ``scheduler`` and ``workers``.
+    complete : bool
+        Every slab is in the cube.
+    seconds : float
+        The slab loop's wall time [s].
+    computed : int
+        Designs computed by this run (not restored from the journal) [-].
+    resumed : int
+        Slabs restored from the journal [-].
+    """
+    import datetime as dt
+    import os
+    import platform
+
+    from .. import __version__
+
+    created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+    out = typed_info(info)
+    out.update({
+        "complete": np.int8(1 if complete else 0),
+        "created": created,
+        "history": f"{created} nylonflex {__version__}: nylonflex sweep"
+                   f"{'' if complete else ' (stopped; resume with --resume)'}"
+                   f"{f' ({resumed} slabs resumed)' if resumed else ''}",
+        "run_seconds": np.float64(round(seconds, 3)),
+        "designs_per_second": np.float64(round(computed / seconds) if seconds > 0
+                                         else np.nan),
+        "resumed_slabs": np.int64(resumed),
+        "python_version": platform.python_version(),
+    })
+    if os.environ.get(RECORD_HOST_ENV, "") not in ("", "0"):
+        out["hostname"] = platform.node()
+    return out
 
 
 def provenance(cfg: ResolvedConfig) -> dict:
@@ -37,7 +97,8 @@ def provenance(cfg: ResolvedConfig) -> dict:
     return {
         "nylonflex_cube": CUBE_FORMAT,
         "title": f"nylonflex design cube '{cfg.name}'",
-        "Conventions": "CF-1.10",
+        # CF 1.8 is what the cube follows (nothing of 1.9-1.11 is used)
+        "Conventions": "CF-1.8",
         "name": cfg.name,
         "config_yaml": cfg.text,
         "config_sha256": cfg.sha256,
@@ -61,7 +122,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
                  "nylon artificial muscles' and Polygerinos et al. 2015",
         "models": " ".join(cfg.models),
         "supply_voltage": "none" if cfg.supply_voltage is None else f"{cfg.supply_voltage:g} V",
-        "complete": "false",
+        "complete": np.int8(0),
         **_sampling(cfg),
     }
 
@@ -141,11 +202,187 @@ def _sampling(cfg: ResolvedConfig) -> dict:
     if cfg.uncertainty is not None:
         spec = cfg.uncertainty
         out["uncertainty"] = yaml.safe_dump(spec.to_dict(), sort_keys=False, width=100)
-        out["uncertainty_samples"] = str(spec.samples)
-        out["uncertainty_seed"] = str(spec.seed)
+        out["uncertainty_samples"] = np.int64(spec.samples)
+        out["uncertainty_seed"] = np.int64(spec.seed)
         out["uncertainty_method"] = ("scrambled Sobol' points (scipy.stats.qmc.Sobol), "
                                      "normal or uniform quantile functions; a fit's "
                                      "covariance by its Cholesky factor")
     if cfg.requirements:
         out["requirements"] = "; ".join(cfg.requirements)
     return out
+
+
+def runnable_config(attrs) -> str:
+    """A sweep config (YAML text) that recomputes a cube: ``nylonflex info CUBE --config``.
+
+    Built from the cube's resolved config (``config_yaml``, SI) and material attributes:
+    each grid axis as ``start/stop/num`` or ``values`` in its display unit (mm, deg, kPa)
+    where those decimals resolve to exactly the cube's coordinates, else as SI values;
+    materials by set name (with the fields that differ), or by their fitted file where it
+    is still there and unchanged, else every field; the model, supply, uncertainty and
+    requirements as the cube has them, and its codec. Sweeping it gives a cube whose
+    data equal this one's bit for bit (the slab size aside, which does not change them).
+
+    Parameters
+    ----------
+    attrs : mapping
+        Global attributes of a cube (``ds.attrs`` or :func:`nylonflex.storage.cube_attrs`).
+
+    Returns
+    -------
+    str
+        The config, YAML, with a comment naming the cube's config hash.
+
+    Raises
+    ------
+    ValueError
+        The attributes hold no readable ``config_yaml`` (not a nylonflex cube).
+    """
+    import yaml
+
+    from ..config import parse_config
+
+    doc = yaml.safe_load(attrs.get("config_yaml") or "null") if attrs else None
+    if not isinstance(doc, dict) or "grid" not in doc:
+        raise ValueError("cube: no readable config_yaml attribute; cannot rebuild its "
+                         "config (was it written by 'nylonflex sweep'?)")
+    out = {"name": doc["name"],
+           "silicone": _material_spec("silicone", doc["silicone"],
+                                      attrs.get("silicone_parameters")),
+           "nylon": _material_spec("nylon", doc["nylon"], attrs.get("nylon_parameters"))}
+    from ..variables import AXES
+
+    out["grid"] = {k: _axis_spec(k, doc["grid"][k]) for k in AXES}
+    base = doc.get("base_thickness", "wall")
+    out["base_thickness"] = "wall" if base in (None, "wall") else \
+        {"value": float(base), "units": "m"}
+    out["curves"] = {k: _axis_spec(k, doc["curves"][k]) for k in ("stroke", "pressure")}
+    if "model" in doc:
+        out["model"] = list(doc["model"]) if len(doc["model"]) > 1 else doc["model"][0]
+    if doc.get("supply_voltage") is not None:
+        out["supply"] = {"voltage": float(doc["supply_voltage"]), "units": "V"}
+    if "uncertainty" in doc:
+        out["uncertainty"] = _uncertainty_spec(doc["uncertainty"])
+    if doc.get("requirements"):
+        out["requirements"] = list(doc["requirements"])
+    if attrs.get("compression"):
+        out["compression"] = str(attrs["compression"])
+    out["charts"] = []
+    # any axis whose display decimals do not resolve to the very same floats: SI values
+    cfg = parse_config(out)
+    for group, axes in (("grid", cfg.axes), ("curves", cfg.curves)):
+        for name, values in axes.items():
+            if values.tolist() != [float(x) for x in doc[group][name]]:
+                out[group][name] = {"values": [float(x) for x in doc[group][name]],
+                                    "units": _SI_UNITS.get(name, "1")}
+    head = (f"# the config of cube '{doc['name']}' (config sha256 "
+            f"{str(attrs.get('config_sha256', ''))[:16]}), written by nylonflex info "
+            "--config\n")
+    return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
+
+
+#: The SI unit a config may give each axis in (the last resort of :func:`runnable_config`).
+_SI_UNITS = {"radius": "m", "wall_thickness": "m", "length": "m", "wrap_angle": "rad",
+             "pressure": "Pa"}
+
+
+def _decimals(name: str, values) -> list | None:
+    """The shortest decimals in the axis's display unit that convert back to ``values``
+    [SI] exactly, or None."""
+    from ..units import decimal_to_si, from_si
+    from ..variables import VARIABLES
+
+    unit = VARIABLES[name].display
+    out = []
+    for x in values:
+        shown = from_si(float(x), unit)
+        for digits in range(1, 18):
+            d = float(f"{shown:.{digits}g}")
+            if decimal_to_si(d, unit) == x:
+                out.append(int(d) if d.is_integer() and abs(d) < 1e15 else d)
+                break
+        else:
+            return None
+    return out
+
+
+def _axis_spec(name: str, values) -> dict:
+    """An axis as a config gives it: start/stop/num when its display-unit decimals are
+    evenly spaced, else values (exactness is checked by :func:`runnable_config`)."""
+    from fractions import Fraction
+
+    from ..variables import VARIABLES
+
+    unit = VARIABLES[name].display
+    units = {} if unit == "1" else {"units": unit}
+    dec = _decimals(name, values)
+    if dec is None:
+        return {"values": [float(x) for x in values], "units": _SI_UNITS.get(name, "1")}
+    if len(dec) >= 3:
+        steps = {Fraction(repr(b)) - Fraction(repr(a)) for a, b in zip(dec, dec[1:])}
+        if len(steps) == 1:
+            return {"start": dec[0], "stop": dec[-1], "num": len(dec), **units}
+    return {"values": dec, **units}
+
+
+def _material_spec(kind: str, resolved: dict, parameters_text):
+    """A material as a config names it: the set's name, ``{set, changed fields}``, the
+    fitted file (where it still holds these values), or every field over the default set."""
+    import yaml
+
+    from ..materials import nylon_parameters, silicone_parameters
+
+    make = silicone_parameters if kind == "silicone" else nylon_parameters
+    fields = {k: v for k, v in resolved.items() if k != "name"}
+    name = str(resolved.get("name", ""))
+    try:
+        extra = yaml.safe_load(parameters_text) if parameters_text else {}
+    except yaml.YAMLError:
+        extra = {}
+    extra = extra if isinstance(extra, dict) else {}
+    base = name.removesuffix("+override")
+    try:
+        ref = make(base).to_dict()
+    except ValueError:
+        ref = None
+    if ref is not None:
+        changed = {k: v for k, v in fields.items() if ref.get(k) != v}
+        if not changed and name == base:
+            return base
+        return {"set": base, **changed}
+    source = (extra.get("sources") or {}).get("file")
+    if source:
+        from pathlib import Path
+
+        path = Path(source).resolve()
+        try:
+            if path.is_file() and make({"file": str(path)}).to_dict() == resolved:
+                return {"file": str(path)}
+        except ValueError:
+            pass
+    default = "tc5005" if kind == "silicone" else "silver_nylon66"
+    spec = {"set": default, **fields}
+    if kind == "silicone" and isinstance(extra.get("stretch_range"), list):
+        spec["stretch_range"] = [float(x) for x in extra["stretch_range"]]
+    return spec
+
+
+def _uncertainty_spec(resolved: dict) -> dict:
+    """The ``uncertainty:`` section from its resolved form (SI sd, sorted parameters)."""
+    params = {}
+    for name, p in resolved.get("parameters", {}).items():
+        if p.get("fields"):  # a fit's covariance: from_fit of the material's file
+            params[name] = {"from_fit": True}
+            continue
+        d = {"distribution": p["distribution"]}
+        if p.get("rel_sd") is not None:
+            d["rel_sd"] = float(p["rel_sd"])
+        if p.get("sd") is not None:
+            d["sd"] = float(p["sd"])
+            if name in _SI_UNITS:
+                d["units"] = _SI_UNITS[name]
+            elif "." in name:
+                d["units"] = "1"
+        params[name] = d
+    return {"samples": int(resolved["samples"]), "seed": int(resolved["seed"]),
+            "quantiles": [float(q) for q in resolved["quantiles"]], "parameters": params}

@@ -1,6 +1,10 @@
-"""Example configs shipped with the package, for ``nylonflex init`` to copy and users to edit.
+"""Example configs and data shipped with the package, for ``nylonflex init`` to copy and
+users to edit.
 
-``configs/`` in the repository holds the same files (a test keeps them identical).
+``nylonflex init DIR`` lays them out as the README's commands expect them: ``configs/``
+(the files of the repository's ``configs/``, a test keeps them identical, with the fitted
+material ``configs/fits/``) and ``data/`` (the bench file ``nylonflex fit silicone`` reads,
+a copy of ``tests/data/ecoflex_0050.csv``), so every command of the README runs in DIR.
 """
 
 from __future__ import annotations
@@ -8,15 +12,24 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["EXAMPLES", "example_text", "write_examples"]
+__all__ = ["DATA", "EXAMPLES", "NEEDS", "example_text", "write_examples"]
 
-#: Example name -> what it is for (the file is ``<name>.yaml``).
+#: Example name -> what it is for (the file is ``configs/<name>.yaml``).
 EXAMPLES = {
-    "fig12": "sweep: the design space of the paper's figure 12 (nylonflex sweep fig12.yaml)",
-    "control": "simulate: the closed loop of figure 9 (nylonflex simulate control.yaml)",
+    "fig12": "sweep: the design space of the paper's figure 12 (nylonflex sweep configs/fig12.yaml)",
+    "fig12_uncertain": "sweep with uncertainty and requirements: quantiles and feasibility",
+    "fig12_fitted": "sweep with a fitted silicone (configs/fits/ecoflex_0050_ogden2.yaml)",
+    "big20m": "sweep: 20 million designs, for clusters and memory checks",
+    "design_force": "design: the largest tip force with a full range (needs sweeps/fig12)",
+    "design_front": "design: the Pareto front of force and size (needs sweeps/fig12)",
+    "control": "simulate: the closed loop of figure 9 (nylonflex simulate configs/control.yaml)",
     "step": "simulate: a step response with rise time and overshoot",
     "gripper": "simulate: three actuators on one 9 V battery",
 }
+#: Files an example reads, written with it (paths inside the package = paths in DIR/configs).
+NEEDS = {"fig12_fitted": ("fits/ecoflex_0050_ogden2.yaml",)}
+#: Data files a full ``init`` writes under DIR/data.
+DATA = ("ecoflex_0050.csv", "README.md")
 
 
 def example_text(name: str) -> str:
@@ -26,15 +39,19 @@ def example_text(name: str) -> str:
     return resources.files(__name__).joinpath(f"{name}.yaml").read_text()
 
 
+def _package_file(rel: str) -> bytes:
+    return resources.files(__name__).joinpath(rel).read_bytes()
+
+
 def write_examples(folder, names=None) -> list[Path]:
-    """Write the example configs into ``folder`` (created if missing); never overwrite.
+    """Write the example configs (and what they read) into ``folder``; never overwrite.
 
     Parameters
     ----------
     folder : path
-        Where the files go.
+        Where the files go (``configs/``, ``configs/fits/``, ``data/`` inside it).
     names : sequence of str, optional
-        Which examples (default: all of :data:`EXAMPLES`).
+        Which examples (default: all of :data:`EXAMPLES`, and the data).
 
     Returns
     -------
@@ -49,20 +66,30 @@ def write_examples(folder, names=None) -> list[Path]:
     from ..units import InputError
 
     folder = Path(folder)
-    names = list(EXAMPLES) if not names else list(names)
+    everything = not names
+    names = list(EXAMPLES) if everything else list(names)
     for n in names:
         if n not in EXAMPLES:
             raise InputError(f"init: unknown example {n!r}; accepted: {', '.join(EXAMPLES)}")
     if folder.exists() and not folder.is_dir():
         raise InputError(f"init: {folder} is a file; give a folder for the example configs")
-    paths = [folder / f"{n}.yaml" for n in names]
-    existing = [str(p) for p in paths if p.exists()]
+    files = {}  # target path -> package file
+    for n in names:
+        files[folder / "configs" / f"{n}.yaml"] = f"{n}.yaml"
+        for rel in NEEDS.get(n, ()):
+            files[folder / "configs" / rel] = rel
+    if everything:
+        for rel in DATA:
+            files[folder / "data" / rel] = f"data/{rel}"
+    existing = [str(p) for p in files if p.exists()]
     if existing:
-        verb = "exists" if len(existing) == 1 else "exist"
-        raise InputError(f"init: {', '.join(existing)} already {verb}; nothing written "
-                         "(move them away, or init another folder)")
-    folder.mkdir(parents=True, exist_ok=True)
-    for n, p in zip(names, paths):
-        with open(p, "x") as f:  # exclusive: never replace a file made meanwhile
-            f.write(example_text(n))
-    return paths
+        what = existing[0] if len(existing) == 1 else \
+            f"{len(existing)} of its files ({existing[0]}, ...)"
+        verb = "already exists" if len(existing) == 1 else "already exist"
+        raise InputError(f"init: {what} {verb}; nothing written (move them away, or init "
+                         "another folder)")
+    for target, rel in files.items():
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with open(target, "xb") as f:  # exclusive: never replace a file made meanwhile
+            f.write(_package_file(rel))
+    return list(files)

@@ -7,9 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine.provenance import is_complete
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
-from .cube import load_filter_plugins
+from .cube import require_filters
 from .journal import Journal
 
 __all__ = ["MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_cube", "check_chunk_sizes",
@@ -81,6 +82,8 @@ def open_cube(path, *, quiet: bool = False):
     """
     import xarray as xr
 
+    from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
+
     path = Path(path)
     if not path.exists():
         parts = Journal(path)
@@ -92,9 +95,11 @@ def open_cube(path, *, quiet: bool = False):
         raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
                          "written by 'nylonflex sweep')")
     check_chunk_sizes(path)
-    load_filter_plugins()  # zstd and lz4 cubes need hdf5plugin's filters registered
+    require_filters(attrs.get("compression"))  # zstd and lz4 need a filter plugin
     ds = xr.open_dataset(path, engine="h5netcdf")
-    if attrs.get("complete") != "true":
+    for var in ds.variables.values():
+        var.encoding = portable_encoding(var.encoding)
+    if not is_complete(attrs):
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
@@ -103,6 +108,27 @@ def open_cube(path, *, quiet: bool = False):
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
+
+
+#: Encoding keys of codecs only HDF5 filter plugins know: h5py's filter id and options, and
+#: the netCDF4-style flags xarray reads them into (zstd; lz4 reads as blosc). Neither engine
+#: writes them again without the plugin (h5netcdf: 'Compression filter "zstd" is
+#: unavailable'; netcdf4: 'Unsupported value for compression kwarg').
+_PLUGIN_KEYS = ("compression", "compression_opts", "zstd", "blosc", "szip", "bzip2")
+
+
+def portable_encoding(encoding: dict) -> dict:
+    """A variable's encoding as both xarray engines (h5netcdf, netcdf4) write it again.
+
+    A chunk filter only a plugin decodes (zstd, lz4) becomes deflate level 1 with the
+    shuffle filter, the default cube's codec, which every reader decompresses; deflate,
+    chunking, dtype and fill value are kept as read.
+    """
+    out = dict(encoding)
+    filters = [out.pop(key, None) for key in _PLUGIN_KEYS]
+    if any(f not in (None, False, "gzip") for f in filters):
+        out.update(zlib=True, complevel=1, shuffle=True)
+    return out
 
 
 def _validity_lines(ds) -> list[str]:
@@ -199,7 +225,7 @@ def check_cube(path, *, full: bool = True, progress=None) -> list[str]:
     import h5py
 
     check_chunk_sizes(path)
-    load_filter_plugins()
+    require_filters((cube_attrs(path) or {}).get("compression"))
     problems = []
     with h5py.File(path, "r") as f:
         names = [n for n, obj in f.items() if isinstance(obj, h5py.Dataset)]
@@ -244,7 +270,7 @@ def cube_summary(path) -> list[str]:
         ds = open_cube(path, quiet=True)
     a = ds.attrs
     out = []
-    complete = a.get("complete") == "true"
+    complete = is_complete(a)
     done = int(ds["slab_done"].sum())
     out.append(f"cube      {path}")
     # a spot check: the first chunk of each variable read ('info --check' reads all)

@@ -8,21 +8,19 @@ killed run never leaves a file that reads as complete. ``--resume`` keeps the jo
 slabs (if the config hash, the nylonflex version and the model digest match, the slab plan
 and codec are ones the config implies, and each slab passes its own verification, which
 covers the codec it decodes with; a slab that fails is recomputed) and computes the rest. A run
-stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete = "false"`` and a ``slab_done`` mask, so the part
+stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete`` 0 and a ``slab_done`` mask, so the part
 already done can be queried.
 """
 
 from __future__ import annotations
 
-import datetime as _dt
 import errno
-import platform
 from pathlib import Path
 
 from .. import __version__
 from ..config import ResolvedConfig
 from ..engine.grid import coords, cube_variables, global_arrays, plan_is_implied, plan_slabs
-from ..engine.provenance import provenance
+from ..engine.provenance import is_complete, provenance, run_attrs
 from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
 from ..units import InputError
 from .cube import CODECS, CubeFile
@@ -117,7 +115,7 @@ def _check_existing(cfg, out, attrs, resume, overwrite, log):
     if attrs is None:
         return False
     same = attrs.get("config_sha256") == cfg.sha256
-    complete = attrs.get("complete") == "true"
+    complete = is_complete(attrs)
     if resume and not same and not overwrite:
         raise InputError(f"--resume: {out} was made from another config "
                          f"(sha256 {str(attrs.get('config_sha256', '?'))[:12]} vs "
@@ -197,7 +195,7 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
                          f"{journal.dir} and run again without --resume")
     # what the cube at out implies, not what the manifest says: a finished cube there is
     # kept until this run completes
-    replaces = attrs is not None and attrs.get("complete") == "true"
+    replaces = is_complete(attrs)
     codec = manifest.get("compression", "gzip")  # journaled chunks are in this codec
     if codec != cfg.compression:
         log(f"resuming with the journal's compression, {codec} (the config now says "
@@ -317,16 +315,8 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
     done = len(keep) + len(stats.done)
     complete = not stats.stopped and done == len(slabs)
     seconds = stats.seconds
-    final = {
-        **executor.info(),
-        "complete": "true" if complete else "false",
-        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "run_seconds": f"{seconds:.3f}",
-        "designs_per_second": f"{stats.computed / seconds:.0f}" if seconds > 0 else "nan",
-        "resumed_slabs": str(len(keep)),
-        "python_version": platform.python_version(),
-        "hostname": platform.node(),
-    }
+    final = run_attrs(executor.info(), complete=complete, seconds=seconds,
+                      computed=stats.computed, resumed=len(keep))
     with deferred_signals():  # the publishing steps run to their end
         cube.close(final)
         if complete or not replaces:
@@ -339,7 +329,7 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
             journal.remove()
     if complete:
         log(f"wrote {out}: {cfg.n_designs:,} designs in {seconds:.2f} s "
-            f"({final['designs_per_second']} designs/s computed)")
+            f"({final['designs_per_second']:.0f} designs/s computed)")
         return
     where = (f"{out} (the finished cube) is kept until this run completes"
              if replaces else f"{out} is marked incomplete")

@@ -1,0 +1,84 @@
+"""``ds.nf`` and ``da.nf``: a cube's values in the units people read them in (mm, deg, kPa).
+
+Registered with xarray when a cube is opened or swept (:func:`nylonflex.open_cube`,
+:func:`nylonflex.run_sweep`); ``import nylonflex.storage.accessor`` registers it for any
+Dataset. The cube itself stays SI; these give display-unit copies for plots and tables::
+
+    ds = nf.open_cube("sweeps/fig12/cube.h5")
+    ds.nf.sel(radius="10.5 mm", wrap_angle="8 deg")     # sel with units (exact grid values)
+    ds["tip_force_max"].nf.display()                     # N -> N, torque N m -> N mm, ...
+    ds.nf.display()["radius"]                            # every registered variable
+"""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from ..units import parse_quantity
+from ..variables import VARIABLES, to_display
+
+__all__ = ["CubeAccessor", "VariableAccessor"]
+
+
+def _display(da: xr.DataArray, name: str | None = None) -> xr.DataArray:
+    """``da`` (a registered variable, SI) in its display unit, ``units`` attr to match;
+    a name the registry does not know is returned as it is."""
+    name = name or da.name
+    v = VARIABLES.get(name)
+    if v is None or v.display == v.units:
+        return da
+    out = da.copy(data=to_display(name, da.values))
+    out.attrs = {**da.attrs, "units": v.display}
+    return out
+
+
+@xr.register_dataarray_accessor("nf")
+class VariableAccessor:
+    """``da.nf``: a cube variable in its display unit."""
+
+    def __init__(self, da: xr.DataArray):
+        self._da = da
+
+    def display(self) -> xr.DataArray:
+        """The values [display unit: mm, deg, kPa, N mm, ...] and the coordinates too;
+        the ``units`` attributes say which."""
+        da = _display(self._da)
+        coords = {c: _display(da[c], c) for c in da.coords if c in VARIABLES}
+        return da.assign_coords(coords)
+
+
+@xr.register_dataset_accessor("nf")
+class CubeAccessor:
+    """``ds.nf``: selections with units, and the cube in display units."""
+
+    def __init__(self, ds: xr.Dataset):
+        self._ds = ds
+
+    def sel(self, **at) -> xr.Dataset:
+        """``ds.sel`` with values that carry units (``radius="10.5 mm"``; a bare number
+        is in the axis's display unit, as on the command line). Exact: the grid's
+        coordinates are the floats nearest their decimal values, and so is a value typed.
+
+        Raises
+        ------
+        nylonflex.units.InputError
+            A name that is not an axis of the cube, or a unit of the wrong kind.
+        KeyError
+            The value is not a grid value (xarray's own error).
+        """
+        from ..units import InputError
+
+        si = {}
+        for name, value in at.items():
+            v = VARIABLES.get(name)
+            if name not in self._ds.dims or v is None:
+                raise InputError(f"{name}: not an axis of this cube; axes: "
+                                 f"{', '.join(d for d in self._ds.dims if d in VARIABLES)}")
+            si[name] = parse_quantity(value, name, v.kind, v.display)
+        return self._ds.sel(si)
+
+    def display(self) -> xr.Dataset:
+        """A copy with every registered variable and coordinate in its display unit."""
+        ds = self._ds
+        out = ds.assign({n: _display(ds[n], n) for n in ds.data_vars if n in VARIABLES})
+        return out.assign_coords({c: _display(ds[c], c) for c in ds.coords if c in VARIABLES})
