@@ -27,6 +27,7 @@ ZERO_CELSIUS = 273.15  # [K]
 __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
+    "WALL_STRETCH_RANGE",
     "Nylon",
     "FIELD_UNITS",
     "SHEAR_MODULUS_RANGE",
@@ -35,6 +36,12 @@ __all__ = [
     "nylon_parameters",
     "silicone_parameters",
 ]
+
+#: Stretch range [-] the actuators' walls reach, the window a silicone fit is made over by
+#: default (``nylonflex fit silicone``). D: the paper's two worked examples stretch the top
+#: fibre of the wall to about 1.2 (a = 20 mm) and 1.6 (a = 7.5 mm) at full stroke
+#: (docs/model.md s. 5); 2 leaves a margin above the stiffer of them.
+WALL_STRETCH_RANGE = (1.0, 2.0)
 
 #: Ogden sets in the paper's convention (eq. 5): W = sum mu_i/alpha_i (l1^a + l2^a + l3^a - 3).
 #: ``mu`` [Pa], ``alpha`` [-].
