@@ -179,6 +179,7 @@ class AR1Solution(Solution):
     rho: float = 0.0
     rho_set: tuple = (0.0, 0.0)
     profile: list | None = None
+    bounds: tuple | None = None  # (lower, upper): the intervals are cut to them
 
     @property
     def stderr(self) -> np.ndarray:
@@ -187,7 +188,10 @@ class AR1Solution(Solution):
 
     def ci95(self) -> np.ndarray:
         se = self.stderr
-        return np.stack([self.x - self.t95 * se, self.x + self.t95 * se], axis=1)
+        lo, hi = self.x - self.t95 * se, self.x + self.t95 * se
+        if self.bounds is not None:  # the estimate is inside its bounds, so still inside
+            lo, hi = np.maximum(lo, self.bounds[0]), np.minimum(hi, self.bounds[1])
+        return np.stack([lo, hi], axis=1)
 
 
 def solve_ar1(residual, jacobian, x0, lower, upper, *, max_nfev=2000):
@@ -203,7 +207,8 @@ def solve_ar1(residual, jacobian, x0, lower, upper, *, max_nfev=2000):
     errors are the largest over the set of rho within :data:`PROFILE_DROP` of the best
     restricted likelihood, which allows for the uncertainty of rho itself (REML is biased
     towards 0 on short series). Intervals are estimate +- t_(n-p) se, so they always contain
-    their estimate.
+    their estimate; a parameter's interval is cut to its bounds (mu_i alpha_i >= 0,
+    0.05 <= |alpha_i| <= 40), which the estimate also keeps.
 
     Parameters
     ----------
@@ -254,4 +259,5 @@ def solve_ar1(residual, jacobian, x0, lower, upper, *, max_nfev=2000):
     best = max(fits, key=lambda f: f[0])
     keep = [f for f in fits if f[0] >= best[0] - PROFILE_DROP]
     return AR1Solution(x_ols, keep[-1][2], res, n - p, "ar1", True, rho=best[1],
-                       rho_set=(keep[0][1], keep[-1][1]), profile=[(f[1], f[2]) for f in keep])
+                       rho_set=(keep[0][1], keep[-1][1]), profile=[(f[1], f[2]) for f in keep],
+                       bounds=(lower, upper))

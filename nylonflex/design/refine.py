@@ -23,6 +23,8 @@ A move is kept only when it meets every constraint and the epsilon bounds and st
 improves the objective, so the result still weakly dominates its seed. Several objectives
 also get more starts where the grid front is sparse: between neighbouring grid-front designs
 in the second objective, the first is optimised with the second bounded by the midpoint.
+SLSQP is given ``range_fraction >= 1`` as ``range_fraction - nylon_use + 1 >= 1``: the same
+designs, but a constraint whose value falls towards the strength limit instead of staying 1.
 """
 
 from __future__ import annotations
@@ -143,6 +145,11 @@ def _bounds(spec, ranges, fixed):
     return out
 
 
+def _full_range(c) -> bool:
+    """Whether a constraint asks for a full range of motion (``range_fraction >= 1``)."""
+    return c.name == "range_fraction" and c.op in (">=", ">") and c.value == 1.0
+
+
 class _Problem:
     """SLSQP's view: unit-scaled free axes, one primary objective, inequality functions."""
 
@@ -178,6 +185,12 @@ class _Problem:
         q = [self.primary.sign * rows[self.primary.name] / self.f_scale]
         for c, s in zip(self.conds, self.c_scale):
             x = rows[c.name]
+            if _full_range(c) and "nylon_use" in rows:
+                # range_fraction is 1 all over the stroke-limited side (no gradient to see
+                # the boundary coming); range_fraction - nylon_use + 1 is the same on the
+                # strength-limited side (nylon_use = 1) and 2 - nylon_use on the other,
+                # both 1 at the boundary: the same feasible set, with a gradient
+                x = x - rows["nylon_use"] + 1.0
             q.append((x - c.value) / s if c.op in (">=", ">", "==") else (c.value - x) / s)
         for (o, v), s in zip(self.eps, self.e_scale):
             q.append(o.sign * (v - rows[o.name]) / s)
