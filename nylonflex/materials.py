@@ -143,9 +143,10 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
             "resistance_per_length": "S: the paper, 0.15 ohm/mm",
             "heat_capacity_per_length": "D: rho = 1300 kg/m3, c_p = 1267 J/(kg K) (Sun et al., "
             "IROS 2018) for a coiled 4-ply thread",
-            "heat_loss_per_length": "P: wound on silicone, one side insulated; with 12 V on a "
-            "0.5 m muscle it settles near t_max. Free convection in still air gives 3.1 times "
-            "more (set silver_nylon66_still_air, docs/model.md s. 9)",
+            "heat_loss_per_length": "K: so that the paper's 12 V supply (160 mA, 1.92 W: the "
+            "0.503 m muscle of its second example) holds the muscle near t_max (151.5 degC); "
+            "free convection in still air gives 3.1 times more (set silver_nylon66_still_air, "
+            "docs/model.md s. 9)",
             "stiffness": "P: order of magnitude for a 60 mm self-coiled thread",
             "damping": "P: same",
             "thermal_force_coefficient": "P: same",
