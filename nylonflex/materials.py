@@ -27,6 +27,8 @@ ZERO_CELSIUS = 273.15  # [K]
 __all__ = [
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
+    "WALL_STRETCH_RANGE",
+    "WALL_STRETCH_RANGE",
     "Nylon",
     "FIELD_UNITS",
     "SHEAR_MODULUS_RANGE",
@@ -35,6 +37,18 @@ __all__ = [
     "nylon_parameters",
     "silicone_parameters",
 ]
+
+#: Stretch range [-] the actuators' walls reach, the window a silicone fit is made over by
+#: default (``nylonflex fit silicone``). D: the paper's two worked examples stretch the top
+#: fibre of the wall to about 1.2 (a = 20 mm) and 1.6 (a = 7.5 mm) at full stroke
+#: (docs/model.md s. 5); 2 leaves a margin above the stiffer of them.
+WALL_STRETCH_RANGE = (1.0, 2.0)
+
+#: Stretch range [-] the actuators' walls reach, the window a silicone fit is made over by
+#: default (``nylonflex fit silicone``). D: the paper's two worked examples stretch the top
+#: fibre of the wall to about 1.2 (a = 20 mm) and 1.6 (a = 7.5 mm) at full stroke
+#: (docs/model.md s. 5); 2 leaves a margin above the stiffer of them.
+WALL_STRETCH_RANGE = (1.0, 2.0)
 
 #: Ogden sets in the paper's convention (eq. 5): W = sum mu_i/alpha_i (l1^a + l2^a + l3^a - 3).
 #: ``mu`` [Pa], ``alpha`` [-].
@@ -129,8 +143,10 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
             "resistance_per_length": "S: the paper, 0.15 ohm/mm",
             "heat_capacity_per_length": "D: rho = 1300 kg/m3, c_p = 1267 J/(kg K) (Sun et al., "
             "IROS 2018) for a coiled 4-ply thread",
-            "heat_loss_per_length": "P: wound on silicone, one side insulated; with 12 V on a "
-            "0.5 m muscle it settles near t_max",
+            "heat_loss_per_length": "K: so that the paper's 12 V supply (160 mA, 1.92 W: the "
+            "0.503 m muscle of its second example) holds the muscle near t_max (151.5 degC); "
+            "free convection in still air gives 3.1 times more (set silver_nylon66_still_air, "
+            "docs/model.md s. 9)",
             "stiffness": "P: order of magnitude for a 60 mm self-coiled thread",
             "damping": "P: same",
             "thermal_force_coefficient": "P: same",
@@ -144,6 +160,20 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
     },
 }
 
+#: The same muscle in still air, its heat loss from first principles (docs/model.md s. 9).
+NYLON_PARAMETERS["silver_nylon66_still_air"] = {
+    **NYLON_PARAMETERS["silver_nylon66"],
+    "heat_loss_per_length": 0.0924,
+    "description": "silver-coated nylon 6,6 sewing thread, self-coiled, in still air",
+    "sources": {
+        **NYLON_PARAMETERS["silver_nylon66"]["sources"],
+        "heat_loss_per_length": "D: free convection from a horizontal cylinder in still air "
+        "(Churchill & Chu, Int. J. Heat Mass Transfer 18:1049, 1975) of the muscle's outer "
+        "diameter d_f (C + 1) at C = 1.4 (0.816 mm), T_s = t_max, T_amb = t_amb, air at the "
+        "film temperature (Incropera Table A.4): Nu_D = 0.955, lambda' = pi k Nu_D; "
+        "0.0879-0.0968 over C = 1.1-1.7; radiation left out (silver surface)",
+    },
+}
 
 #: Unit of every field of a material set, as the code (and a config override) takes it.
 FIELD_UNITS = {

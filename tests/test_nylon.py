@@ -3,6 +3,7 @@ import math
 import numpy as np
 import pytest
 
+from nylonflex.materials import nylon_parameters
 from nylonflex.physics import nylon, thermal, wrap
 from nylonflex.physics.nylon import free_strain, stroke, stroke_max, tensile_strength
 
@@ -151,3 +152,31 @@ def test_thermal_step_is_the_exact_solution_of_eq3():
 def test_bad_input_names_the_parameter(kwargs, match):
     with pytest.raises(ValueError, match=match):
         stroke(**kwargs)
+
+
+def test_still_air_heat_loss_is_churchill_chu_for_the_muscles_diameter():
+    # issue 30: Churchill & Chu 1975, Nu = {0.60 + 0.387 Ra^(1/6)/[1 + (0.559/Pr)^(9/16)]^(8/27)}^2;
+    # by hand at T_f = 360.65 K (Incropera A.4 between 350 and 400 K: k 0.030808,
+    # nu 2.2089e-5, a 3.1688e-5, Pr 0.69787), D = 0.34 mm (1.4 + 1), dT = 125 K:
+    # Ra = 9.80665 125/360.65 (0.816e-3)^3 / (nu a) = 2.638, Nu = 0.9548, pi k Nu = 0.09242
+    d = 0.34e-3 * (1.4 + 1.0)
+    lam = thermal.free_convection_loss_per_length(d, T_MAX, T_AMB)
+    assert lam == pytest.approx(0.09242, rel=2e-4)
+    still = nylon_parameters("silver_nylon66_still_air")
+    assert still.heat_loss_per_length == pytest.approx(lam, rel=1e-3)  # the set, rounded
+    # a thin wire: the conduction limit Nu -> 0.36, lambda' -> 0.36 pi k
+    k300 = thermal.AIR_PROPERTIES["k"][0]
+    assert thermal.free_convection_loss_per_length(1e-9, 300.5, 299.5) == pytest.approx(
+        0.36 * math.pi * k300, rel=2e-3)
+    # radiation adds eps sigma (Ts^2 + Ta^2)(Ts + Ta) pi D
+    rad = 0.9 * 5.670374419e-8 * (T_MAX**2 + T_AMB**2) * (T_MAX + T_AMB) * math.pi * d
+    assert thermal.free_convection_loss_per_length(d, T_MAX, T_AMB, 0.9) == pytest.approx(
+        lam + rad, rel=1e-12)
+    with pytest.raises(ValueError, match="film temperature"):
+        thermal.free_convection_loss_per_length(d, 700.0, T_AMB)
+
+
+def test_close_wound_coil_holds_sqrt_pi_c_squared_plus_one_of_thread():
+    # a helix of pitch d_f and mean diameter C d_f: sqrt((pi C d_f)^2 + d_f^2) per d_f
+    assert thermal.coiled_resistance_per_length(1.0, 1.1) == pytest.approx(3.5975, abs=1e-4)
+    assert thermal.coiled_resistance_per_length(1.0, 1.7) == pytest.approx(5.4335, abs=1e-4)

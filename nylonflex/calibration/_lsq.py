@@ -4,7 +4,8 @@ The covariance of the parameters is s^2 (J^T J)^-1 at the optimum (s^2 = SSR/(n 
 Gauss-Newton approximation that is right for independent, equal-variance errors and a
 solution inside the bounds. Where it is not (a parameter on a bound, a singular J^T J), the
 caller gets a residual bootstrap instead. Intervals are Student-t with n - p degrees of
-freedom; a derived quantity g(theta) gets the delta method, g'^T C g'.
+freedom; a derived quantity g(theta) gets the delta method, g'^T C g'. A tensile pull, whose
+residuals are correlated along the pull, gets :func:`solve_ar1` instead.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, stats
 
-__all__ = ["Solution", "solve", "derived"]
+__all__ = ["AR1Solution", "Solution", "derived", "solve", "solve_ar1"]
 
 
 @dataclass
@@ -134,6 +135,10 @@ def derived(sol: Solution, value, gradient):
     bootstrap draws' percentiles otherwise.
     """
     g = float(value(sol.x))
+    if getattr(sol, "profile", None):  # AR(1): the largest over the profile set of rho
+        d = np.asarray(gradient(sol.x), float)
+        se = float(np.sqrt(max(max(d @ c @ d for _, c in sol.profile), 0.0)))
+        return g, se, (g - sol.t95 * se, g + sol.t95 * se)
     if sol.samples is not None:
         vals = np.array([value(s) for s in sol.samples])
         lo, hi = np.percentile(vals, [2.5, 97.5])
@@ -142,3 +147,117 @@ def derived(sol: Solution, value, gradient):
     d = np.asarray(gradient(sol.x), float)
     se = float(np.sqrt(max(d @ sol.covariance @ d, 0.0)))
     return g, se, (g - sol.t95 * se, g + sol.t95 * se)
+
+
+#: Lag-1 correlations the AR(1) residual model is profiled over: 0 (independent errors) to
+#: 0.999, denser towards 1 where a dense pull's residuals sit.
+RHO_GRID = np.concatenate([np.linspace(0.0, 0.9, 10), 1.0 - np.geomspace(0.1, 1e-3, 12)[1:]])
+#: Drop of the restricted log-likelihood that bounds the set of rho the intervals are the
+#: widest over: 1/2, the one-sigma set (chi^2_1 = 1). The 95 % set (1.92) gave 199 of 200
+#: intervals covering mu_0 on simulated pulls (rho = 0.99, 43 points), wider than asked; the
+#: one-sigma set gave 148 of 160 (92.5 %), docs/calibration.md.
+PROFILE_DROP = 0.5
+
+
+def _whiten(v, rho):
+    """Prais-Winsten transform of residuals (n,) or a Jacobian (n, p) for AR(1) errors."""
+    out = np.array(v, dtype=float, copy=True)
+    out[1:] = v[1:] - rho * v[:-1]
+    out[0] = np.sqrt(1.0 - rho * rho) * v[0]
+    return out
+
+
+@dataclass
+class AR1Solution(Solution):
+    """A least-squares solution with intervals under AR(1) errors (internal).
+
+    ``x`` is the ordinary least-squares estimate; ``profile`` holds ``(rho, covariance)``
+    for every rho of its profile set, the covariance of ``x`` under AR(1) errors with that
+    rho; the standard errors are the largest over that set.
+    """
+
+    rho: float = 0.0
+    rho_set: tuple = (0.0, 0.0)
+    profile: list | None = None
+    bounds: tuple | None = None  # (lower, upper): the intervals are cut to them
+
+    @property
+    def stderr(self) -> np.ndarray:
+        var = np.max([np.clip(np.diag(c), 0.0, None) for _, c in self.profile], axis=0)
+        return np.sqrt(var)
+
+    def ci95(self) -> np.ndarray:
+        se = self.stderr
+        lo, hi = self.x - self.t95 * se, self.x + self.t95 * se
+        if self.bounds is not None:  # the estimate is inside its bounds, so still inside
+            lo, hi = np.maximum(lo, self.bounds[0]), np.minimum(hi, self.bounds[1])
+        return np.stack([lo, hi], axis=1)
+
+
+def solve_ar1(residual, jacobian, x0, lower, upper, *, max_nfev=2000):
+    """Intervals of a least-squares optimum whose residuals are correlated in order.
+
+    A dense tensile pull's residuals are strongly correlated (lag-1 correlation near 1), so
+    s^2 (J^T J)^-1 understates the uncertainty many times over. The errors are modelled as
+    AR(1), e_i = rho e_(i-1) + w_i with w white. For each rho of :data:`RHO_GRID` the model is
+    fitted by generalised least squares (Prais-Winsten whitening, warm-started from the
+    previous rho), which gives the restricted (REML) likelihood of rho and the innovation
+    variance s_w^2; the covariance of the ordinary estimate ``x0`` is then the sandwich
+    A J^T Sigma J A, A = (J^T J)^-1, Sigma_ij = s_w^2 rho^|i-j| / (1 - rho^2). The standard
+    errors are the largest over the set of rho within :data:`PROFILE_DROP` of the best
+    restricted likelihood, which allows for the uncertainty of rho itself (REML is biased
+    towards 0 on short series). Intervals are estimate +- t_(n-p) se, so they always contain
+    their estimate; a parameter's interval is cut to its bounds (mu_i alpha_i >= 0,
+    0.05 <= |alpha_i| <= 40), which the estimate also keeps.
+
+    Parameters
+    ----------
+    residual, jacobian : callable
+        ``x -> model - data`` (n,) and its derivative (n, p), the data in time order.
+    x0 : array
+        The ordinary least-squares optimum, inside the bounds.
+    lower, upper : array
+        Bounds.
+    max_nfev : int
+        Evaluations allowed each rho's solve.
+
+    Returns
+    -------
+    AR1Solution or None
+        None when no rho gives a finite solution.
+    """
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    x_ols = np.clip(np.asarray(x0, float), lower, upper)
+    res = np.asarray(residual(x_ols), float)
+    jac = np.asarray(jacobian(x_ols), float)
+    n, p = jac.shape
+    a = np.linalg.pinv(jac.T @ jac)
+    lag = np.abs(np.subtract.outer(np.arange(n), np.arange(n)))
+    x, fits = x_ols, []
+    for rho in RHO_GRID:
+        try:
+            r = optimize.least_squares(lambda v, rho=rho: _whiten(residual(v), rho), x,
+                                       jac=lambda v, rho=rho: _whiten(jacobian(v), rho),
+                                       bounds=(lower, upper), method="trf", x_scale="jac",
+                                       max_nfev=max_nfev)
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+            continue
+        if not (np.all(np.isfinite(r.x)) and np.isfinite(r.cost)):
+            continue
+        x = r.x
+        ssr = float(r.fun @ r.fun)
+        jw = np.asarray(r.jac, float)
+        sign, logdet = np.linalg.slogdet(jw.T @ jw)
+        if not ssr > 0 or sign <= 0:
+            continue
+        reml = (-0.5 * (n - p) * np.log(ssr / (n - p)) + 0.5 * np.log(1.0 - rho * rho)
+                - 0.5 * logdet)
+        sigma = ssr / (n - p) / (1.0 - rho * rho) * rho ** lag
+        fits.append((reml, float(rho), a @ jac.T @ sigma @ jac @ a))
+    if not fits:
+        return None
+    best = max(fits, key=lambda f: f[0])
+    keep = [f for f in fits if f[0] >= best[0] - PROFILE_DROP]
+    return AR1Solution(x_ols, keep[-1][2], res, n - p, "ar1", True, rho=best[1],
+                       rho_set=(keep[0][1], keep[-1][1]), profile=[(f[1], f[2]) for f in keep],
+                       bounds=(lower, upper))

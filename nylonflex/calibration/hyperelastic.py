@@ -24,7 +24,7 @@ import itertools
 import numpy as np
 
 from ..units import InputError
-from ._lsq import derived, solve
+from ._lsq import derived, solve, solve_ar1
 from .data import Table, column, read_table
 from .result import FitResult, statistics
 
@@ -37,6 +37,10 @@ _K = {"uniaxial": -0.5, "planar": -1.0}  # l3 = l^k
 _ALPHA_MIN, _ALPHA_MAX = 0.05, 40.0
 #: A fit that explains less than this of the variance is refused as not converged.
 MIN_R2 = 0.5
+#: An Ogden term whose stress stays below this fraction of the largest stress has collapsed.
+COLLAPSE = 1e-3
+#: A fit that reaches this many times the designs' top stretch is warned about.
+FAR_BEYOND = 1.5
 
 
 def _check_model(model, test):
@@ -141,7 +145,42 @@ def _ogden_starts(n_terms, lam, stress, test, rng, per_pattern):
             yield np.concatenate([mu, alpha]), signs
 
 
-def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="",
+def _window(max_stretch):
+    """(top stretch or None for the whole curve, how it was chosen) of ``max_stretch``."""
+    from ..materials import WALL_STRETCH_RANGE
+
+    if max_stretch is None or (isinstance(max_stretch, str) and max_stretch == "all"):
+        return None, "all"
+    if isinstance(max_stretch, str) and max_stretch == "design":
+        return float(WALL_STRETCH_RANGE[1]), "design"
+    if isinstance(max_stretch, str):
+        try:
+            max_stretch = float(max_stretch)
+        except ValueError:
+            raise InputError(f"--max-stretch: a stretch > 1, 'design' or 'all'; got "
+                             f"{max_stretch!r}") from None
+    return float(max_stretch), "given"
+
+
+def _collapsed(x, n_terms, lam, y, test):
+    """Indices of Ogden terms that carry (almost) nothing of the stress over the data.
+
+    A term collapses when its largest |mu_i (l^a_i - l^(k a_i))/l| over the fitted
+    stretches is below :data:`COLLAPSE` of the largest |stress|: the fit drove it to zero
+    (mu_i on its bound) and its exponent, then its interval, is undetermined.
+    """
+    mu, alpha = x[:n_terms], x[n_terms:]
+    _, dmu, _ = _ogden(lam, mu, alpha, test)
+    share = np.max(np.abs(dmu * mu[None, :]), axis=0) / max(float(np.max(np.abs(y))), 1e-300)
+    return [i for i in range(n_terms) if share[i] < COLLAPSE]
+
+
+def _bic(ssr, n, p):
+    """Bayesian information criterion of a least-squares fit, n ln(SSR/n) + p ln n."""
+    return n * np.log(max(ssr, 1e-300) / n) + p * np.log(n)
+
+
+def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch="design", name="",
                  starts=6, seed=0) -> FitResult:
     """Fit an incompressible hyperelastic law to a tensile test.
 
@@ -150,23 +189,30 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="
     data : str, Path or Table
         A data file (see :func:`nylonflex.calibration.read_table`) or a read table.
     model : str
-        ``ogden1``, ``ogden2``, ``ogden3``, ``neo_hookean`` or ``yeoh2``.
+        ``ogden1``, ``ogden2``, ``ogden3``, ``neo_hookean`` or ``yeoh2``. An Ogden term that
+        collapses (carries less than :data:`COLLAPSE` of the stress) is dropped, and the
+        form with one term fewer is reported when it fits as well by the BIC; the result's
+        ``model`` and ``notes`` say so.
     test : str
         ``uniaxial`` (tensile) or ``planar`` (pure shear).
-    max_stretch : float, optional
-        Fit only the points with stretch <= this [-], > 1.
+    max_stretch : float, "design" or "all"
+        Fit only the points with stretch <= this [-], > 1. ``"design"`` (the default): the
+        stretch the actuators' walls reach, :data:`nylonflex.materials.WALL_STRETCH_RANGE`;
+        ``"all"`` (or None): the whole curve.
     name : str
         Name of the fitted set.
     starts : int
         Starts per sign pattern of the Ogden exponents (>= 2).
     seed : int
-        Seed of the random starts and of a bootstrap.
+        Seed of the random starts.
 
     Returns
     -------
     FitResult
         ``parameters`` ``{"mu": [Pa], "alpha": [-]}`` (Ogden forms; neo-Hookean alpha = 2)
-        or ``{"c1": Pa, "c2": Pa}`` (Yeoh); ``derived["initial_shear_modulus"]`` [Pa].
+        or ``{"c1": Pa, "c2": Pa}`` (Yeoh); ``derived["initial_shear_modulus"]`` [Pa]. The
+        estimate and intervals allow for residuals correlated along the pull (an AR(1)
+        residual model, :func:`nylonflex.calibration._lsq.solve_ar1`).
 
     Raises
     ------
@@ -175,12 +221,44 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="
     """
     _check_model(model, test)
     table = data if isinstance(data, Table) else read_table(data)
+    top, how = _window(max_stretch)
+    lam_all, _ = silicone_data(table, None)
+    lam, stress = silicone_data(table, top)
+    notes = _window_notes(lam_all, lam, top, how)
+    res = _fit_form(table, lam, stress, model, test, top, starts, seed)
+    res.notes[:0] = notes
+    return _named(res, name)
+
+
+def _window_notes(lam_all, lam, top, how):
+    from ..materials import WALL_STRETCH_RANGE
+
+    design = float(WALL_STRETCH_RANGE[1])
+    notes = []
+    if how == "design" and lam_all[-1] > top:
+        notes.append(f"fitted stretch <= {top:g}, the window the designs use "
+                     f"(docs/model.md s. 5); {lam_all.size - lam.size} of {lam_all.size} "
+                     f"points beyond it left out (the data reaches {lam_all[-1]:.3g}); "
+                     "--max-stretch all fits the whole curve")
+    if lam[-1] > FAR_BEYOND * design:
+        notes.append(f"the fit reaches stretch {lam[-1]:.3g}, far beyond the designs' "
+                     f"{design:g}: its small-strain stiffness is set by stretches no wall "
+                     "reaches; --max-stretch design fits the designs' window")
+    return notes
+
+
+def _named(res, name):
+    res.name = name
+    return res
+
+
+def _fit_form(table, lam, stress, model, test, top, starts, seed):
+    """One form fitted (the ordinary least-squares optimum from many starts, then AR(1))."""
     path = table.path
-    lam, stress = silicone_data(table, max_stretch)
     n_terms = MODELS[model]
     n_par = 2 if model == "yeoh2" else (1 if model == "neo_hookean" else 2 * n_terms)
     if lam.size < n_par + 2:
-        raise InputError(f"{path}: {lam.size} points (stretch <= {max_stretch or 'any'}); "
+        raise InputError(f"{path}: {lam.size} points (stretch <= {top or 'any'}); "
                          f"{model} needs at least {n_par + 2}")
     scale = float(np.max(np.abs(stress))) or 1.0
     y = stress / scale
@@ -199,36 +277,78 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch=None, name="
 
         def jac(x):
             return _yeoh(lam, x, test)[1]
-        sol = solve(res, jac, [np.array([0.1, 0.0]), np.array([1.0, 0.01])],
-                    [0.0, -np.inf], [np.inf, np.inf], seed=seed)
+        lo, hi = np.array([0.0, -np.inf]), np.array([np.inf, np.inf])
+        sol = solve(res, jac, [np.array([0.1, 0.0]), np.array([1.0, 0.01])], lo, hi,
+                    bootstrap=0)
     elif model == "neo_hookean":
         def res(x):
             return _ogden(lam, x, np.array([2.0]), test)[0] - y
 
         def jac(x):
             return _ogden(lam, x, np.array([2.0]), test)[1]
-        sol = solve(res, jac, [np.array([0.1]), np.array([1.0])], [0.0], [np.inf], seed=seed)
+        lo, hi = np.array([0.0]), np.array([np.inf])
+        sol = solve(res, jac, [np.array([0.1]), np.array([1.0])], lo, hi, bootstrap=0)
     else:
+        res, jac = _res, _jac
         screened = []  # a short run from every start, then the best few run to the end
         for x0, signs in _ogden_starts(n_terms, lam, y, test, rng, max(starts, 2)):
-            lo = np.concatenate([np.where(signs > 0, 0.0, -np.inf),
-                                 np.where(signs > 0, _ALPHA_MIN, -_ALPHA_MAX)])
-            hi = np.concatenate([np.where(signs > 0, np.inf, 0.0),
-                                 np.where(signs > 0, _ALPHA_MAX, -_ALPHA_MIN)])
-            cand = solve(_res, _jac, [x0], lo, hi, bootstrap=0, max_nfev=400)
+            lo_s = np.concatenate([np.where(signs > 0, 0.0, -np.inf),
+                                   np.where(signs > 0, _ALPHA_MIN, -_ALPHA_MAX)])
+            hi_s = np.concatenate([np.where(signs > 0, np.inf, 0.0),
+                                   np.where(signs > 0, _ALPHA_MAX, -_ALPHA_MIN)])
+            cand = solve(_res, _jac, [x0], lo_s, hi_s, bootstrap=0, max_nfev=400)
             if cand is not None:
-                screened.append((float(cand.residuals @ cand.residuals), cand.x, lo, hi))
+                screened.append((float(cand.residuals @ cand.residuals), cand.x, lo_s, hi_s))
         screened.sort(key=lambda c: c[0])
-        sol = None
-        for _, x0, lo, hi in screened[:4]:
-            cand = solve(_res, _jac, [x0], lo, hi, seed=seed)
+        sol, lo, hi = None, None, None
+        for _, x0, lo_s, hi_s in screened[:4]:
+            cand = solve(_res, _jac, [x0], lo_s, hi_s, bootstrap=0)
             if cand is not None and (sol is None or cand.residuals @ cand.residuals <
                                      sol.residuals @ sol.residuals):
-                sol = cand
+                sol, lo, hi = cand, lo_s, hi_s
     if sol is None or not sol.converged or not np.all(np.isfinite(sol.x)):
         raise InputError(f"{path}: the {model} fit did not converge; try another --model "
                          "or --max-stretch")
-    return _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
+    if n_terms and n_terms > 1 and model.startswith("ogden"):
+        fewer = _fewer_terms(table, lam, stress, model, test, top, starts, seed, sol, y)
+        if fewer is not None:
+            return fewer
+    ar1 = solve_ar1(res, jac, sol.x, lo, hi)
+    if ar1 is None or not np.all(np.isfinite(ar1.x)):
+        raise InputError(f"{path}: the {model} fit did not converge; try another --model "
+                         "or --max-stretch")
+    return _silicone_result(ar1, model, test, lam, stress, scale, table, "", n_terms)
+
+
+def _fewer_terms(table, lam, stress, model, test, top, starts, seed, sol, y):
+    """The fit with fewer Ogden terms when terms collapsed or it fits as well (BIC)."""
+    n_terms = MODELS[model]
+    gone = _collapsed(sol.x, n_terms, lam, y, test)
+    k = max(len(gone), 1)
+    if k >= n_terms:
+        return None
+    fewer_model = f"ogden{n_terms - k}"
+    try:
+        fewer = _fit_form(table, lam, stress, fewer_model, test, top, starts, seed)
+    except InputError:
+        return None
+    n = lam.size
+    bic_n = _bic(float(sol.residuals @ sol.residuals) * (np.max(np.abs(stress))) ** 2, n,
+                 2 * n_terms)
+    bic_f = _bic(float(fewer.residuals @ fewer.residuals), n, 2 * (n_terms - k))
+    mu = sol.x[:n_terms] * float(np.max(np.abs(stress)))
+    if gone:
+        terms = ", ".join(f"term {i + 1} (mu = {mu[i]:.3g} Pa, alpha = "
+                          f"{sol.x[n_terms + i]:.3g})" for i in gone)
+        why = (f"{model}: {terms} collapsed (carries < {100 * COLLAPSE:g} % of the stress, "
+               f"its interval undetermined): dropped, reported as {fewer.model}")
+    elif bic_f <= bic_n:
+        why = (f"{model} fits no better than {fewer_model} by the BIC ({bic_n:.1f} against "
+               f"{bic_f:.1f}): reported as {fewer.model}")
+    else:
+        return None
+    fewer.notes.insert(0, why)
+    return fewer
 
 
 def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms):
@@ -254,6 +374,7 @@ def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
     ci = sol.ci95() * unit_scale[:, None]
     cov = sol.covariance * np.outer(unit_scale, unit_scale)
     g, g_se, g_ci = derived(sol, *mu0)
+    g_ci = (max(g_ci[0], 0.0), g_ci[1])  # mu_0 > 0: a stable silicone
     if model == "yeoh2":
         params = {"c1": value[0], "c2": value[1]}
         stderr = {"c1": se[0], "c2": se[1]}
@@ -272,9 +393,10 @@ def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
         raise InputError(f"{table.path}: the {model} fit did not converge to a usable "
                          f"solution (R^2 = {r2:.3g} < {MIN_R2}); is this a loading curve?")
     notes = []
-    if sol.method == "bootstrap":
-        notes.append("a parameter sits on its bound (a vanishing or extreme Ogden term): "
-                     "intervals from a residual bootstrap; consider fewer terms")
+    if sol.method == "ar1":
+        notes.append(f"intervals allow for residuals correlated along the pull: AR(1) "
+                     f"lag-1 correlation {sol.rho:.3g} (likely {sol.rho_set[0]:.3g}-"
+                     f"{sol.rho_set[1]:.3g}; the widest interval over that range)")
     return FitResult(
         kind="silicone", model=model, test=test, name=name, parameters=params,
         stderr=stderr, ci95=ci95, parameter_order=order, covariance=cov,

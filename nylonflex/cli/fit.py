@@ -8,6 +8,7 @@ HELP = "fit a silicone or nylon muscle set to bench data"
 DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
 as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md.
 
+  nylonflex fit silicone tests/data/ecoflex_0050.csv      # stretch <= 2, the designs' window
   nylonflex fit silicone tests/data/ecoflex_0050.csv --model ogden2 --max-stretch 4 \\
       --out fits/ecoflex50.yaml --chart fits/
   nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
@@ -25,7 +26,9 @@ def add_arguments(p):
                    help="silicone: ogden1|ogden2|ogden3|neo_hookean|yeoh2 (default ogden2)")
     p.add_argument("--test", default="uniaxial", choices=["uniaxial", "planar"],
                    help="silicone: the test (default uniaxial)")
-    p.add_argument("--max-stretch", type=float, help="silicone: fit stretch <= X only")
+    p.add_argument("--max-stretch", default="design", metavar="X|design|all",
+                   help="silicone: fit stretch <= X only; 'design' (default): the stretch "
+                   "the designs' walls reach (2); 'all': the whole curve")
     p.add_argument("--coil-index", type=float, help="stroke: coil index C of the muscle")
     p.add_argument("--voltage", help="thermal: step voltage, e.g. 5V")
     p.add_argument("--muscle-length", help="thermal: muscle length, e.g. 300mm (for lambda', c')")

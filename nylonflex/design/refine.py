@@ -12,6 +12,19 @@ The model is only piecewise smooth (the strength limit switches ``limit``), so t
 optimiser's answer is never trusted: it is re-evaluated exactly, and when it violates a
 constraint or is worse than its seed, the segment from the (feasible) seed to it is
 searched for the best point that meets every constraint.
+
+SLSQP, and the straight segment back to the seed, stop short of a curved constraint (at a
+small radius the bend-angle constraint binds, and the best wall sits exactly where the bend
+reaches its bound). So every refined design (or its seed, when SLSQP found nothing) is then
+pushed onto the constraints: along each free axis in turn, a 17-point scan of the axis's whole
+range, then five zooms around the best acceptable point (each 1/8 of the last window), until
+no axis improves (at most three sweeps); then SLSQP once more from there, and the push again.
+A move is kept only when it meets every constraint and the epsilon bounds and strictly
+improves the objective, so the result still weakly dominates its seed. Several objectives
+also get more starts where the grid front is sparse: between neighbouring grid-front designs
+in the second objective, the first is optimised with the second bounded by the midpoint.
+SLSQP is given ``range_fraction >= 1`` as ``range_fraction - nylon_use + 1 >= 1``: the same
+designs, but a constraint whose value falls towards the strength limit instead of staying 1.
 """
 
 from __future__ import annotations
@@ -28,6 +41,10 @@ _FD_STEP = 1e-6
 _MEMO_MAX = 200_000
 # bisection steps of the fall-back segment search
 _BISECT = 30
+# the push onto the active constraints: points of a 1-D scan, zooms, sweeps over the axes
+_PUSH_POINTS = 17
+_PUSH_ZOOMS = 6
+_PUSH_SWEEPS = 3
 
 
 class Model:
@@ -128,6 +145,11 @@ def _bounds(spec, ranges, fixed):
     return out
 
 
+def _full_range(c) -> bool:
+    """Whether a constraint asks for a full range of motion (``range_fraction >= 1``)."""
+    return c.name == "range_fraction" and c.op in (">=", ">") and c.value == 1.0
+
+
 class _Problem:
     """SLSQP's view: unit-scaled free axes, one primary objective, inequality functions."""
 
@@ -163,6 +185,12 @@ class _Problem:
         q = [self.primary.sign * rows[self.primary.name] / self.f_scale]
         for c, s in zip(self.conds, self.c_scale):
             x = rows[c.name]
+            if _full_range(c) and "nylon_use" in rows:
+                # range_fraction is 1 all over the stroke-limited side (no gradient to see
+                # the boundary coming); range_fraction - nylon_use + 1 is the same on the
+                # strength-limited side (nylon_use = 1) and 2 - nylon_use on the other,
+                # both 1 at the boundary: the same feasible set, with a gradient
+                x = x - rows["nylon_use"] + 1.0
             q.append((x - c.value) / s if c.op in (">=", ">", "==") else (c.value - x) / s)
         for (o, v), s in zip(self.eps, self.e_scale):
             q.append(o.sign * (v - rows[o.name]) / s)
@@ -254,6 +282,80 @@ def _improve(model, spec, bounds, fixed, seed_row, primary, eps, maxiter):
     return row
 
 
+def _acceptable_rows(spec, fixed, eps, rows):
+    """Mask: meets every constraint and keeps every epsilon bound."""
+    ok = meets(spec, rows, fixed)
+    for o, v in eps:
+        ok &= o.sign * rows[o.name] <= o.sign * v
+    return ok
+
+
+def _push(model, spec, bounds, fixed, row, primary, eps):
+    """The best acceptable design reached from ``row`` by moves along one axis at a time.
+
+    Per free axis: a scan of its whole range, then zooms around the best acceptable value,
+    so a constraint that binds is reached to about 1e-6 of the range. Returns ``row`` itself
+    when nothing improves it.
+    """
+    free = [a for a in AXES if bounds[a][1] > bounds[a][0] and a not in fixed]
+    x = np.array([float(row[a]) for a in AXES])
+    best, best_f = row, primary.sign * float(row[primary.name])
+    for _ in range(_PUSH_SWEEPS):
+        moved = False
+        for a in free:
+            k = AXES.index(a)
+            lo, hi = bounds[a]
+            w_lo, w_hi = lo, hi
+            for _ in range(_PUSH_ZOOMS):
+                t = np.linspace(w_lo, w_hi, _PUSH_POINTS)
+                X = np.repeat(x[None, :], len(t), axis=0)
+                X[:, k] = t
+                rows = model(X)
+                f = np.where(_acceptable_rows(spec, fixed, eps, rows),
+                             primary.sign * rows[primary.name], np.inf)
+                j = int(np.argmin(f))
+                if f[j] < best_f:
+                    x[k], best_f, best, moved = t[j], float(f[j]), _take1(rows, j), True
+                step = (w_hi - w_lo) / (_PUSH_POINTS - 1)
+                w_lo, w_hi = max(lo, x[k] - step), min(hi, x[k] + step)
+        if not moved:
+            break
+    return best
+
+
+def _refine_one(model, spec, bounds, fixed, seed, primary, eps):
+    """SLSQP, push, SLSQP, push from one seed: the best row, or None when nothing beats it."""
+    best = seed
+    for _ in range(2):
+        row = _improve(model, spec, bounds, fixed, best, primary, eps, spec.maxiter)
+        best = row if row is not None else best
+        best = _push(model, spec, bounds, fixed, best, primary, eps)
+    if not primary.sign * best[primary.name] < primary.sign * seed[primary.name]:
+        return None
+    return best
+
+
+def _sparse_targets(seeds, others, n_max):
+    """Extra (seed index, epsilon bounds) between neighbouring front designs (2 objectives).
+
+    Sorted by the second objective, each neighbour pair gets a start from the design that is
+    better in it, with the second objective bounded by the pair's midpoint.
+    """
+    if len(others) != 1 or n_max <= 0:
+        return []
+    o = others[0]
+    v = o.sign * np.asarray(seeds[o.name], float)
+    order = np.argsort(v, kind="stable")
+    gaps = [(v[order[i + 1]] - v[order[i]], int(order[i]), int(order[i + 1]))
+            for i in range(len(order) - 1) if v[order[i + 1]] > v[order[i]]]
+    gaps.sort(reverse=True)
+    out = []
+    for _, i, j in gaps[:n_max]:
+        mid = 0.5 * (float(seeds[o.name][i]) + float(seeds[o.name][j]))
+        out.append((i, [(o, mid)]))
+    return out
+
+
 def _take1(rows, k) -> dict:
     return {key: float(np.asarray(v)[k]) for key, v in rows.items()}
 
@@ -286,19 +388,22 @@ def refine(model, spec, scan, progress=None) -> list:
         pick = np.unique(np.linspace(0, n - 1, min(spec.starts, n)).round().astype(int))
     else:
         pick = np.arange(min(spec.starts, n))
+    tasks = [(int(i), None) for i in pick]
+    if others:
+        tasks += _sparse_targets(seeds, others, spec.starts)
     out = []
-    for done, i in enumerate(pick):
+    for done, (i, eps) in enumerate(tasks):
         if progress is not None:
-            progress(done, len(pick))
-        seed = _take1(seeds, int(i))
+            progress(done, len(tasks))
+        seed = _take1(seeds, i)
         if not meets(spec, {k: np.array([v]) for k, v in seed.items()}, scan.fixed)[0]:
             continue
-        eps = [(o, seed[o.name]) for o in others]
-        row = _improve(model, spec, bounds, scan.fixed, seed, primary, eps, spec.maxiter)
+        eps = [(o, seed[o.name]) for o in others] if eps is None else eps
+        row = _refine_one(model, spec, bounds, scan.fixed, seed, primary, eps)
         if row is not None:
             out.append(row)
     if progress is not None:
-        progress(len(pick), len(pick))
+        progress(len(tasks), len(tasks))
     if not others and out:
         out = [min(out, key=lambda r: primary.sign * r[primary.name])]
     return out

@@ -7,6 +7,8 @@ import io
 import json
 import math
 
+import numpy as np
+
 from ..query import COLUMNS, _cell
 from ..variables import VARIABLES, to_display
 
@@ -57,11 +59,29 @@ def summary(res) -> list:
                      "(refine is off)")
     elif not res.improvement:
         lines.append(f"grid front: {len(res.designs)} designs (refine is off)")
+    lines += _density(res)
     if res.dropped:
         lines.append(f"{res.dropped} design(s) dropped: exact re-evaluation broke "
                      "a constraint")
     lines.append(f"{res.evaluations} exact evaluations")
     return lines
+
+
+def _density(res) -> list:
+    """Two objectives: how densely the front covers the second, and its largest gap."""
+    if len(res.spec.objectives) != 2 or len(res.designs) < 2:
+        return []
+    name = res.spec.objectives[1].name
+    v = np.unique([d[name] for d in res.designs])
+    if len(v) < 2:
+        return []
+    gaps = np.diff(v)
+    k = int(np.argmax(gaps))
+    return [f"front density: {len(res.designs)} designs over {name} {_shown(name, v[0])} .. "
+            f"{_shown(name, v[-1])}, median gap {_shown(name, float(np.median(gaps)))}, "
+            f"largest gap {_shown(name, gaps[k])} (between {_shown(name, v[k])} and "
+            f"{_shown(name, v[k + 1])}); between neighbours the front is not searched and "
+            "a design there may beat the nearer front design"]
 
 
 def format_table(res) -> str:

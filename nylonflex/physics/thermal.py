@@ -14,14 +14,101 @@ from ..materials import nylon_parameters
 from ._formula import check, formula, scalar_or_array
 
 __all__ = [
+    "AIR_PROPERTIES",
     "MIN_SUPPLY_RISE",
     "check_supply_rise",
+    "coiled_resistance_per_length",
+    "free_convection_loss_per_length",
     "muscle_resistance",
     "steady_temperature",
     "temperature_rate",
     "temperature_step",
     "thermal_time_constant",
 ]
+
+
+#: Dry air at 1 atm: temperature [K], conductivity k [W/(m K)], kinematic viscosity nu [m^2/s],
+#: thermal diffusivity a [m^2/s], Prandtl number [-]. Incropera, DeWitt, Bergman & Lavine,
+#: Fundamentals of Heat and Mass Transfer, 6th ed., Table A.4; linear in between.
+AIR_PROPERTIES = {
+    "t": (300.0, 350.0, 400.0, 450.0),
+    "k": (26.3e-3, 30.0e-3, 33.8e-3, 37.3e-3),
+    "nu": (15.89e-6, 20.92e-6, 26.41e-6, 32.39e-6),
+    "a": (22.5e-6, 29.9e-6, 38.3e-6, 47.2e-6),
+    "pr": (0.707, 0.700, 0.690, 0.686),
+}
+_G = 9.80665  # [m/s^2]
+_SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m^2 K^4)]
+
+
+def free_convection_loss_per_length(diameter, t_surface, t_amb, emissivity=0.0):
+    """Heat loss per length of a horizontal cylinder in still air, lambda' [W/(K m)].
+
+    Free convection by the Churchill-Chu correlation for a horizontal cylinder (S. W.
+    Churchill and H. H. S. Chu, Int. J. Heat Mass Transfer 18:1049-1053, 1975; valid for
+    Ra_D <= 1e12, down to the conduction limit Nu_D -> 0.36)::
+
+        Nu_D = {0.60 + 0.387 Ra_D^(1/6) / [1 + (0.559/Pr)^(9/16)]^(8/27)}^2
+        Ra_D = g beta (T_s - T_amb) D^3 / (nu a),  beta = 1/T_f
+
+    with the air's properties (:data:`AIR_PROPERTIES`) at the film temperature T_f =
+    (T_s + T_amb)/2; lambda' = h pi D = pi k Nu_D. Radiation to surroundings at T_amb adds
+    emissivity sigma (T_s^2 + T_amb^2)(T_s + T_amb) pi D (0 by default: docs/model.md s. 9).
+
+    Parameters
+    ----------
+    diameter : float
+        Outer diameter of the cylinder D [m], > 0 (a coiled muscle: d_f (C + 1)).
+    t_surface, t_amb : float
+        Surface and ambient temperature [K], T_s > T_amb, T_f within 300-450 K.
+    emissivity : float
+        Surface emissivity [-], 0-1.
+
+    Returns
+    -------
+    float
+        lambda' [W/(K m)].
+    """
+    d = float(diameter)
+    ts, ta = float(t_surface), float(t_amb)
+    if not d > 0:
+        raise ValueError(f"diameter: must be > 0 m, got {d:g}")
+    if not ts > ta > 0:
+        raise ValueError(f"t_surface: must be above t_amb > 0 K, got {ts:g} and {ta:g}")
+    if not 0.0 <= emissivity <= 1.0:
+        raise ValueError(f"emissivity: must be in [0, 1], got {emissivity:g}")
+    tf = 0.5 * (ts + ta)
+    t = AIR_PROPERTIES["t"]
+    if not t[0] <= tf <= t[-1]:
+        raise ValueError(f"film temperature (t_surface + t_amb)/2: must be in [{t[0]:g}, "
+                         f"{t[-1]:g}] K (the air table), got {tf:g}")
+    k, nu, a, pr = (float(np.interp(tf, t, AIR_PROPERTIES[q])) for q in ("k", "nu", "a", "pr"))
+    ra = _G * (ts - ta) / tf * d**3 / (nu * a)
+    nu_d = (0.60 + 0.387 * ra ** (1 / 6) / (1 + (0.559 / pr) ** (9 / 16)) ** (8 / 27)) ** 2
+    radiation = emissivity * _SIGMA * (ts * ts + ta * ta) * (ts + ta) * np.pi * d
+    return float(np.pi * k * nu_d + radiation)
+
+
+def coiled_resistance_per_length(thread_resistance_per_length, coil_index):
+    """Resistance per muscle length of a close-wound coil of a thread, r' [ohm/m].
+
+    A coil of touching turns (pitch = d_f) of mean diameter C d_f holds
+    sqrt((pi C)^2 + 1) of thread per length of muscle (the helix's length per turn over its
+    pitch), so r' = r'_thread sqrt((pi C)^2 + 1): 3.6 times the thread's at C = 1.1, 5.4 at
+    1.7. Not used by the named sets (docs/model.md s. 9: the paper's r' is measured on its
+    muscle, the thread's is not given).
+
+    Parameters
+    ----------
+    thread_resistance_per_length : float or array
+        Resistance per length of the straight (twisted) thread [ohm/m], > 0.
+    coil_index : float or array
+        Coil index C [-], > 0.
+    """
+    r = check("thread_resistance_per_length", thread_resistance_per_length, 0.0,
+              lo_open=True, unit="ohm/m")
+    c = check("coil_index", coil_index, 0.0, lo_open=True)
+    return scalar_or_array(r * np.sqrt((np.pi * c) ** 2 + 1.0))
 
 
 @formula
