@@ -36,6 +36,7 @@ COMMANDS = {
     "sensitivity": "sensitivity",
     "explore": "explore",
     "fe": "fe",
+    "verify": "verify",
 }
 
 

@@ -35,6 +35,9 @@ def run(args) -> int:
     lines = cube_summary(args.cube)
     for line in lines:
         print(line)
+    fidelity = _fidelity_lines(args.cube)
+    for line in fidelity:
+        print(line)
     damaged = any(line.startswith("damaged ") for line in lines)
     if args.check:
         from ._common import progress_bar
@@ -47,3 +50,24 @@ def run(args) -> int:
               if problems else "check     every chunk of every variable read")
         damaged = damaged or bool(problems)
     return 1 if damaged else 0
+
+
+def _fidelity_lines(cube) -> list[str]:
+    """The fidelity dataset beside the cube (``nylonflex verify``), summarised, if any."""
+    from pathlib import Path
+
+    from ..fe.verify import fidelity_path, fidelity_summary
+
+    path = fidelity_path(cube)
+    if not Path(path).is_file():
+        return []
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as fid:
+            fid.load()
+    except (OSError, ValueError) as exc:
+        return [f"fidelity  {path}: unreadable ({type(exc).__name__})"]
+    head = (f"fidelity  {path.name}: {fid.sizes.get('design', 0)} designs, FE mesh "
+            f"{fid.attrs.get('fe_mesh', '?')} (nylonflex verify)")
+    return [head] + [f"          {line}" for line in fidelity_summary(fid)]

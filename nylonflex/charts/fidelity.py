@@ -1,0 +1,79 @@
+"""The fidelity map: each variant's bend angle over the FE twin's, across two design axes.
+
+Drawn from the fidelity dataset ``nylonflex verify`` writes beside a cube
+(:mod:`nylonflex.fe.verify`), never from physics. One panel a model: the sampled designs
+coloured by model/FE (1 is exact; below 1 the model bends too little), the 10 % and 25 %
+bands outlined where three or more designs allow a triangulation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..variables import display_label, to_display
+from ._common import _figure
+
+__all__ = ["fidelity_map"]
+
+#: The bands drawn: |model/FE - 1| = 0.10 and 0.25.
+BANDS = (0.10, 0.25)
+
+
+def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None):
+    """Model/FE bend-angle ratio of every sampled design over axes ``x`` and ``y``.
+
+    Parameters
+    ----------
+    fid : xarray.Dataset
+        A fidelity dataset (``nylonflex verify``).
+    x, y : str
+        Design axes (radius, wall_thickness, length, coil_index, wrap_angle).
+    level : float, optional
+        The fraction of each design's p* to show (default the largest, p* itself).
+    models : sequence of str, optional
+        Models to draw (default every one in the dataset).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.colors as mcolors
+    from matplotlib.tri import Triangulation
+
+    models = list(fid["model"].values) if models is None else list(models)
+    lv = float(fid["level"].values.max()) if level is None else float(level)
+    fig, axes = _figure(1, len(models), size=(4.2 * len(models), 3.9))
+    xs = np.asarray(to_display(x, fid[x].values), dtype=float)
+    ys = np.asarray(to_display(y, fid[y].values), dtype=float)
+    norm = mcolors.TwoSlopeNorm(vmin=0.4, vcenter=1.0, vmax=1.6)
+    mappable = None
+    for ax, model in zip(axes[0], models):
+        r = fid["ratio"].sel(model=model).sel(level=lv, method="nearest").values.astype(float)
+        ok = np.isfinite(r)
+        if ok.sum() >= 3 and np.ptp(xs[ok]) > 0 and np.ptp(ys[ok]) > 0:
+            try:
+                tri = Triangulation(xs[ok], ys[ok])
+                levels = sorted({1 - b for b in BANDS} | {1 + b for b in BANDS})
+                cs = ax.tricontour(tri, r[ok], levels=levels, colors="0.25",
+                                   linewidths=[1.2, 0.8, 0.8, 1.2], linestyles=
+                                   ["--", "-", "-", "--"])
+                ax.clabel(cs, fmt=lambda v: f"{v:.2f}", fontsize=7)
+            except (ValueError, RuntimeError):
+                pass  # collinear designs: no triangulation, points only
+        mappable = ax.scatter(xs[ok], ys[ok], c=r[ok], cmap="RdBu", norm=norm, s=42,
+                              edgecolors="0.2", linewidths=0.5)
+        if (~ok).any():
+            ax.scatter(xs[~ok], ys[~ok], marker="x", color="0.5", s=30, label="no FE angle")
+        within = np.mean(np.abs(r[ok] - 1) <= BANDS[0]) * 100 if ok.any() else 0.0
+        med = np.median(r[ok]) if ok.any() else float("nan")
+        ax.set_title(f"{model}\nmedian {med:.2f}, {within:.0f} % within 10 %")
+        ax.margins(0.06)
+        ax.set_xlabel(display_label(x))
+        ax.set_ylabel(display_label(y))
+        ax.grid(alpha=0.3)
+    cbar = fig.colorbar(mappable, ax=axes[0].tolist(), shrink=0.9)
+    cbar.set_label("model / FE bend angle [1]")
+    fig.suptitle(f"Model / FE bend angle: {fid.sizes['design']} designs at {lv:g} of their p*, "
+                 f"FE mesh {fid.attrs.get('fe_mesh', '?')}; lines at 0.75, 0.9, 1.1, 1.25",
+                 fontsize=10)
+    return fig

@@ -1,0 +1,66 @@
+"""``nylonflex verify CUBE``: the FE twin on a sample of the cube's designs."""
+
+from __future__ import annotations
+
+import sys
+
+HELP = "hold a cube's models against the FE twin (needs the [fe] extra)"
+DESCRIPTION = """\
+Sample designs over the cube's axes (the paper's examples among them where the cube holds
+them), solve each with the finite-element twin at half and all of the pressure it reaches,
+and write a fidelity dataset beside the cube (<cube>.fidelity.nc): every variant's bend
+angle over the FE's, per design and pressure. Each FE run is journaled: a killed verify
+resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map."""
+
+
+def _designs(text):
+    from ..units import InputError
+
+    try:
+        return int(text)
+    except ValueError:
+        raise InputError(f"--designs: must be an integer, got {text!r}") from None
+
+
+def add_arguments(p):
+    p.add_argument("cube")
+    p.add_argument("--designs", type=_designs, default=24, metavar="N",
+                   help="designs to sample (default 24, at most 500)")
+    p.add_argument("--workers", type=_designs, default=1, metavar="N",
+                   help="local processes, one FE run each (default 1)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="a Dask scheduler (tcp://HOST:PORT): the runs go to its workers")
+    p.add_argument("--mesh", default="default", metavar="coarse|default|fine")
+    p.add_argument("--seed", type=_designs, default=0, help="the sample's seed (default 0)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args) -> int:
+    import time
+
+    import xarray as xr
+
+    from ..charts.fidelity import fidelity_map
+    from ..fe import require_felupe
+    from ..fe.verify import fidelity_summary, run_verify
+    from ..files import save_figure
+    from ._common import progress_bar
+
+    require_felupe()
+    start = time.monotonic()
+    with progress_bar("verify", unit="design", quiet=args.quiet, delay=0.0) as bar:
+        path = run_verify(args.cube, args.designs, workers=args.workers,
+                          scheduler=args.scheduler, mesh=args.mesh, seed=args.seed,
+                          progress=bar,
+                          log=lambda m: print(f"nylonflex verify: {m}", file=sys.stderr))
+    with xr.open_dataset(path, engine="h5netcdf") as fid:
+        fid.load()
+    chart = path.with_name(path.name.removesuffix(".nc") + "_map.png")
+    save_figure(fidelity_map(fid), chart, what="verify", inputs=(args.cube,), dpi=130)
+    print(f"fidelity  {path} ({fid.sizes['design']} designs x {fid.sizes['level']} "
+          f"pressures, mesh {fid.attrs['fe_mesh']}, {time.monotonic() - start:.0f} s)")
+    print(f"map       {chart}")
+    for line in fidelity_summary(fid):
+        print(f"  {line}")
+    return 0
+

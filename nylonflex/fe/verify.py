@@ -1,0 +1,271 @@
+"""``nylonflex verify``: the FE twin on a space-filling sample of a cube's designs.
+
+For each sampled design the FE twin solves the body at the pressures the design reaches
+(half and all of its p*, from the cube's own model and materials) and every variant's
+analytic angle is set beside it. Each FE run is journaled as its own file in
+``<cube>.fidelity.parts/`` (written whole, then renamed), so a killed verify resumes with
+the runs still to do; the result is a fidelity dataset ``<cube stem>.fidelity.nc`` beside the
+cube: per design and pressure, the FE angle, its discretisation error and each variant's
+ratio to FE, with provenance.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..units import InputError
+
+__all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
+           "fidelity_summary", "run_verify", "sample_designs"]
+
+#: The variants whose bend angle at a given pressure differs (the others change the
+#: muscle's side only): the ones the fidelity dataset compares.
+ANGLE_MODELS = ("paper", "cauchy_moment", "lateral_pressure")
+#: The paper's worked examples (docs/model.md s. 8), included when the cube's axes hold them.
+PAPER_EXAMPLES = ({"radius": 20e-3, "wall_thickness": 6e-3, "length": 90e-3,
+                   "coil_index": 1.1, "wrap_angle": np.radians(8.0)},
+                  {"radius": 7.5e-3, "wall_thickness": 2e-3, "length": 70e-3,
+                   "coil_index": 1.7, "wrap_angle": np.radians(8.0)})
+#: Accepted --designs.
+MAX_DESIGNS = 500
+#: Fractions of each design's p* the FE is solved at.
+FRACTIONS = (0.5, 1.0)
+
+AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
+
+
+def fidelity_path(cube) -> Path:
+    """The fidelity dataset of a cube: ``<stem>.fidelity.nc`` beside it."""
+    cube = Path(cube)
+    return cube.with_name(cube.stem + ".fidelity.nc")
+
+
+def _parts(cube) -> Path:
+    cube = Path(cube)
+    return cube.with_name(cube.name + ".fidelity.parts")
+
+
+def sample_designs(ds, n, seed=0) -> list[dict]:
+    """``n`` designs filling the cube's axes (a scrambled Latin hypercube, scipy), the
+    paper's examples first where the axes hold them; each a dict of the five axes [SI]."""
+    from scipy.stats import qmc
+
+    lo = {a: float(ds[a].min()) for a in AXES}
+    hi = {a: float(ds[a].max()) for a in AXES}
+    out = [dict(e) for e in PAPER_EXAMPLES
+           if all(lo[a] * (1 - 1e-9) <= e[a] <= hi[a] * (1 + 1e-9) for a in AXES)][:n]
+    rest = n - len(out)
+    if rest > 0:
+        u = qmc.LatinHypercube(d=len(AXES), seed=seed).random(rest)
+        for row in u:
+            out.append({a: lo[a] + row[k] * (hi[a] - lo[a]) for k, a in enumerate(AXES)})
+    return out
+
+
+def _plan(ds, attrs, n, seed, mesh):
+    from ..engine import evaluate
+    from ..engine.provenance import evaluate_settings
+
+    settings = evaluate_settings(attrs)
+    model = settings.get("model", "paper")
+    if isinstance(model, list):
+        settings["model"] = model[0]
+    designs = sample_designs(ds, n, seed)
+    arr = {a: np.array([d[a] for d in designs]) for a in AXES}
+    res = evaluate(arr["radius"], arr["wall_thickness"], arr["length"], arr["coil_index"],
+                   arr["wrap_angle"], **settings)
+    runs = []
+    for k, d in enumerate(designs):
+        p_star = float(res["pressure_max"][k])
+        runs.append({**d, "pressures": [f * p_star for f in FRACTIONS],
+                     "base_thickness": settings.get("base_thickness")})
+    sil = settings["silicone"]
+    return {"designs": runs, "mesh": mesh, "seed": int(seed), "model": settings["model"],
+            "silicone": {"name": getattr(sil, "name", "custom"),
+                         "mu": [float(m) for m in sil.mu],
+                         "alpha": [float(a) for a in sil.alpha]},
+            "cube_config_sha256": str(attrs.get("config_sha256", ""))}
+
+
+def _silicone(sil):
+    """The plan's Ogden constants as a silicone nylonflex accepts (a set with its fields
+    replaced: only mu and alpha enter the FE and the angles)."""
+    return {"set": "tc5005", "mu": list(sil["mu"]), "alpha": list(sil["alpha"])}
+
+
+def _solve(task):
+    """One FE run (a task of the executor): the design's angles and error estimates."""
+    from . import fe_bend
+
+    d, sil, mesh = task
+    silicone = _silicone(sil)
+    res = fe_bend(d["radius"], d["wall_thickness"], d["length"], d["pressures"],
+                  base_thickness=d["base_thickness"], silicone=silicone, mesh=mesh)
+    return {"bend_angle": res["bend_angle"].tolist(),
+            "discretisation_error": res["discretisation_error"].tolist()}
+
+
+def _map(tasks, workers, scheduler):
+    """Yield (index, result) as the tasks finish: local processes, or a Dask cluster."""
+    if scheduler:
+        try:
+            from distributed import Client, as_completed
+        except ImportError:
+            raise InputError("--scheduler: needs dask's distributed: pip install "
+                             "'nylonflex[dask]'") from None
+        with Client(scheduler, timeout=30, set_as_default=False) as client:
+            futures = {client.submit(_solve, t, pure=False): i for i, t in tasks}
+            for fut in as_completed(futures):
+                yield futures[fut], fut.result()
+        return
+    if workers <= 1:
+        for i, t in tasks:
+            yield i, _solve(t)
+        return
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
+        futures = {ex.submit(_solve, t): i for i, t in tasks}
+        for fut in as_completed(futures):
+            yield futures[fut], fut.result()
+
+
+def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", seed=0,
+               progress=None, log=None) -> Path:
+    """Verify a cube against the FE twin; returns the fidelity dataset's path.
+
+    Parameters
+    ----------
+    cube : path
+        A finished cube (``nylonflex sweep``).
+    designs : int
+        Designs to sample, 1 to :data:`MAX_DESIGNS` (the paper's examples among them where
+        the cube holds them).
+    workers : int
+        Local processes (each FE run is one process; FElupe holds the GIL).
+    scheduler : str, optional
+        A Dask scheduler's address: the runs go to its workers instead.
+    mesh : str
+        The FE mesh level (:data:`nylonflex.fe.MESH_NAMES`).
+    progress : callable, optional
+        ``progress(done, total)`` after each FE run.
+    log : callable, optional
+        One-line messages (resumed runs).
+    """
+    import xarray as xr
+
+    from .. import __version__
+    from ..files import write_atomic
+    from ..engine import bend_angle
+    from ..storage import open_cube
+    from . import MESH_NAMES, require_felupe
+
+    if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
+        raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
+                         f"got {designs!r}")
+    if not isinstance(workers, int) or not 1 <= workers <= 64:
+        raise InputError(f"--workers: must be an integer in [1, 64], got {workers!r}")
+    if mesh not in MESH_NAMES:
+        raise InputError(f"--mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    require_felupe()
+    cube = Path(cube)
+    ds = open_cube(cube)
+    try:
+        plan = _plan(ds, ds.attrs, designs, seed, mesh)
+    finally:
+        ds.close()
+    parts = _parts(cube)
+    if parts.is_symlink():
+        raise InputError(f"{parts}: is a symbolic link; nylonflex does not write through links")
+    parts.mkdir(exist_ok=True)
+    plan_file = parts / "plan.json"
+    text = json.dumps(plan, sort_keys=True, indent=1)
+    if plan_file.exists() and not plan_file.is_symlink():
+        if plan_file.read_text() != text:
+            raise InputError(f"{parts}: holds the runs of another verify (other designs, "
+                             f"mesh or cube); delete it to start again")
+    else:
+        write_atomic(plan_file, text.encode(), what="verify")
+    sil = plan["silicone"]
+    done = {}
+    for k in range(len(plan["designs"])):
+        f = parts / f"design-{k:04d}.json"
+        if f.is_file() and not f.is_symlink():
+            try:
+                done[k] = json.loads(f.read_text())
+            except ValueError:
+                pass  # a damaged run is solved again
+    if done and log is not None:
+        log(f"resuming: {len(done)} of {len(plan['designs'])} FE runs already done")
+    todo = [(k, (d, sil, mesh)) for k, d in enumerate(plan["designs"]) if k not in done]
+    total = len(plan["designs"])
+    if progress is not None:
+        progress(len(done), total)
+    for k, res in _map(todo, workers, scheduler):
+        write_atomic(parts / f"design-{k:04d}.json", json.dumps(res).encode(), what="verify")
+        done[k] = res
+        if progress is not None:
+            progress(len(done), total)
+    # the dataset: design x level (the fractions of p*)
+    n, m = total, len(FRACTIONS)
+    rows = plan["designs"]
+    coords = {"design": np.arange(n), "level": np.array(FRACTIONS)}
+    data = {a: ("design", np.array([r[a] for r in rows])) for a in AXES}
+    pressure = np.array([r["pressures"] for r in rows])
+    fe = np.array([done[k]["bend_angle"] for k in range(n)])
+    err = np.array([done[k]["discretisation_error"] for k in range(n)])
+    data["pressure"] = (("design", "level"), pressure)
+    data["fe_bend_angle"] = (("design", "level"), fe)
+    data["discretisation_error"] = (("design", "level"), err)
+    ratios = []
+    for model in ANGLE_MODELS:
+        ang = np.array([np.atleast_1d(bend_angle(pressure[k], r["radius"], r["wall_thickness"],
+                                                 r["length"], base_thickness=r["base_thickness"],
+                                                 silicone=_silicone(sil), model=model)) for k, r in enumerate(rows)])
+        data[f"{model}_bend_angle"] = (("design", "level"), ang)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratios.append(np.where(fe > 0, ang / fe, np.nan))
+    coords["model"] = np.array(ANGLE_MODELS)
+    data["ratio"] = (("model", "design", "level"), np.array(ratios))
+    out = xr.Dataset(data, coords=coords)
+    units = {"radius": "m", "wall_thickness": "m", "length": "m", "coil_index": "1",
+             "wrap_angle": "rad", "pressure": "Pa", "fe_bend_angle": "rad",
+             "discretisation_error": "1", "ratio": "1", "level": "1"}
+    for name in out.variables:
+        if name in units:
+            out[name].attrs["units"] = units[name]
+        elif name.endswith("_bend_angle"):
+            out[name].attrs["units"] = "rad"
+    out["ratio"].attrs["long_name"] = "analytic bend angle / FE bend angle"
+    out["level"].attrs["long_name"] = "fraction of the design's pressure_max"
+    out["fe_bend_angle"].attrs["long_name"] = "FE bend angle"
+    out.attrs.update({"title": "nylonflex fidelity: the FE twin against the analytic models",
+                      "nylonflex_version": __version__, "fe_mesh": mesh, "seed": seed,
+                      "cube": cube.name, "cube_config_sha256": plan["cube_config_sha256"],
+                      "model_of_cube": plan["model"], "silicone": json.dumps(sil),
+                      "Conventions": "CF-1.8"})
+    path = fidelity_path(cube)
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+    out.to_netcdf(tmp, engine="h5netcdf")
+    os.replace(tmp, path)
+    return path
+
+
+def fidelity_summary(fid) -> list[str]:
+    """One line a model of a fidelity dataset: model/FE over every design and pressure."""
+    out = []
+    for model in fid["model"].values:
+        r = fid["ratio"].sel(model=model).values.ravel()
+        r = r[np.isfinite(r)]
+        if not r.size:
+            continue
+        within = np.mean(np.abs(r - 1) <= 0.1) * 100
+        out.append(f"{model:<17} model/FE median {np.median(r):.3f}, range "
+                   f"{r.min():.3f}-{r.max():.3f}, within 10 %: {within:.0f} % "
+                   f"({r.size} FE angles)")
+    return out
