@@ -1,0 +1,85 @@
+"""Issue 25's papercuts, one test each: what a user types and what nylonflex says back."""
+
+import pytest
+import yaml
+from conftest import write_cube
+
+from nylonflex.cli import main
+from nylonflex.config import parse_config
+from nylonflex.config.sweep import apply_overrides
+from nylonflex.units import InputError
+
+ONE = {
+    "name": "one",
+    "grid": {
+        "radius": {"values": [7.5], "units": "mm"},
+        "wall_thickness": {"values": [2], "units": "mm"},
+        "length": {"values": [70], "units": "mm"},
+        "coil_index": {"values": [1.7]},
+        "wrap_angle": {"values": [8], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+               "pressure": {"start": 0, "stop": 20, "num": 3, "units": "kPa"}},
+}
+
+
+def run(capsys, *argv):
+    rc = main([*map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def one_cube(tmp_path_factory):
+    return write_cube(tmp_path_factory.mktemp("one"), ONE)
+
+
+def test_set_a_field_of_a_named_material_set_overrides_it():
+    raw = apply_overrides({**ONE, "silicone": "tc5005"}, ["silicone.mu=[50000, 10000]"])
+    assert raw["silicone"] == {"set": "tc5005", "mu": [50000, 10000]}
+    assert parse_config(raw).silicone.mu == (50e3, 10e3)
+    with pytest.raises(InputError, match=r"--set 'name.x': 'name' is 'one', not a mapping "
+                                         r"with fields; set it whole instead"):
+        apply_overrides(ONE, ["name.x=3"])
+
+
+@pytest.mark.parametrize("typo, right", [("gird", "grid"), ("curvse", "curves")])
+def test_a_misspelt_key_is_named_as_the_misspelling(typo, right):
+    raw = {k if k != right else typo: v for k, v in ONE.items()}
+    with pytest.raises(InputError, match=rf"^{typo}: unknown key; did you mean '{right}'\?$"):
+        parse_config(raw)
+
+
+def test_missing_curves_says_what_they_are():
+    raw = {k: v for k, v in ONE.items() if k != "curves"}
+    with pytest.raises(InputError, match=r"curves: missing key; every sweep needs its curve "
+                                         r"axes, e.g. curves: \{stroke:"):
+        parse_config(raw)
+
+
+def test_chart_figure_before_the_cube(one_cube, tmp_path, capsys):
+    rc, out, err = run(capsys, "chart", "--figure", "fig4", one_cube, "--out", tmp_path,
+                       "--quiet")
+    assert rc == 0 and (tmp_path / "fig4.png").exists(), err
+    rc, _, err = run(capsys, "chart", "--figure", "fig4", "--quiet")
+    assert rc == 2 and "cube: give the cube to draw" in err
+
+
+def test_a_named_figure_that_cannot_be_drawn_is_a_failure(one_cube, tmp_path, capsys):
+    # one radius: fig12b draws maximum torque against radius, so it needs two or more
+    rc, out, err = run(capsys, "chart", one_cube, "--figure", "fig12b", "fig4", "--out",
+                       tmp_path, "--quiet")
+    assert rc == 1 and "fig12b skipped: it needs at least 2 values of radius" in err
+    assert "1 of the 2 figure(s) asked for could not be drawn" in err
+    assert (tmp_path / "fig4.png").exists() and not (tmp_path / "fig12b.png").exists()
+
+
+def test_explore_html_without_the_extra_says_how_to_install(one_cube, tmp_path, capsys,
+                                                            monkeypatch):
+    from nylonflex.cli import explore
+
+    monkeypatch.setattr(explore, "_has", lambda module: False)
+    rc, out, err = run(capsys, "explore", one_cube, "--html", tmp_path / "x.html")
+    assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
+    assert "pip install 'nylonflex[explore]'" in err and "Traceback" not in err
+    assert not (tmp_path / "x.html").exists()
