@@ -83,3 +83,21 @@ def test_explore_html_without_the_extra_says_how_to_install(one_cube, tmp_path, 
     assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
     assert "pip install 'nylonflex[explore]'" in err and "Traceback" not in err
     assert not (tmp_path / "x.html").exists()
+
+
+def test_every_doc_the_code_and_docs_cite_exists():
+    # issue 25: twelve docstrings cited an INTERFACE.md the repository did not have
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    texts = [*root.joinpath("nylonflex").rglob("*.py"), root / "README.md",
+             *root.joinpath("docs").glob("*.md")]
+    cited = set()
+    for path in texts:
+        text = path.read_text(encoding="utf-8")
+        assert "INTERFACE.md" not in text, path
+        cited |= set(re.findall(r"\bdocs/[a-z_]+\.md\b", text))
+    assert "docs/interface.md" in cited
+    missing = sorted(c for c in cited if not (root / c).exists())
+    assert not missing, missing

@@ -46,7 +46,7 @@ def _module(name):
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser of every ``nylonflex`` command (INTERFACE.md).
+    """The parser of every ``nylonflex`` command (docs/interface.md).
 
     ``command``: only that command's arguments are added (the others are listed by name
     and help line only, which is all ``--help`` and ``--version`` need), so a command

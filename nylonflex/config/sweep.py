@@ -117,7 +117,7 @@ class Limits(_Strict):
 
 
 class SweepConfig(_Strict):
-    """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
+    """The sweep config of docs/interface.md, as typed (not yet resolved to SI)."""
 
     name: str
     silicone: Union[str, dict[str, Any]] = "tc5005"

@@ -173,7 +173,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
                   supply_voltage=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
-    The compiled :func:`evaluate` with INTERFACE.md's positional signature: floats (and an
+    The compiled :func:`evaluate` with docs/interface.md's positional signature: floats (and an
     int ``limit``) for scalar input, arrays of the broadcast shape otherwise. Arguments,
     units and errors as :func:`evaluate`; docs/model.md s. 8.
     """
