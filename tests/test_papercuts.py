@@ -1,5 +1,6 @@
 """Issue 25's papercuts, one test each: what a user types and what nylonflex says back."""
 
+import numpy as np
 import pytest
 import yaml
 from conftest import write_cube
@@ -101,3 +102,21 @@ def test_every_doc_the_code_and_docs_cite_exists():
     assert "docs/interface.md" in cited
     missing = sorted(c for c in cited if not (root / c).exists())
     assert not missing, missing
+
+
+def test_settled_error_at_the_end_of_each_reference_level():
+    from nylonflex.simulate import settled_errors
+
+    t = np.arange(6.0)
+    ref = np.array([0, 0, 1, 1, 1, 2.0])   # levels end at indices 1, 4 and 5
+    angle = np.array([0, 0.1, 0.2, 0.5, 0.9, 1.5])
+    np.testing.assert_allclose(settled_errors(t, angle, ref), [0.1, 0.1, 0.5])
+
+
+@pytest.mark.parametrize("name", ["step", "gripper"])
+def test_simulate_step_and_gripper_report_a_settled_error_not_an_rms(name, tmp_path, capsys):
+    from pathlib import Path
+
+    config = Path(__file__).resolve().parents[1] / "configs" / f"{name}.yaml"
+    rc, out, _ = run(capsys, "simulate", config, "--out", tmp_path / "sim.h5", "--no-charts")
+    assert rc == 0 and "settled error" in out and "RMS error" not in out
