@@ -120,3 +120,19 @@ def test_simulate_step_and_gripper_report_a_settled_error_not_an_rms(name, tmp_p
     config = Path(__file__).resolve().parents[1] / "configs" / f"{name}.yaml"
     rc, out, _ = run(capsys, "simulate", config, "--out", tmp_path / "sim.h5", "--no-charts")
     assert rc == 0 and "settled error" in out and "RMS error" not in out
+
+
+def test_validate_prints_the_rmse_in_the_datas_units(tmp_path, capsys):
+    # bend angles read in deg: the table's RMSE in deg (JSON stays SI, with its unit)
+    import math
+    from pathlib import Path
+
+    from nylonflex.calibration.validate import validate_design
+
+    control = Path(__file__).resolve().parents[1] / "configs" / "control.yaml"
+    data = tmp_path / "fig6.csv"
+    data.write_text("pressure [kPa],bend_angle [deg]\n0,0\n5,10\n10,25\n15,45\n20,70\n")
+    (c,) = validate_design(control, data)
+    assert c.quantity == "bend_angle" and c.unit == "rad"
+    rc, out, _ = run(capsys, "validate", control, data)
+    assert rc == 0 and f"RMSE {math.degrees(c.rmse):.4g} deg" in out and " rad " not in out
