@@ -136,3 +136,19 @@ def test_validate_prints_the_rmse_in_the_datas_units(tmp_path, capsys):
     assert c.quantity == "bend_angle" and c.unit == "rad"
     rc, out, _ = run(capsys, "validate", control, data)
     assert rc == 0 and f"RMSE {math.degrees(c.rmse):.4g} deg" in out and " rad " not in out
+
+
+def test_fit_thermal_prints_tau_once_and_temperatures_in_degc(tmp_path, capsys):
+    # a noiseless eq. (3) step from 25 degC (the set's ambient) with tau = c'/lambda' = 15 s
+    from nylonflex.physics import steady_temperature, thermal_time_constant
+
+    tau, t_ss = thermal_time_constant(), steady_temperature(5.0, 0.3) - 273.15
+    t = np.linspace(0.0, 5 * tau, 40)
+    data = tmp_path / "thermal.csv"
+    np.savetxt(data, np.column_stack([t, t_ss + (25.0 - t_ss) * np.exp(-t / tau)]),
+               delimiter=",", header="time [s],temperature [degC]", comments="")
+    rc, out, _ = run(capsys, "fit", "thermal", data, "--voltage", "5V", "--muscle-length",
+                     "300mm")
+    assert rc == 0 and out.count("tau [s]") == 1 and "[K]" not in out
+    row = next(line for line in out.splitlines() if "temperature_0" in line).split()
+    assert row[1] == "[degC]" and float(row[2]) == pytest.approx(25.0, abs=1e-6)
