@@ -152,3 +152,21 @@ def test_fit_thermal_prints_tau_once_and_temperatures_in_degc(tmp_path, capsys):
     assert rc == 0 and out.count("tau [s]") == 1 and "[K]" not in out
     row = next(line for line in out.splitlines() if "temperature_0" in line).split()
     assert row[1] == "[degC]" and float(row[2]) == pytest.approx(25.0, abs=1e-6)
+
+
+def test_an_up_to_date_sweep_keeps_its_charts(tmp_path, capsys):
+    raw = dict(ONE, name="charted", charts=["fig4", "fig7"],
+               grid=dict(ONE["grid"], radius={"values": [7.5, 10], "units": "mm"}))
+    config = tmp_path / "charted.yaml"
+    config.write_text(yaml.safe_dump(raw))
+    out = tmp_path / "run" / "cube.h5"
+    rc, first, _ = run(capsys, "sweep", config, "--out", out, "--quiet")
+    assert rc == 0 and "fig4.png" in first and "fig7.png" in first
+    stamps = {p.name: p.stat().st_mtime_ns for p in out.parent.glob("*.png")}
+    rc, again, err = run(capsys, "sweep", config, "--out", out)
+    assert rc == 0 and "nothing to do" in err and ".png" not in again
+    assert "2 kept" in err
+    assert {p.name: p.stat().st_mtime_ns for p in out.parent.glob("*.png")} == stamps
+    (out.parent / "fig7.png").unlink()  # a missing one is drawn again, alone
+    rc, third, _ = run(capsys, "sweep", config, "--out", out, "--quiet")
+    assert rc == 0 and "fig7.png" in third and "fig4.png" not in third
