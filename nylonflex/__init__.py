@@ -10,6 +10,7 @@ from ._version import __version__
 
 
 __all__ = [
+    "CompileWarning",
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "__version__",
@@ -28,7 +29,8 @@ __all__ = [
 _LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
          "nylon_parameters": "materials", "silicone_parameters": "materials",
          "design_limits": "engine", "evaluate": "engine", "load_config": "config",
-         "run_sweep": "sweep", "open_cube": "storage", "run_design": "design"}
+         "run_sweep": "sweep", "open_cube": "storage", "run_design": "design",
+         "CompileWarning": "kernels.compiling"}
 
 
 def __dir__():
