@@ -23,7 +23,8 @@ from .units import InputError
 from .variables import AXES, VARIABLES, to_display
 
 __all__ = ["Snapped", "axis_text", "design_curves", "design_table", "design_variables",
-           "display_unit", "fig12_lines", "flag_meanings", "label", "map_slice", "snap",
+           "colour_range", "display_unit", "fig12_lines", "flag_meanings", "label",
+           "map_slice", "snap", "stand_in_note", "validity_names",
            "to_display_any"]
 
 #: Curves of a design and the coordinate each is drawn against.
@@ -84,6 +85,59 @@ def flag_meanings(ds, name: str = "validity") -> list[tuple[int, str]]:
     masks = np.atleast_1d(attrs.get("flag_masks", attrs.get("flag_values", [])))
     meanings = str(attrs.get("flag_meanings", "")).split()
     return [(int(m), s) for m, s in zip(masks, meanings) if int(m) != 0]
+
+
+def validity_names(ds, bits) -> str:
+    """A design's ``validity`` as its flag names: ``"valid"`` for 0, ``"self contact,
+    stretch beyond fit"`` for the bits set, ``"unknown"`` for NaN (docs/model.md s. 17)."""
+    if bits is None or not np.isfinite(bits):
+        return "unknown"
+    names = [m.replace("_", " ") for mask, m in flag_meanings(ds) if int(bits) & mask]
+    return ", ".join(names) if names else "valid"
+
+
+def stand_in_note(ds) -> str:
+    """One sentence naming the cube's material sets whose values include proposals or
+    stand-ins (source tag P, or a description saying "stand-in"), "" when none do."""
+    import yaml
+
+    parts = []
+    for kind in ("silicone", "nylon"):
+        try:
+            doc = yaml.safe_load(str(ds.attrs.get(f"{kind}_parameters", ""))) or {}
+        except yaml.YAMLError:
+            continue
+        if not isinstance(doc, dict):
+            continue
+        sources = doc.get("sources") or {}
+        proposed = sorted(k for k, v in sources.items() if "P" in str(v).split(":")[0])
+        stand_in = "stand-in" in str(doc.get("description", ""))
+        if proposed or stand_in:
+            name = doc.get("name", ds.attrs.get(kind, kind))
+            what = f"{len(proposed)} of its {len(sources)} values are proposals (tag P)" \
+                if proposed else "a stand-in"
+            parts.append(f"{kind} {name}: {'a stand-in; ' if stand_in and proposed else ''}"
+                         f"{what}")
+    if not parts:
+        return ""
+    return ("Stand-in materials: " + "; ".join(parts) + " (docs/model.md s. 9; fit your "
+            "own with nylonflex fit). The numbers are the model's with these sets, not "
+            "measurements.")
+
+
+def colour_range(z, validity=None) -> tuple[float, float]:
+    """``(lo, hi)`` of a map's colour scale: the finite values of the clean designs
+    (``validity`` 0), so that flagged ones (a 1 mm wall bending 1,300 deg) do not set it;
+    every finite value where no design is clean."""
+    z = np.asarray(z, float)
+    ok = np.isfinite(z)
+    if validity is not None:
+        clean = ok & (np.nan_to_num(np.asarray(validity, float), nan=1.0) == 0)
+        ok = clean if clean.any() else ok
+    if not ok.any():
+        return 0.0, 1.0
+    lo, hi = float(z[ok].min()), float(z[ok].max())
+    return (lo, hi) if hi > lo else (lo, lo + 1.0)
 
 
 @dataclass(frozen=True)
