@@ -23,7 +23,7 @@ from .units import InputError
 from .variables import AXES, VARIABLES, to_display
 
 __all__ = ["Snapped", "axis_text", "design_curves", "design_table", "design_variables",
-           "colour_range", "display_unit", "fig12_lines", "flag_meanings", "label",
+           "colour_range", "design_config", "display_unit", "fig12_lines", "flag_meanings", "label",
            "map_slice", "snap", "stand_in_note", "validity_names",
            "to_display_any"]
 
@@ -138,6 +138,60 @@ def colour_range(z, validity=None) -> tuple[float, float]:
         return 0.0, 1.0
     lo, hi = float(z[ok].min()), float(z[ok].max())
     return (lo, hi) if hi > lo else (lo, lo + 1.0)
+
+
+def _curve_axis(name, si) -> dict:
+    """A curve axis of a config in display units: start/stop/num when evenly spaced."""
+    v = np.asarray(to_display(name, np.asarray(si, float)), float)
+    unit = VARIABLES[name].display
+    units = {} if unit == "1" else {"units": unit}
+    if v.size > 2 and np.allclose(v, np.linspace(v[0], v[-1], v.size), rtol=0,
+                                  atol=1e-9 * max(1.0, abs(v[-1]))):
+        return {"start": float(f"{v[0]:.12g}"), "stop": float(f"{v[-1]:.12g}"),
+                "num": int(v.size), **units}
+    return {"values": [float(f"{x:.12g}") for x in v], **units}
+
+
+def design_config(ds, at: dict, placeholders: bool = False) -> str:
+    """The selected design as a runnable sweep config (YAML, display units): one grid value
+    per axis, the cube's curves, and its materials as ``{set: NAME, field: value, ...}``
+    with every field of the cube's resolved sets, so that ``nylonflex sweep`` of it gives
+    this design's values of the cube ("copy as config"). With ``placeholders`` each grid
+    value is ``'@AXIS@'``, for a page to fill in."""
+    import yaml
+
+    from .materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
+
+    cfg = yaml.safe_load(str(ds.attrs.get("config_yaml", ""))) or {}
+    out = {"name": f"{cfg.get('name', 'design')}_design"}
+    for kind, table, default in (("silicone", SILICONE_PARAMETERS, "tc5005"),
+                                 ("nylon", NYLON_PARAMETERS, "silver_nylon66")):
+        m = cfg.get(kind)
+        if isinstance(m, dict):
+            base = str(m.get("name", default)).split("+")[0]
+            out[kind] = {"set": base if base in table else default,
+                         **{k: v for k, v in m.items() if k != "name"}}
+        elif m is not None:
+            out[kind] = m
+    if "base_thickness" in cfg:
+        b = cfg["base_thickness"]
+        out["base_thickness"] = b if b == "wall" or b is None else \
+            {"value": float(f"{float(to_display('wall_thickness', float(b))):.12g}"),
+             "units": "mm"}
+    if isinstance(cfg.get("model"), str):
+        out["model"] = cfg["model"]
+    grid = {}
+    for axis in AXES:
+        value = float(ds[axis].values[snap(ds, axis, float(at[axis])).index])
+        unit = VARIABLES[axis].display
+        shown = f"@{axis}@" if placeholders else float(f"{float(to_display(axis, value)):.12g}")
+        grid[axis] = {"values": [shown],
+                      **({} if unit == "1" else {"units": unit})}
+    out["grid"] = grid
+    out["curves"] = {c: _curve_axis(c, ds[c].values) for c in ("stroke", "pressure")}
+    head = (f"# the design picked in the explorer of cube '{cfg.get('name', '?')}': "
+            "nylonflex sweep THIS.yaml\n")
+    return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
 
 
 @dataclass(frozen=True)

@@ -19,8 +19,8 @@ import re
 
 import numpy as np
 
-from .explore import (design_variables, display_unit, flag_meanings, label, snap,
-                      stand_in_note, to_display_any)
+from .explore import (design_config, design_variables, display_unit, flag_meanings, label,
+                      snap, stand_in_note, to_display_any)
 from .variables import AXES
 
 #: The most designs an exported page carries (the rest of a larger cube is left out).
@@ -149,6 +149,12 @@ let text = '<div id="nf-readout" class="nf-readout" data-variable="' + vnames[iv
   '<br><span id="nf-validity" data-value="' + (validity ? validity[sel] : 0) + '">validity: <b>' +
   flagtext(validity ? validity[sel] : 0) + '</b></span>';
 if (note.tags.length) text += '<br><span class="nf-snap" style="color:#a0522d">' + note.tags[0] + '</span>';
+if (config) {
+  let yaml = config;
+  for (const k of AXES) yaml = yaml.replace("'@" + k + "@'", cfgvals[k][ix[k]]);
+  text += '<details style="font-size:12px"><summary>copy as config (a sweep of this design)' +
+    '</summary><pre id="nf-config">' + yaml + '</pre></details>';
+}
 readout.text = text + '</div>';
 let rows = '';
 for (let j = 0; j < vnames.length; j++) {
@@ -340,6 +346,10 @@ def build_html(ds, *, source: str = "") -> str:
 
     args = dict(variable=variable, model=model, sliders=sliders, data=data, limit=limit,
                 flags=[[m, n.replace("_", " ")] for m, n in flag_meanings(ds)],
+                config=(html.escape(design_config(ds, _DEFAULT, placeholders=True), quote=False)
+                        if "config_yaml" in ds.attrs else ""),
+                cfgvals={a: [f"{float(to_display_any(ds, a, v)):.12g}" for v in grid[a]]
+                         for a in AXES},
                 colorbar=colorbar, hover=hover,
                 validity=validity, sizes=sizes, AXES=list(AXES), map_src=map_src,
                 mapper=mapper, star=star, gx=gx, names={"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",

@@ -25,7 +25,8 @@ import math
 
 import numpy as np
 
-from .explore import (_index, axis_text, colour_range, design_curves, design_table,
+from .explore import (_index, axis_text, colour_range, design_config, design_curves,
+                      design_table,
                       design_variables, display_unit, fig12_lines, flag_meanings, label,
                       map_slice, snap, stand_in_note, validity_names)
 from .variables import AXES
@@ -174,6 +175,10 @@ def _readout_html(ds, var, at, notes) -> str:
                  f'<b>{html.escape(validity_names(ds, bits))}</b></span>')
     for note in notes:
         text += f'<br><span class="nf-snap" style="color:#a0522d">{html.escape(note)}</span>'
+    if "config_yaml" in ds.attrs:
+        text += ('<details style="font-size:12px"><summary>copy as config (a sweep of this '
+                 'design)</summary><pre id="nf-config">'
+                 f'{html.escape(design_config(ds, at))}</pre></details>')
     return text + "</div>"
 
 

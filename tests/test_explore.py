@@ -238,3 +238,28 @@ def test_stand_in_materials_are_named(ds):
     other.attrs = {k: v for k, v in ds.attrs.items()
                    if k not in ("silicone_parameters", "nylon_parameters")}
     assert explore.stand_in_note(other) == ""
+
+
+def test_copy_as_config_sweeps_to_the_selected_designs_values(ds):
+    import yaml
+
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+
+    at = {**AT, "radius": 12.5e-3, "wrap_angle": 20 * DEG}
+    text = explore.design_config(ds, at)
+    one = nf.run_sweep(parse_config(yaml.safe_load(text)))
+    for name in ("tip_force_max", "bend_angle_max", "limit", "validity"):
+        assert float(one[name].squeeze()) == float(ds[name].sel(at, method="nearest")), name
+    assert "values: ['@radius@']" in explore.design_config(ds, at, placeholders=True)
+
+
+def test_both_pages_offer_the_config(ds):
+    pytest.importorskip("bokeh")
+    pytest.importorskip("panel")
+    from nylonflex.explore_html import build_html
+    from nylonflex.explore_page import _readout_html
+
+    assert 'id="nf-config"' in _readout_html(ds, "tip_force_max", AT, [])
+    text = build_html(ds, source="cube.h5")
+    assert "copy as config" in text and "@radius@" in text

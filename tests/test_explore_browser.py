@@ -110,6 +110,11 @@ def _drive(page, cube, select_label):
     shown = page.locator("#nf-validity")
     assert float(shown.get_attribute("data-value")) == bits
     assert ("valid" if bits == 0 else "self contact") in shown.inner_text()
+    # "copy as config": the selected design's grid values, as a sweep config takes them
+    import re
+
+    config = page.locator("#nf-config").text_content()
+    assert re.search(r"length:\s+values: \[70(\.0)?\]", config), config
 
 
 @contextlib.contextmanager
