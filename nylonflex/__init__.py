@@ -10,6 +10,7 @@ from ._version import __version__
 
 
 __all__ = [
+    "CompileWarning",
     "NYLON_PARAMETERS",
     "SILICONE_PARAMETERS",
     "__version__",
@@ -31,7 +32,8 @@ _LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
          "nylon_parameters": "materials", "silicone_parameters": "materials",
          "design_limits": "engine", "evaluate": "engine", "load_config": "config",
          "bend_angle": "engine", "fe_bend": "fe",
-         "run_sweep": "sweep", "open_cube": "storage", "run_design": "design"}
+         "run_sweep": "sweep", "open_cube": "storage", "run_design": "design",
+         "CompileWarning": "kernels.compiling"}
 
 
 def __dir__():

@@ -23,7 +23,8 @@ from .units import InputError
 from .variables import AXES, VARIABLES, to_display
 
 __all__ = ["Snapped", "axis_text", "design_curves", "design_table", "design_variables",
-           "display_unit", "fig12_lines", "flag_meanings", "label", "map_slice", "snap",
+           "colour_range", "design_config", "display_unit", "fig12_lines", "flag_meanings", "label",
+           "map_slice", "snap", "stand_in_note", "validity_names",
            "to_display_any"]
 
 #: Curves of a design and the coordinate each is drawn against.
@@ -84,6 +85,113 @@ def flag_meanings(ds, name: str = "validity") -> list[tuple[int, str]]:
     masks = np.atleast_1d(attrs.get("flag_masks", attrs.get("flag_values", [])))
     meanings = str(attrs.get("flag_meanings", "")).split()
     return [(int(m), s) for m, s in zip(masks, meanings) if int(m) != 0]
+
+
+def validity_names(ds, bits) -> str:
+    """A design's ``validity`` as its flag names: ``"valid"`` for 0, ``"self contact,
+    stretch beyond fit"`` for the bits set, ``"unknown"`` for NaN (docs/model.md s. 17)."""
+    if bits is None or not np.isfinite(bits):
+        return "unknown"
+    names = [m.replace("_", " ") for mask, m in flag_meanings(ds) if int(bits) & mask]
+    return ", ".join(names) if names else "valid"
+
+
+def stand_in_note(ds) -> str:
+    """One sentence naming the cube's material sets whose values include proposals or
+    stand-ins (source tag P, or a description saying "stand-in"), "" when none do."""
+    import yaml
+
+    parts = []
+    for kind in ("silicone", "nylon"):
+        try:
+            doc = yaml.safe_load(str(ds.attrs.get(f"{kind}_parameters", ""))) or {}
+        except yaml.YAMLError:
+            continue
+        if not isinstance(doc, dict):
+            continue
+        sources = doc.get("sources") or {}
+        proposed = sorted(k for k, v in sources.items() if "P" in str(v).split(":")[0])
+        stand_in = "stand-in" in str(doc.get("description", ""))
+        if proposed or stand_in:
+            name = doc.get("name", ds.attrs.get(kind, kind))
+            what = f"{len(proposed)} of its {len(sources)} values are proposals (tag P)" \
+                if proposed else "a stand-in"
+            parts.append(f"{kind} {name}: {'a stand-in; ' if stand_in and proposed else ''}"
+                         f"{what}")
+    if not parts:
+        return ""
+    return ("Stand-in materials: " + "; ".join(parts) + " (docs/model.md s. 9; fit your "
+            "own with nylonflex fit). The numbers are the model's with these sets, not "
+            "measurements.")
+
+
+def colour_range(z, validity=None) -> tuple[float, float]:
+    """``(lo, hi)`` of a map's colour scale: the finite values of the clean designs
+    (``validity`` 0), so that flagged ones (a 1 mm wall bending 1,300 deg) do not set it;
+    every finite value where no design is clean."""
+    z = np.asarray(z, float)
+    ok = np.isfinite(z)
+    if validity is not None:
+        clean = ok & (np.nan_to_num(np.asarray(validity, float), nan=1.0) == 0)
+        ok = clean if clean.any() else ok
+    if not ok.any():
+        return 0.0, 1.0
+    lo, hi = float(z[ok].min()), float(z[ok].max())
+    return (lo, hi) if hi > lo else (lo, lo + 1.0)
+
+
+def _curve_axis(name, si) -> dict:
+    """A curve axis of a config in display units: start/stop/num when evenly spaced."""
+    v = np.asarray(to_display(name, np.asarray(si, float)), float)
+    unit = VARIABLES[name].display
+    units = {} if unit == "1" else {"units": unit}
+    if v.size > 2 and np.allclose(v, np.linspace(v[0], v[-1], v.size), rtol=0,
+                                  atol=1e-9 * max(1.0, abs(v[-1]))):
+        return {"start": float(f"{v[0]:.12g}"), "stop": float(f"{v[-1]:.12g}"),
+                "num": int(v.size), **units}
+    return {"values": [float(f"{x:.12g}") for x in v], **units}
+
+
+def design_config(ds, at: dict, placeholders: bool = False) -> str:
+    """The selected design as a runnable sweep config (YAML, display units): one grid value
+    per axis, the cube's curves, and its materials as ``{set: NAME, field: value, ...}``
+    with every field of the cube's resolved sets, so that ``nylonflex sweep`` of it gives
+    this design's values of the cube ("copy as config"). With ``placeholders`` each grid
+    value is ``'@AXIS@'``, for a page to fill in."""
+    import yaml
+
+    from .materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
+
+    cfg = yaml.safe_load(str(ds.attrs.get("config_yaml", ""))) or {}
+    out = {"name": f"{cfg.get('name', 'design')}_design"}
+    for kind, table, default in (("silicone", SILICONE_PARAMETERS, "tc5005"),
+                                 ("nylon", NYLON_PARAMETERS, "silver_nylon66")):
+        m = cfg.get(kind)
+        if isinstance(m, dict):
+            base = str(m.get("name", default)).split("+")[0]
+            out[kind] = {"set": base if base in table else default,
+                         **{k: v for k, v in m.items() if k != "name"}}
+        elif m is not None:
+            out[kind] = m
+    if "base_thickness" in cfg:
+        b = cfg["base_thickness"]
+        out["base_thickness"] = b if b == "wall" or b is None else \
+            {"value": float(f"{float(to_display('wall_thickness', float(b))):.12g}"),
+             "units": "mm"}
+    if isinstance(cfg.get("model"), str):
+        out["model"] = cfg["model"]
+    grid = {}
+    for axis in AXES:
+        value = float(ds[axis].values[snap(ds, axis, float(at[axis])).index])
+        unit = VARIABLES[axis].display
+        shown = f"@{axis}@" if placeholders else float(f"{float(to_display(axis, value)):.12g}")
+        grid[axis] = {"values": [shown],
+                      **({} if unit == "1" else {"units": unit})}
+    out["grid"] = grid
+    out["curves"] = {c: _curve_axis(c, ds[c].values) for c in ("stroke", "pressure")}
+    head = (f"# the design picked in the explorer of cube '{cfg.get('name', '?')}': "
+            "nylonflex sweep THIS.yaml\n")
+    return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
 
 
 @dataclass(frozen=True)

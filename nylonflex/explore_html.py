@@ -19,8 +19,8 @@ import re
 
 import numpy as np
 
-from .explore import (design_variables, display_unit, flag_meanings, label, snap,
-                      to_display_any)
+from .explore import (design_config, design_variables, display_unit, flag_meanings, label,
+                      snap, stand_in_note, to_display_any)
 from .variables import AXES
 
 #: The most designs an exported page carries (the rest of a larger cube is left out).
@@ -73,24 +73,43 @@ _JS = """
 const iv = Number(variable.value), im = model ? model.active : 0;
 const ix = {}; for (const k of AXES) ix[k] = sliders[k].value;
 const N = sizes;  // per axis, C order radius, wall, length, coil, wrap
+function flagtext(bits) {
+  if (!isFinite(bits)) return "unknown";
+  const on = flags.filter(f => (bits & f[0]) != 0).map(f => f[1]);
+  return on.length ? on.join(", ") : "valid";
+}
 function flat(r, t, l, c, w) {
   return (((r * N[1] + t) * N[2] + l) * N[3] + c) * N[4] + w;
 }
 const nd = N[0] * N[1] * N[2] * N[3] * N[4];
 const off = im * nd;
 const arr = data[iv];
-const z = map_src.data.z, h = map_src.data.h, lc = map_src.data.lc;
-let lo = Infinity, hi = -Infinity;
+const z = map_src.data.z, h = map_src.data.h, lc = map_src.data.lc, fa = map_src.data.fa;
+// the colour scale: clean designs only (flagged ones, drawn faded, do not set it)
+let lo = Infinity, hi = -Infinity, alo = Infinity, ahi = -Infinity;
 for (let t = 0; t < N[1]; t++) for (let r = 0; r < N[0]; r++) {
   const i = flat(r, t, ix.length, ix.coil_index, ix.wrap_angle) + off;
   const k = t * N[0] + r;
+  const bad = validity && validity[i] != 0;
   z[k] = arr[i];
-  if (isFinite(arr[i])) { lo = Math.min(lo, arr[i]); hi = Math.max(hi, arr[i]); }
+  if (isFinite(arr[i])) {
+    alo = Math.min(alo, arr[i]); ahi = Math.max(ahi, arr[i]);
+    if (!bad) { lo = Math.min(lo, arr[i]); hi = Math.max(hi, arr[i]); }
+  }
   h[k] = (limit && limit[i] == 1) ? "x" : " ";
-  lc[k] = (validity && validity[i] != 0) ? "#D55E00" : null;
+  lc[k] = bad ? "#D55E00" : null;
+  fa[k] = bad ? 0.35 : 1.0;
 }
+if (!isFinite(lo)) { lo = alo; hi = ahi; }
 if (!(hi > lo)) { hi = lo + 1; }
 mapper.low = lo; mapper.high = hi;
+colorbar.title = vlabels[iv];
+hover.tooltips = [[vlabels[iv], "@z{0.000}"], ["validity", "@vf"]];
+const vf = map_src.data.vf;
+for (let t = 0; t < N[1]; t++) for (let r = 0; r < N[0]; r++) {
+  const i = flat(r, t, ix.length, ix.coil_index, ix.wrap_angle) + off;
+  vf[t * N[0] + r] = flagtext(validity ? validity[i] : 0);
+}
 map_src.change.emit();
 const sel = flat(ix.radius, ix.wall_thickness, ix.length, ix.coil_index, ix.wrap_angle) + off;
 star.data = {x: [gx.radius[ix.radius]], y: [gx.wall_thickness[ix.wall_thickness]]};
@@ -126,8 +145,16 @@ let text = '<div id="nf-readout" class="nf-readout" data-variable="' + vnames[iv
   '" data-value="' + v + '" data-unit="' + vunits[iv] + '" style="font-size:15px">' +
   vshort[iv] + ' of the selected design: <b>' + fmt(v) +
   (vunits[iv] == "1" ? "" : " " + vunits[iv]) + '</b><br><span style="color:#555">design: ' +
-  AXES.map(k => k + " " + labels[k][ix[k]]).join(", ") + mname + '</span>';
+  AXES.map(k => k + " " + labels[k][ix[k]]).join(", ") + mname + '</span>' +
+  '<br><span id="nf-validity" data-value="' + (validity ? validity[sel] : 0) + '">validity: <b>' +
+  flagtext(validity ? validity[sel] : 0) + '</b></span>';
 if (note.tags.length) text += '<br><span class="nf-snap" style="color:#a0522d">' + note.tags[0] + '</span>';
+if (config) {
+  let yaml = config;
+  for (const k of AXES) yaml = yaml.replace("'@" + k + "@'", cfgvals[k][ix[k]]);
+  text += '<details style="font-size:12px"><summary>copy as config (a sweep of this design)' +
+    '</summary><pre id="nf-config">' + yaml + '</pre></details>';
+}
 readout.text = text + '</div>';
 let rows = '';
 for (let j = 0; j < vnames.length; j++) {
@@ -168,7 +195,7 @@ def build_html(ds, *, source: str = "") -> str:
     from bokeh.embed import file_html
     from bokeh.layouts import column, row
     from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter,
-                              Div, LinearColorMapper, RadioButtonGroup, Select, Slider,
+                              Div, HoverTool, LinearColorMapper, RadioButtonGroup, Select, Slider,
                               Span, TapTool, Title)
     from bokeh.plotting import figure
     from bokeh.resources import Resources
@@ -243,17 +270,21 @@ def build_html(ds, *, source: str = "") -> str:
     map_src = ColumnDataSource({
         "left": ex[rr.ravel()], "right": ex[rr.ravel() + 1], "bottom": ey[tt.ravel()],
         "top": ey[tt.ravel() + 1], "z": np.zeros(nr * nt), "h": [" "] * (nr * nt),
-        "lc": [None] * (nr * nt)})
+        "lc": [None] * (nr * nt), "fa": [1.0] * (nr * nt), "vf": ["valid"] * (nr * nt)})
     mapper = LinearColorMapper(palette="Viridis256", low=0, high=1)
-    map_fig = figure(width=520, height=380, tools="tap,hover,reset,save",
+    map_fig = figure(width=520, height=380, tools="tap,reset,save",
                      x_axis_label=label(ds, "radius"), y_axis_label=label(ds, "wall_thickness"),
-                     x_range=(ex[0], ex[-1]), y_range=(ey[0], ey[-1]),
-                     tooltips=[("value", "@z{0.000}")])
-    map_fig.quad(source=map_src, left="left", right="right", bottom="bottom", top="top",
-                 fill_color={"field": "z", "transform": mapper}, line_color="lc",
-                 line_width=2, hatch_pattern="h", hatch_color="white", hatch_alpha=0.8,
-                 hatch_scale=8, nonselection_fill_alpha=1.0, selection_fill_alpha=1.0)
-    map_fig.add_layout(ColorBar(color_mapper=mapper, width=12), "right")
+                     x_range=(ex[0], ex[-1]), y_range=(ey[0], ey[-1]))
+    cells = map_fig.quad(source=map_src, left="left", right="right", bottom="bottom",
+                         top="top", fill_color={"field": "z", "transform": mapper},
+                         fill_alpha="fa", line_color="lc", line_width=2, hatch_pattern="h",
+                         hatch_color="white", hatch_alpha=0.8, hatch_scale=8,
+                         nonselection_fill_alpha="fa", selection_fill_alpha="fa")
+    # the cells only (the star has no value), named with the variable and its unit
+    hover = HoverTool(renderers=[cells], tooltips=[(label(ds, variables[default_var]), "@z{0.000}")])
+    map_fig.add_tools(hover)
+    colorbar = ColorBar(color_mapper=mapper, width=12, title=label(ds, variables[default_var]))
+    map_fig.add_layout(colorbar, "right")
     star = ColumnDataSource({"x": [0.0], "y": [0.0]})
     map_fig.scatter("x", "y", source=star, marker="star", size=20, fill_color="gold",
                     line_color="black")
@@ -309,9 +340,17 @@ def build_html(ds, *, source: str = "") -> str:
         "<b>hatched (x) cells are strength-limited</b>: the nylon breaks before the muscle "
         f"uses its full stroke, so the range of motion is cut short.{flag_text} Run "
         f"<code>nylonflex explore {html.escape(source or 'CUBE')}</code> for other map "
-        "axes.</p>"))
+        "axes. The colour scale is set by the unflagged designs; flagged ones are faded."
+        "</p>" + (f"<p id='nf-stand-in' style='color:#a0522d'>{html.escape(stand_in_note(ds))}"
+                  "</p>" if stand_in_note(ds) else "")))
 
     args = dict(variable=variable, model=model, sliders=sliders, data=data, limit=limit,
+                flags=[[m, n.replace("_", " ")] for m, n in flag_meanings(ds)],
+                config=(html.escape(design_config(ds, _DEFAULT, placeholders=True), quote=False)
+                        if "config_yaml" in ds.attrs else ""),
+                cfgvals={a: [f"{float(to_display_any(ds, a, v)):.12g}" for v in grid[a]]
+                         for a in AXES},
+                colorbar=colorbar, hover=hover,
                 validity=validity, sizes=sizes, AXES=list(AXES), map_src=map_src,
                 mapper=mapper, star=star, gx=gx, names={"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
                        "wrap_angle": "\u03c8"}, labels=labels,

@@ -25,8 +25,10 @@ import math
 
 import numpy as np
 
-from .explore import (axis_text, design_curves, design_table, design_variables,
-                      display_unit, fig12_lines, flag_meanings, label, map_slice, snap)
+from .explore import (_index, axis_text, colour_range, design_config, design_curves,
+                      design_table,
+                      design_variables, display_unit, fig12_lines, flag_meanings, label,
+                      map_slice, snap, stand_in_note, validity_names)
 from .variables import AXES
 
 #: The most widget states an exported page embeds (variable x embedded sliders).
@@ -83,10 +85,15 @@ def _map_plot(ds, var, x, y, at, hv):
     m = map_slice(ds, var, x, y, at)
     ttl = _held(ds, at, [k for k in AXES if k not in (x, y)])
     xs, ys = np.meshgrid(m["x"], m["y"])
+    # hover and colour bar named with the variable and its unit; the colour scale set by
+    # the clean designs (a flagged 1 mm wall bending 1,300 deg would wash out the rest)
+    value = hv.Dimension(var, label=label(ds, var).split(" [")[0],
+                         unit=None if display_unit(ds, var) == "1" else display_unit(ds, var))
     qm = hv.QuadMesh((m["x"], m["y"], m["z"]), kdims=[label(ds, x), label(ds, y)],
-                     vdims=["value"]).opts(
+                     vdims=[value]).opts(
         cmap="viridis", colorbar=True, tools=["hover"], title=f"{label(ds, var)}\n"
-        f"at {ttl}", framewise=True, **_PLOT, toolbar="above")
+        f"at {ttl}", framewise=True, clim=colour_range(m["z"], m["validity"]),
+        clabel=label(ds, var), **_PLOT, toolbar="above")
     layers = [qm]
     if m["limit"] is not None:
         strong = m["limit"] == 1
@@ -161,8 +168,17 @@ def _readout_html(ds, var, at, notes) -> str:
             f'style="font-size:15px">{html.escape(label(ds, var).split(" [")[0])} of the '
             f'selected design: <b>{_fmt(row["value"])}{html.escape(unit)}</b>'
             f'<br><span style="color:#555">design: {html.escape(where)}</span>')
+    if "validity" in ds:
+        index = {k: v for k, v in _index(ds, at).items() if k in ds["validity"].dims}
+        bits = float(ds["validity"].isel(index).values)
+        text += (f'<br><span id="nf-validity" data-value="{bits:g}">validity: '
+                 f'<b>{html.escape(validity_names(ds, bits))}</b></span>')
     for note in notes:
         text += f'<br><span class="nf-snap" style="color:#a0522d">{html.escape(note)}</span>'
+    if "config_yaml" in ds.attrs:
+        text += ('<details style="font-size:12px"><summary>copy as config (a sweep of this '
+                 'design)</summary><pre id="nf-config">'
+                 f'{html.escape(design_config(ds, at))}</pre></details>')
     return text + "</div>"
 
 
@@ -334,7 +350,10 @@ def build_page(ds, *, static: bool = False, source: str = ""):
               f"materials {ds.attrs.get('silicone', '?')} / {ds.attrs.get('nylon', '?')}"
               + (f", file `{source}`" if source else "") + ".  \n"
               "Every value shown is a grid point of the cube: sliders snap to grid values and "
-              "nothing is interpolated.")
+              "nothing is interpolated. The map's colour scale is set by the unflagged "
+              "designs.")
+    if stand_in_note(ds):
+        header += f"  \n<span id='nf-stand-in' style='color:#a0522d'>{stand_in_note(ds)}</span>"
     if static:
         held = ", ".join(f"{a} {axis_text(ds, a, v)}" for a, v in fixed.items())
         emb = "; ".join(f"{a}: {len(embed_states[s])} of {ds.sizes[a]} grid values"

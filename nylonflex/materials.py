@@ -32,8 +32,10 @@ __all__ = [
     "Nylon",
     "FIELD_UNITS",
     "SHEAR_MODULUS_RANGE",
+    "SILICONE_KINDS",
     "Silicone",
     "check_shear_modulus",
+    "silicone_kind",
     "nylon_parameters",
     "silicone_parameters",
 ]
@@ -57,6 +59,7 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (56.19e3, 10.49e3),
         "alpha": (0.2975, 2.770),
         "description": "BJB TC-5005 (the paper's silicone), stand-in fit",
+        "kind": "shore_00",
         "stretch_range": (1.0, 4.0),
         "sources": {
             "stretch_range": "D: the fit's data window, stretch <= 4",
@@ -70,6 +73,7 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (16.11e3, -0.3231e3),
         "alpha": (1.977, -8.149),
         "description": "Smooth-On Ecoflex 00-30",
+        "kind": "shore_00",
         "stretch_range": (1.0, 4.0),
         "sources": {
             "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
@@ -82,6 +86,7 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (30.30e3, -1.620e3),
         "alpha": (2.970, -6.266),
         "description": "Smooth-On Dragon Skin 10",
+        "kind": "shore_a",
         "stretch_range": (1.0, 4.0),
         "sources": {
             "stretch_range": "P: the fit's window is not recorded; taken as tc5005's "
@@ -94,6 +99,7 @@ SILICONE_PARAMETERS: dict[str, dict[str, Any]] = {
         "mu": (220e3, 0.0),
         "alpha": (2.0, 1.0),
         "description": "Wacker Elastosil M4601 (neo-Hookean)",
+        "kind": "shore_a",
         "stretch_range": (1.0, 2.0),
         "sources": {
             "stretch_range": "P: a small-strain neo-Hookean equivalent of a Yeoh fit; trusted "
@@ -187,14 +193,71 @@ FIELD_UNITS = {
 }
 
 
-#: Plausible initial shear modulus mu_0 = 1/2 sum mu_i alpha_i of a silicone [Pa]: the
-#: softest gels (about 1 kPa) to stiff rubbers (tens of MPa). Below it, mu was most likely
-#: typed in kPa (or MPa) where the code takes Pa.
-SHEAR_MODULUS_RANGE = (100.0, 100e6)
+#: Plausible initial shear modulus mu_0 = 1/2 sum mu_i alpha_i [Pa] of each kind of silicone,
+#: stated here once: every named set has a ``kind``, the messages quote these ranges, and the
+#: README and docs/model.md print this table (tests/test_materials.py checks they agree).
+#: ``shore_00`` and ``shore_a`` each span a factor of 100, so a named set's stiffness typed
+#: 100 times too small or too large (kPa typed as Pa is 1000 times) always falls outside
+#: its kind's range. ``any`` is for a set of no stated kind (a fitted file, a custom set).
+SILICONE_KINDS = {
+    "shore_00": {"range": (2e3, 200e3), "description":
+                 "soft platinum silicones, Shore 00-10 to 00-50 (Ecoflex; tc5005's stand-in)"},
+    "shore_a": {"range": (20e3, 2e6), "description":
+                "Shore A silicones, about A 5 to A 45 (Dragon Skin 10, Elastosil M4601, "
+                "Sylgard 184)"},
+    "any": {"range": (100.0, 100e6), "description":
+            "a silicone of no stated kind: the softest gels to stiff rubbers"},
+}
+#: The widest plausible range [Pa] (kind ``any``).
+SHEAR_MODULUS_RANGE = SILICONE_KINDS["any"]["range"]
 
 
-def check_shear_modulus(mu0, field="silicone.mu"):
-    """Refuse an initial shear modulus no silicone has, naming the likely unit slip.
+def silicone_kind(silicone) -> str:
+    """The kind (a key of :data:`SILICONE_KINDS`) of a silicone argument: a mapping's own
+    ``kind``, else its named set's, else ``"any"``."""
+    if isinstance(silicone, Mapping):
+        if "kind" in silicone:
+            return _kind_name(silicone["kind"])
+        silicone = silicone.get("set")
+    if isinstance(silicone, str) and silicone in SILICONE_PARAMETERS:
+        return SILICONE_PARAMETERS[silicone].get("kind", "any")
+    return "any"
+
+
+def _kind_name(kind) -> str:
+    if not isinstance(kind, str) or kind not in SILICONE_KINDS:
+        raise ValueError(f"silicone.kind: must be one of {', '.join(SILICONE_KINDS)}, "
+                         f"got {short(kind)}")
+    return kind
+
+
+def shear_modulus_range_text(kind) -> str:
+    """``"[2 kPa, 200 kPa]"``: a kind's plausible mu_0 range as the docs print it."""
+    def k(x):
+        for factor, unit in ((1e6, "MPa"), (1e3, "kPa")):
+            if x >= factor:
+                return f"{x / factor:g} {unit}"
+        return f"{x:g} Pa"
+    lo, hi = SILICONE_KINDS[kind]["range"]
+    return f"[{k(lo)}, {k(hi)}]"
+
+
+def _slip(got, own, name) -> str:
+    """What a mu_0 of ``got`` [Pa] against its set's ``own`` [Pa] most likely is."""
+    p = int(np.round(np.log10(got / own)))
+    if p == 0:
+        return ""
+    times = f"{10.0 ** abs(p):g} times {'below' if p < 0 else 'above'} {name}'s own " \
+            f"{own:g} Pa"
+    hint = {-3: "the mu values look like kPa typed as Pa: the code takes Pa",
+            -6: "the mu values look like MPa typed as Pa: the code takes Pa",
+            3: "a value in Pa converted from kPa once more?",
+            -2: "a misplaced decimal point?", 2: "a misplaced decimal point?"}.get(p, "")
+    return f"; it is {times}" + (f" ({hint})" if hint else "")
+
+
+def check_shear_modulus(mu0, field="silicone.mu", kind="any", name=None):
+    """Refuse an initial shear modulus no silicone of its kind has, naming the likely slip.
 
     Parameters
     ----------
@@ -202,6 +265,10 @@ def check_shear_modulus(mu0, field="silicone.mu"):
         Initial shear modulus 1/2 sum mu_i alpha_i [Pa].
     field : str
         The parameter to name in the message.
+    kind : str
+        A key of :data:`SILICONE_KINDS`: the accepted range [Pa].
+    name : str, optional
+        The named set the values override (the message compares with its own mu_0).
 
     Raises
     ------
@@ -209,7 +276,7 @@ def check_shear_modulus(mu0, field="silicone.mu"):
         One line: the field, the accepted range [Pa], the value and the likely slip.
     """
     arr = np.asarray(mu0, dtype=float)
-    lo, hi = SHEAR_MODULUS_RANGE
+    lo, hi = SILICONE_KINDS[_kind_name(kind)]["range"]
     bad = ~(arr > 0)
     if np.any(bad):
         raise ValueError(f"{field}: initial shear modulus 1/2 sum mu_i alpha_i = "
@@ -217,13 +284,22 @@ def check_shear_modulus(mu0, field="silicone.mu"):
     bad = (arr < lo) | (arr > hi)
     if np.any(bad):
         got = float(arr[bad].flat[0])
+        of = "a silicone" if kind == "any" else f"a {kind} silicone"
         msg = (f"{field}: initial shear modulus 1/2 sum mu_i alpha_i = {got:g} Pa is "
-               f"implausible for a silicone; must be in [{lo:g}, {hi:g}] Pa")
-        for factor, unit in ((1e3, "kPa"), (1e6, "MPa")):
-            if got < lo and lo <= got * factor <= hi:
-                msg += (f"; the mu values look like {unit}: the code takes Pa "
-                        f"(mu_0 would be {got * factor:g} Pa)")
-                break
+               f"implausible for {of}; must be in [{lo:g}, {hi:g}] Pa")
+        if name in SILICONE_PARAMETERS:
+            own = SILICONE_PARAMETERS[name]
+            msg += _slip(got, 0.5 * sum(m * a for m, a in zip(own["mu"], own["alpha"])),
+                         name)
+            if kind != "any":
+                msg += (f"; for a silicone of another kind give silicone.kind, one of "
+                        f"{', '.join(SILICONE_KINDS)}")
+        else:
+            for factor, unit in ((1e3, "kPa"), (1e6, "MPa")):
+                if got < lo and lo <= got * factor <= hi:
+                    msg += (f"; the mu values look like {unit}: the code takes Pa "
+                            f"(mu_0 would be {got * factor:g} Pa)")
+                    break
         raise ValueError(msg)
 
 
@@ -361,6 +437,8 @@ def _resolve(kind, table, value, overrides):
     if overrides:
         cls = Silicone if kind == "silicone" else Nylon
         known = {f.name for f in fields(cls)} - {"name", "description", "sources"}
+        if kind == "silicone":
+            known |= {"kind"}  # the plausible stiffness range (SILICONE_KINDS)
         for key in overrides:
             if key not in known:
                 raise ValueError(
@@ -400,7 +478,8 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         A name of :data:`SILICONE_PARAMETERS`, a mapping ``{"set": name, field: value}``
         or a ready :class:`Silicone` (returned as is).
     **overrides
-        Fields to replace: ``mu`` [Pa], ``alpha`` [-].
+        Fields to replace: ``mu`` [Pa], ``alpha`` [-]; ``kind`` (a key of
+        :data:`SILICONE_KINDS`) sets the plausible range of the initial shear modulus.
 
     Raises
     ------
@@ -422,7 +501,9 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         raise ValueError(f"silicone.alpha: each term must be finite, non-zero and in "
                          f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
     mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
-    check_shear_modulus(mu0)
+    base = silicone.get("set") if isinstance(silicone, Mapping) else silicone
+    check_shear_modulus(mu0, kind=_kind_name(p.get("kind", "any")),
+                        name=base if isinstance(base, str) else None)
     stretch_range = p.get("stretch_range", (0.0, float("inf")))
     try:
         lo, hi = (float(x) for x in stretch_range)

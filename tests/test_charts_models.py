@@ -134,7 +134,7 @@ def test_query_prints_the_model_in_every_row(ds):
     table = format_table(res).splitlines()
     assert table[1].split()[0] == "model"
     assert [line.split()[0] for line in table[3:6]] == MODELS
-    records = json.loads(format_json(res))
+    records = json.loads(format_json(res))["designs"]
     assert [r["model"] for r in records] == MODELS
     rows = list(csv.reader(io.StringIO(format_csv(res))))
     assert rows[0][:2] == ["point", "model"] and [r[1] for r in rows[1:]] == MODELS

@@ -112,7 +112,17 @@ def test_two_objectives_return_exactly_the_cubes_non_dominated_feasible_set(ds):
     want = {tuple(np.round([rows[a][ok][i] for a in AXES], 12))
             for i in np.flatnonzero(brute_front(F))}
     got = {tuple(np.round([d[a] for a in AXES], 12)) for d in res.designs}
-    assert got == want and all(d["source"] == "grid" for d in res.designs)
+    assert got <= want and all(d["source"] == "grid" for d in res.designs)
+    # designs equal in both objectives are one row (issue 25), listing the axes that differ
+    objectives = {(round(d["tip_force_max"], 12), round(d["radius"], 12)) for d in res.designs}
+    assert len(objectives) == len(res.designs)
+    ok_rows = {tuple(np.round([rows[a][ok][i] for a in AXES], 12)): i
+               for i in np.flatnonzero(brute_front(F))}
+    assert {(round(-F[i, 0], 12), round(F[i, 1], 12)) for i in ok_rows.values()} == objectives
+    assert res.snapped["merged"] == len(want) - len(got)
+    for d in res.designs:
+        for axis, values in d["alternatives"].items():
+            assert d[axis] in values and len(values) > 1
 
 
 def test_refined_front_dominates_or_equals_the_grid_front(ds):
@@ -307,3 +317,88 @@ def test_chart_is_written(cube, tmp_path, capsys):
                       refine={"starts": 3, "maxiter": 10})
     rc, _, err = run(capsys, path, "--chart", tmp_path / "charts")
     assert rc == 0 and (tmp_path / "charts" / "t.png").stat().st_size > 10_000
+
+
+# ---------------------------------------------------------------------------- issue 25
+RESOLUTION = {"radius": "0.5 mm", "wall_thickness": "0.5 mm", "coil_index": 0.05,
+              "wrap_angle": "1 deg"}
+STEPS = {"radius": 0.5e-3, "wall_thickness": 0.5e-3, "coil_index": 0.05,
+         "wrap_angle": np.pi / 180}
+
+
+def _on(x, step):
+    return abs(x / step - round(x / step)) < 1e-6
+
+
+@pytest.mark.parametrize("objectives", [FRONT, [{"max": "tip_force_max"}]])
+def test_resolution_gives_only_buildable_rechecked_distinct_designs(ds, objectives):
+    constraints = ["range_fraction >= 1", "bend_angle_max >= 30 deg"]
+    refine = {"starts": 8, "maxiter": 30}
+    free = run_design(spec(objectives, constraints, refine=refine), cube=ds)
+    # without a resolution refinement answers coil indices and walls nobody can build
+    assert any(not all(_on(d[a], STEPS[a]) for a in STEPS) for d in free.designs)
+    res = run_design(spec(objectives, constraints, refine=refine, resolution=RESOLUTION),
+                     cube=ds)
+    assert res.designs and res.spec.resolution == pytest.approx(STEPS)
+    for d in res.designs:
+        assert all(_on(d[a], STEPS[a]) for a in STEPS), d
+        exact = nf.evaluate(*(d[a] for a in AXES))  # re-checked: the exact model's values
+        assert d["tip_force_max"] == exact["tip_force_max"]
+        for c in constraints:
+            assert Condition(c).mask(np.array([d[Condition(c).name]]))[0], (c, d)
+    F = [tuple(d[o.name] for o in res.spec.objectives) for d in res.designs]
+    assert len(set(F)) == len(F)  # no two rows equal in every objective
+    if len(objectives) == 1:  # the best on-resolution design is no better than the free one
+        assert res.designs[0]["tip_force_max"] <= free.designs[0]["tip_force_max"]
+
+
+def test_resolution_snaps_between_multiples_in_display_units():
+    from nylonflex.design.resolution import _neighbours, merge_equal, on_resolution
+
+    # the refined values issue 25 saw: coil index 1.3989, wall 4.00006 mm
+    assert _neighbours("coil_index", 1.3989, 0.05, 1.1, 1.7) == [1.35, 1.4]
+    # as "4.5 mm" converts when typed in a config: 4.5 * 1e-3
+    assert _neighbours("wall_thickness", 4.00006e-3, 0.5e-3, 1e-3, 6e-3) == [4e-3, 4.5 * 1e-3]
+    assert _neighbours("wall_thickness", 4e-3, 0.5e-3, 1e-3, 6e-3) == [4e-3]
+    assert _neighbours("coil_index", 1.69, 0.05, 1.1, 1.7) == [1.65, 1.7]
+    assert _neighbours("coil_index", 1.72, 0.05, 1.1, 1.7) == [1.7]  # 1.75: off the grid
+    assert on_resolution(8 * np.pi / 180, np.pi / 180) and not on_resolution(1.3989, 0.05)
+    a = {"radius": 5e-3, "wall_thickness": 4e-3, "length": 0.07, "coil_index": 1.7,
+         "tip_force_max": 0.0788}
+    rows = [dict(a, wrap_angle=w, source=s) for w, s in ((0.35, "refined"), (0.09, "grid"))]
+    from nylonflex.design import Objective
+
+    merged, n = merge_equal(rows, [Objective("tip_force_max", "max"),
+                                   Objective("radius", "min")])
+    assert n == 1 and merged[0]["source"] == "grid"
+    assert merged[0]["alternatives"] == {"wrap_angle": [0.09, 0.35]}
+
+
+@pytest.mark.parametrize("resolution, match", [
+    ({"size": 1}, r"resolution.size: unknown axis; accepted: radius"),
+    ({"radius": "0.5 kPa"}, r"resolution.radius: unit 'kPa' is not a length"),
+    ({"coil_index": 0}, r"resolution.coil_index: the step must be > 0"),
+    ({"coil_index": True}, r"resolution.coil_index: expected a step like 0.5"),
+    ([0.5], r"resolution: expected a mapping"),
+])
+def test_bad_resolution_is_refused_with_one_line(resolution, match):
+    with pytest.raises(InputError, match=match):
+        spec(FRONT, resolution=resolution)
+
+
+def test_fixed_axis_off_the_resolution_is_refused(ds):
+    with pytest.raises(InputError, match=r"resolution.coil_index: the constraint coil_index "
+                                         r"== 1.1 is not a multiple of the step 0.2"):
+        run_design(spec(FRONT, ["coil_index == 1.1"], resolution={"coil_index": 0.2}),
+                   cube=ds)
+
+
+def test_table_lists_the_merged_alternatives(cube, tmp_path, capsys):
+    path = write_spec(tmp_path, cube, objectives=FRONT, constraints=["range_fraction >= 1"],
+                      resolution={"wall_thickness": "1 mm"})
+    rc, out, _ = run(capsys, path)
+    assert rc == 0 and "resolution wall_thickness 1 mm" in out and "alternatives" in out
+    assert "wrap_angle 5, 8" in out
+    rc, out, _ = run(capsys, path, "--format", "json")
+    doc = json.loads(out)
+    assert any(d["alternatives"].get("wrap_angle") for d in doc["designs"])

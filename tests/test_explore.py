@@ -191,3 +191,75 @@ def test_cli_refuses_a_port_in_use(cube, capsys):
         assert main(["explore", str(cube), "--port", str(port), "--no-browser"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"--port {port}: already in use" in err
+
+
+# ---------------------------------------------------------------------------- issue 25
+def test_validity_by_flag_name_in_the_served_readout(ds):
+    pytest.importorskip("panel")
+    from nylonflex.explore_page import _readout_html
+
+    syn = synthetic(ds)  # bits: 1 where radius > 20 mm, 4 where wall < 3 mm
+    assert explore.validity_names(syn, 5) == "self contact, under one turn"
+    assert explore.validity_names(syn, 0) == "valid"
+    assert explore.validity_names(syn, float("nan")) == "unknown"
+    text = _readout_html(syn, "tip_force_max", {**AT, "model": "paper"}, [])
+    assert 'id="nf-validity" data-value="4"' in text and "under one turn" in text
+    clean = _readout_html(syn, "tip_force_max", {**AT, "wall_thickness": 4e-3,
+                                                 "model": "paper"}, [])
+    assert "validity: <b>valid</b>" in clean
+
+
+def test_colour_scale_is_set_by_the_clean_designs():
+    z = np.array([[1.0, 2.0, 50.0], [3.0, np.nan, 4.0]])
+    bits = np.array([[0, 0, 1], [0, 0, 0]])
+    assert explore.colour_range(z, bits) == (1.0, 4.0)  # the flagged 50 does not set it
+    assert explore.colour_range(z) == (1.0, 50.0)
+    assert explore.colour_range(z, np.ones_like(bits)) == (1.0, 50.0)  # none clean: all
+
+
+def test_offline_file_names_its_hover_colour_bar_and_validity(ds):
+    pytest.importorskip("bokeh")
+    from nylonflex.explore_html import build_html
+
+    text = build_html(synthetic(ds), source="cube.h5")
+    # the hover names the variable (it said "value", and "???" over the star marker)
+    assert '"tooltips":[["maximum tip force [N]","@z{0.000}"]]' in text
+    assert '["value","@z' not in text
+    assert '"title":"maximum tip force [N]"' in text  # the colour bar
+    assert 'nf-validity' in text and "flagtext" in text
+    assert "colour scale is set by the unflagged designs" in text
+
+
+def test_stand_in_materials_are_named(ds):
+    note = explore.stand_in_note(ds)  # tc5005 and silver_nylon66: the default sets
+    assert note.startswith("Stand-in materials: silicone tc5005: a stand-in")
+    assert "nylon silver_nylon66:" in note and "proposals (tag P)" in note
+    other = ds.copy()
+    other.attrs = {k: v for k, v in ds.attrs.items()
+                   if k not in ("silicone_parameters", "nylon_parameters")}
+    assert explore.stand_in_note(other) == ""
+
+
+def test_copy_as_config_sweeps_to_the_selected_designs_values(ds):
+    import yaml
+
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+
+    at = {**AT, "radius": 12.5e-3, "wrap_angle": 20 * DEG}
+    text = explore.design_config(ds, at)
+    one = nf.run_sweep(parse_config(yaml.safe_load(text)))
+    for name in ("tip_force_max", "bend_angle_max", "limit", "validity"):
+        assert float(one[name].squeeze()) == float(ds[name].sel(at, method="nearest")), name
+    assert "values: ['@radius@']" in explore.design_config(ds, at, placeholders=True)
+
+
+def test_both_pages_offer_the_config(ds):
+    pytest.importorskip("bokeh")
+    pytest.importorskip("panel")
+    from nylonflex.explore_html import build_html
+    from nylonflex.explore_page import _readout_html
+
+    assert 'id="nf-config"' in _readout_html(ds, "tip_force_max", AT, [])
+    text = build_html(ds, source="cube.h5")
+    assert "copy as config" in text and "@radius@" in text

@@ -105,6 +105,16 @@ def _drive(page, cube, select_label):
     var, value = _wait_for(page, "bend_angle_max")
     assert value == pytest.approx(_expected(cube, "bend_angle_max", DESIGN), rel=5e-4)
     assert "length 70 mm" in page.locator("#nf-readout").inner_text()
+    # the read-out says the design's validity by flag name (issue 25); the cube's value
+    bits = _expected(cube, "validity", DESIGN)
+    shown = page.locator("#nf-validity")
+    assert float(shown.get_attribute("data-value")) == bits
+    assert ("valid" if bits == 0 else "self contact") in shown.inner_text()
+    # "copy as config": the selected design's grid values, as a sweep config takes them
+    import re
+
+    config = page.locator("#nf-config").text_content()
+    assert re.search(r"length:\s+values: \[70(\.0)?\]", config), config
 
 
 @contextlib.contextmanager

@@ -20,7 +20,7 @@ NAMES = {"usable_stroke", "limit", "pressure_max", "torque_max", "tip_force_max"
 
 
 def test_returns_every_design_variable_of_the_cube_table():
-    # INTERFACE.md, the cube's design variables
+    # docs/interface.md, the cube's design variables
     assert set(design_limits(**EXAMPLE_2)) == NAMES == set(DESIGN_VARIABLES)
 
 

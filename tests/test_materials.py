@@ -1,9 +1,13 @@
+import re
+
 import pytest
 
 from nylonflex.materials import (
     NYLON_PARAMETERS,
+    SILICONE_KINDS,
     SILICONE_PARAMETERS,
     nylon_parameters,
+    shear_modulus_range_text,
     silicone_parameters,
 )
 
@@ -52,8 +56,9 @@ def test_bad_material_names_the_field(call, match):
 def test_silicone_stiffness_in_kpa_is_caught_as_a_unit_slip():
     # the README's old table listed mu in kPa; a config or a call that copies 56.19, 10.49
     # gives mu_0 = 22.9 Pa, a thousand times softer than any silicone
-    with pytest.raises(ValueError, match=r"silicone.mu: .* 22.88.. Pa is implausible .*"
-                                         r"must be in \[100, 1e\+08\] Pa.* look like kPa"):
+    with pytest.raises(ValueError, match=r"silicone.mu: .* 22.88.. Pa is implausible for a "
+                                         r"shore_00 silicone; must be in \[2000, 200000\] Pa.*"
+                                         r"look like kPa"):
         silicone_parameters("tc5005", mu=[56.19, 10.49])
     import nylonflex as nf
     from conftest import EXAMPLE_2
@@ -69,3 +74,60 @@ def test_radius_in_mm_is_caught_as_a_unit_slip(example_2):
 
     with pytest.raises(ValueError, match=r"radius: must be .* 7.5 looks like mm"):
         nf.design_limits(**dict(example_2, radius=7.5))
+
+
+# ---------------------------------------------------------------------------- issue 25
+@pytest.mark.parametrize("name", sorted(SILICONE_PARAMETERS))
+@pytest.mark.parametrize("factor, slip", [
+    (1e-3, r"1000 times below .* look like kPa typed as Pa"),
+    (1e-2, r"100 times below .* misplaced decimal point"),
+    (1e2, r"100 times above .* misplaced decimal point"),
+    (1e3, r"1000 times above"),
+])
+def test_a_hundredfold_slip_of_any_named_set_is_refused_and_named(name, factor, slip):
+    # every kind's range spans a factor of 100 around its sets (materials.SILICONE_KINDS),
+    # so the set's own mu scaled by 100 or 1000 either way leaves it
+    p = SILICONE_PARAMETERS[name]
+    lo, hi = SILICONE_KINDS[p["kind"]]["range"]
+    assert hi / lo <= 100 and lo < silicone_parameters(name).initial_shear_modulus < hi
+    mu = [m * factor for m in p["mu"]]
+    bounds = re.escape(f"[{lo:g}, {hi:g}]")
+    with pytest.raises(ValueError, match=rf"silicone.mu: .* implausible for a {p['kind']} "
+                                         rf"silicone; must be in {bounds} Pa; it is {slip}"):
+        silicone_parameters(name, mu=mu)
+
+
+def test_elastosil_in_kpa_typed_as_pa_is_refused_everywhere():
+    # issue 25: mu: [220, 0] gave a 56,115 deg bend; elastosil's kind is shore_a
+    import nylonflex as nf
+    from conftest import EXAMPLE_2
+
+    bad = {"set": "elastosil_m4601", "mu": [220, 0]}
+    for call in (lambda: silicone_parameters(bad),
+                 lambda: nf.design_limits(**EXAMPLE_2, silicone=bad),
+                 lambda: nf.evaluate(**EXAMPLE_2, silicone=dict(bad, mu=[[220, 0]] * 2))):
+        with pytest.raises(ValueError, match=r"220 Pa is implausible for a shore_a silicone; "
+                                             r"must be in \[20000, 2e\+06\] Pa; it is 1000 "
+                                             r"times below elastosil_m4601's own"):
+            call()
+
+
+def test_kind_widens_the_range_on_request_and_is_checked():
+    stiff = {"set": "tc5005", "mu": [220e3, 0], "alpha": [2, 1]}
+    with pytest.raises(ValueError, match=r"give silicone.kind, one of shore_00, shore_a"):
+        silicone_parameters(stiff)
+    assert silicone_parameters(dict(stiff, kind="shore_a")).initial_shear_modulus == 220e3
+    with pytest.raises(ValueError, match=r"silicone.kind: must be one of shore_00, shore_a, any"):
+        silicone_parameters(dict(stiff, kind="rubber"))
+
+
+def test_readme_docs_and_messages_quote_the_registrys_bounds():
+    # the bounds are stated once (SILICONE_KINDS); README and docs/model.md print them
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    for doc in ("README.md", "docs/model.md"):
+        text = " ".join((root / doc).read_text().split())  # a quote may wrap a line
+        for kind in SILICONE_KINDS:
+            assert f"`{kind}` {shear_modulus_range_text(kind)}" in text, (doc, kind)
+        assert "100 Pa is refused" not in text and "[1 kPa, 100 MPa]" not in text

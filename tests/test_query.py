@@ -7,6 +7,7 @@ Expected numbers come from docs/model.md section 8 (the paper's worked examples,
 import csv
 import io
 import json
+import re
 
 import h5py
 import numpy as np
@@ -112,10 +113,13 @@ def test_limit_between_disagreeing_grid_points_is_unknown(ds):
                           wrap_angle=20 * DEG).values
     i = int(np.argmax(lim[1:] != lim[:-1]))  # last radius before the limit flips
     a = ds["radius"].values
-    res = query.query_cube(ds, at=dict(EXAMPLE_2, wrap_angle=20 * DEG,
-                                       radius=0.5 * (a[i] + a[i + 1])), interpolate=True)
-    assert np.isnan(res.data["limit"][0])
-    assert "boundary" in query.format_table(res) or "disagree" in query.format_table(res)
+    at = dict(EXAMPLE_2, wrap_angle=20 * DEG, radius=0.5 * (a[i] + a[i + 1]))
+    # the slab reader leaves it unknown; the query then takes it from the exact model
+    at_loc = {n: query.scan._locate(ds, n, v) for n, v in at.items()}
+    assert np.isnan(query.scan._slab_rows(ds, at_loc, i, i + 2)["limit"][0])
+    res = query.query_cube(ds, at=at, interpolate=True)
+    assert res.data["limit"][0] == nf.design_limits(**at)["limit"]
+    assert "boundary" not in query.format_table(res)
 
 
 def test_partial_at_lists_every_value_of_the_free_axes(ds):
@@ -184,7 +188,9 @@ def test_smallest_designs_giving_half_a_newton(cube, capsys):
     assert lines[0].split()[:2] == ["radius", "wall_thickness"] and "[mm]" in lines[1]
     rows = [line.split() for line in lines[2:7]]
     assert len(rows) == 5 and lines[7].startswith("5 designs shown of")
-    assert all(float(r[9]) >= 0.5 for r in rows)  # tip_force_max column [N]
+    force = lines[0].split().index("tip_force_max")  # after the axes: the asked-for column
+    assert force == 5
+    assert all(float(r[force]) >= 0.5 for r in rows)
     radii = [float(r[0]) for r in rows]
     assert radii == sorted(radii)
     with open_cube(cube) as ds:
@@ -243,21 +249,31 @@ def test_slabs_give_the_same_answer(ds, monkeypatch):
 
 # ---------------------------------------------------------------------------- formats
 def test_json_one_object_in_si_with_units(cube, capsys):
+    # docs/interface.md: {"designs": [...], "units": {...}, "matching": N, "shown": M}
     rc, out, _ = run(capsys, cube, "--at", AT_2, "--format", "json")
     doc = json.loads(out)
     assert rc == 0 and isinstance(doc, dict)
-    assert doc["point"] == "grid point" and doc["limit"] == 0
-    assert doc["radius"] == pytest.approx(7.5e-3)
-    assert doc["tip_force_max"] == pytest.approx(0.150, abs=5e-4)
+    assert doc["matching"] == doc["shown"] == len(doc["designs"]) == 1
+    one = doc["designs"][0]
+    assert one["point"] == doc["point"] == "grid point" and one["limit"] == 0
+    assert one["validity"] == 0 and isinstance(one["validity"], int)
+    assert one["radius"] == pytest.approx(7.5e-3)
+    assert one["tip_force_max"] == pytest.approx(0.150, abs=5e-4)  # docs/model.md s. 8
     assert doc["units"]["tip_force_max"] == "N" and doc["units"]["wrap_angle"] == "rad"
+    assert doc["flags"]["validity"]["1"] == "self_contact"
 
 
-def test_json_list_for_many(cube, capsys):
-    rc, out, _ = run(capsys, cube, "--where", "radius == 5 mm", "--limit", "3",
-                     "--format", "json")
+def test_json_many_is_one_object_with_the_units_once_and_the_count(cube, capsys):
+    rc, out, err = run(capsys, cube, "--where", "radius == 5 mm", "--limit", "3",
+                       "--format", "json")
     doc = json.loads(out)
-    assert rc == 0 and isinstance(doc, list) and len(doc) == 3
-    assert all(d["units"]["radius"] == "m" and d["radius"] == 5e-3 for d in doc)
+    n = 3 * 2 * 2 * 3  # every design of radius 5 mm in SMALL
+    assert rc == 0 and isinstance(doc, dict) and len(doc["designs"]) == doc["shown"] == 3
+    assert doc["matching"] == n and "held back" not in err
+    assert doc["units"]["radius"] == "m"
+    assert all(d["radius"] == 5e-3 and "units" not in d for d in doc["designs"])
+    assert all(isinstance(d["limit"], int) and isinstance(d["validity"], int)
+               for d in doc["designs"])
 
 
 def test_csv_in_si(cube, capsys):
@@ -392,3 +408,84 @@ def test_where_reads_variable_by_variable_and_finds_what_a_full_read_finds(ds, a
     assert few.matched == res.matched
     for name in query.COLUMNS:
         np.testing.assert_array_equal(few.data[name], full[name][keep][:3], err_msg=name)
+
+
+# ---------------------------------------------------------------------------- issue 25
+SLIM = "tip_force_max >= 0.5 N"
+
+
+def test_default_table_shows_axes_asked_and_headline_in_120_columns(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--where", SLIM, "--limit", "5")
+    lines = out.splitlines()
+    assert rc == 0 and max(len(line) for line in lines) <= 120
+    assert lines[0].split() == [*query.AXES, "tip_force_max", "limit", "bend_angle_max",
+                                "validity"]
+    # sorted by another variable: that one joins the table after the asked-for one
+    rc, out, _ = run(capsys, cube, "--where", SLIM, "--sort=-nylon_use", "--limit", "5")
+    assert out.splitlines()[0].split()[5:7] == ["tip_force_max", "nylon_use"]
+
+
+def test_columns_option_picks_and_refuses(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--where", SLIM, "--limit", "2",
+                     "--columns", "radius,validity,heating_time")
+    assert rc == 0 and out.splitlines()[0].split() == ["radius", "validity", "heating_time"]
+    assert out.splitlines()[2].split()[2] == "nan"  # named: kept although all NaN
+    rc, out, _ = run(capsys, cube, "--limit", "1", "--columns", "all")
+    assert "heating_time" not in out.splitlines()[0]  # no supply: no value in any row
+    assert "usable_stroke" in out.splitlines()[0]
+    rc, out, _ = run(capsys, cube, "--limit", "2", "--format", "csv", "--columns",
+                     "radius,limit")
+    assert rc == 0 and out.splitlines()[0] == "radius [m],limit [1]"
+    for bad, match in (("radius,grip", r"--columns: unknown name 'grip'"),
+                       ("radius,radius", r"--columns: radius given twice"),
+                       ("feasibility", r"--columns: the cube has no feasibility")):
+        rc, _, err = run(capsys, cube, "--columns", bad)
+        assert rc == 2 and re.search(match, err), err
+
+
+def test_table_drops_the_all_nan_heating_time_but_json_keeps_every_column(cube, capsys):
+    rc, out, _ = run(capsys, cube, "--at", AT_2)
+    assert rc == 0 and "heating_time" not in out and "validity         valid" in out
+    rc, out, _ = run(capsys, cube, "--at", AT_2, "--format", "json")
+    assert json.loads(out)["designs"][0]["heating_time"] is None
+
+
+def test_validity_prints_as_flag_names_and_integers(ds):
+    res = query.query_cube(ds, where=["validity == 1"], limit=1)
+    assert res.matched == int((ds["validity"] == 1).sum()) > 0
+    assert "self_contact" in query.format_table(res).splitlines()[2]
+    rows = list(csv.reader(io.StringIO(query.format_csv(res))))
+    assert rows[1][rows[0].index("validity [1]")] == "1"
+    assert rows[1][rows[0].index("limit [1]")] in ("0", "1")
+    assert query.flag_names(0) == "valid" and query.flag_names(3) == \
+        "self_contact+stretch_beyond_fit" and query.flag_names(np.nan) == "unknown"
+
+
+#: SMALL at wall 2 mm, L 90 mm, C 1.7, 8 deg: validity 0 at radius 10 mm, 1 (self_contact)
+#: at 12.5 mm (read from the cube), so 11 mm lies between grid points that disagree.
+FLIP = dict(wall_thickness=2e-3, length=90e-3, coil_index=1.7, wrap_angle=8 * DEG)
+
+
+def test_interpolate_takes_the_flags_from_the_exact_model(ds, cube, capsys):
+    assert [int(ds["validity"].sel(dict(FLIP, radius=r)).item()) for r in (10e-3, 12.5e-3)] == [0, 1]
+    at = dict(FLIP, radius=11e-3)
+    res = query.query_cube(ds, at=at, interpolate=True)
+    exact = nf.design_limits(**at)
+    assert res.point == query.INTERPOLATED and res.flags == query.EXACT
+    assert res.data["validity"][0] == exact["validity"]  # not 0.44, the linear blend
+    assert res.data["limit"][0] == exact["limit"]
+    rc, out, _ = run(capsys, cube, "--at", "radius=11mm,wall_thickness=2mm,length=90mm,"
+                     "coil_index=1.7,wrap_angle=8deg", "--interpolate")
+    assert rc == 0 and "limit and validity: exact model" in out
+    assert f"validity         {query.flag_names(exact['validity'])}" in out
+
+
+def test_interpolated_flags_without_the_exact_model_are_unknown_where_corners_disagree(ds):
+    # the slab reader itself (what a cube of several models gets): never a blend
+    at = dict(FLIP, radius=11e-3)
+    at_loc = {n: query.scan._locate(ds, n, v) for n, v in at.items()}
+    rows = query.scan._slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
+    assert np.isnan(rows["validity"][0])
+    at_loc = {n: query.scan._locate(ds, n, v) for n, v in dict(at, radius=6e-3).items()}
+    rows = query.scan._slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
+    assert rows["validity"][0] == 0  # both corners clean

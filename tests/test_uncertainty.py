@@ -181,10 +181,11 @@ def test_config_hash_follows_the_uncertainty_section():
 def test_query_where_feasibility(sampled_cube, capsys):
     path, _ = sampled_cube
     rc = main(["query", str(path), "--where", "feasibility >= 0.9", "--format", "json"])
-    rows = json.loads(capsys.readouterr().out)
-    assert rc == 0 and rows
+    doc = json.loads(capsys.readouterr().out)  # one object (docs/interface.md)
+    rows = doc["designs"]
+    assert rc == 0 and rows and doc["shown"] == len(rows)
     assert all(r["feasibility"] >= 0.9 for r in rows)
-    assert rows[0]["units"]["feasibility"] == "1"
+    assert doc["units"]["feasibility"] == "1"
 
 
 def test_query_feasibility_on_a_plain_cube_is_refused(tmp_path, capsys):

@@ -81,7 +81,7 @@ class FitResult:
         return self.y - self.y_fit
 
     def to_json(self) -> dict:
-        """The object ``nylonflex fit ... --format json`` prints (INTERFACE.md), SI."""
+        """The object ``nylonflex fit ... --format json`` prints (docs/interface.md), SI."""
         out = {"model": self.model, "parameters": _plain(self.parameters),
                "stderr": _plain(self.stderr), "ci95": _plain(self.ci95)}
         for name, d in self.derived.items():

@@ -127,10 +127,14 @@ def _cut_ins(ds, var, sel, coils, psis):
     return out
 
 
-def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
+def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
     """Fig. 12(b,c) panel: ``var`` against radius per coil index (solid while
     stroke-limited) and each wrap angle's threshold (dashed black) through the last
     designs with a full range of motion.
+
+    The solid line is stroke-limited at some wrap angle of the cube, or, with ``fixed``
+    (the caller fixed the wrap angles to ``psis``), at one of ``psis``: it then ends where
+    their strength limit cuts in, on their thresholds.
 
     Supply- and load-limited designs (``supply``, ``coupled_muscle``) depend on the wrap
     angle: drawn thinner, dashed, at ``psi_ref`` [rad]. Designs flagged by ``validity`` at
@@ -140,7 +144,10 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None):
     x = to_display("radius", ds["radius"].values)
     flagged = "validity" in ds
     # read the panel's slice once (a large cube's chunks span every coil and wrap angle)
-    ds = ds[[var, "limit", *(["validity"] if flagged else [])]].sel(**sel).load()
+    ds = ds[[var, "limit", *(["validity"] if flagged else [])]].sel(**sel)
+    if fixed:  # only the wrap angles asked for: no solid past their thresholds
+        ds = ds.sel(wrap_angle=list(psis))
+    ds = ds.load()
     sel = {}
     j_ref = None if psi_ref is None else \
         int(np.argmin(np.abs(ds["wrap_angle"].values - psi_ref)))
@@ -352,9 +359,10 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
         for w, t in enumerate(walls):
             ax = axes[w][m] if many else axes[0][w]
             sel = {"wall_thickness": t, "length": length}
-            drew, flags = _limit_lines(ax, one, "torque_max", sel, coils, psis, psi_ref)
+            drew, flags = _limit_lines(ax, one, "torque_max", sel, coils, psis, psi_ref,
+                                       fixed=wrap_angle is not None)
             load, bits = load | drew, bits | flags
-            _quantile_bands(ax, one, "torque_max", sel, coils)
+            _quantile_bands(ax, one, "torque_max", sel, coils, psi_ref)
             _examples(ax, one, "torque_max", t, coils=coils, brief=many)
             ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
                          f"{model}\n{_eq('wall_thickness', t)}",
@@ -424,7 +432,8 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             sel = {"wall_thickness": t, "length": length}
             top, bottom = (axes[2 * w][m], axes[2 * w + 1][m]) if many else \
                 (axes[0][w], axes[1][w])
-            drew, flags = _limit_lines(top, one, "bend_angle_max", sel, coils, psis, psi)
+            drew, flags = _limit_lines(top, one, "bend_angle_max", sel, coils, psis, psi,
+                                       fixed=wrap_angle is not None)
             load, bits = load | drew, bits | flags
             _quantile_bands(top, one, "bend_angle_max", sel, coils, psi,
                             note_at=(0.02, 0.98))
@@ -478,7 +487,8 @@ def _band_levels(ds):
 def _quantile_bands(ax, ds, var, sel, coils, wrap_angle=None, note_at=(0.99, 0.01)):
     """Shade each coil index's band between the cube's lowest and highest quantile of
     ``var`` (a cube with ``uncertainty``; nothing otherwise), at ``wrap_angle`` (default
-    nearest 8 deg)."""
+    nearest 8 deg), only where the nominal design there is not strength-limited: a band
+    follows its curve and ends at its wrap angle's threshold."""
     qname = quantile_name(var)
     if qname not in ds or "quantile" not in ds.coords:
         return
@@ -488,7 +498,9 @@ def _quantile_bands(ax, ds, var, sel, coils, wrap_angle=None, note_at=(0.99, 0.0
     for k, c in enumerate(coils):
         cut = ds[qname].sel(coil_index=c, wrap_angle=psi, **sel).transpose("quantile",
                                                                            "radius").values
-        ax.fill_between(x, to_display(var, cut[lo]), to_display(var, cut[hi]),
+        lim = ds["limit"].sel(coil_index=c, wrap_angle=psi, **sel).values.astype(float)
+        drawn = np.isfinite(lim) & (lim != 1)  # where the curve is (not strength-limited)
+        ax.fill_between(x, to_display(var, cut[lo]), to_display(var, cut[hi]), where=drawn,
                         color=_COLOURS[k % len(_COLOURS)], alpha=0.18, lw=0, zorder=2)
     ax.text(*note_at, f"bands: {100 * q[lo]:g}-{100 * q[hi]:g} % at "
             f"{_eq('wrap_angle', psi)}", transform=ax.transAxes,

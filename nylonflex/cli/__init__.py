@@ -50,7 +50,7 @@ def _module(name):
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser of every ``nylonflex`` command (INTERFACE.md).
+    """The parser of every ``nylonflex`` command (docs/interface.md).
 
     ``command``: only that command's arguments are added (the others are listed by name
     and help line only, which is all ``--help`` and ``--version`` need), so a command
@@ -162,7 +162,8 @@ def _main(argv=None) -> int:
         parser.print_help()
         return EXIT_OK
     try:
-        return _module(args.command).run(args) or EXIT_OK
+        with _compile_notices(args.command):
+            return _module(args.command).run(args) or EXIT_OK
     except KeyboardInterrupt:
         print("nylonflex: interrupted", file=sys.stderr)
         return interrupted_status()
@@ -177,6 +178,35 @@ def _main(argv=None) -> int:
         print(f"nylonflex {args.command}: failed: {type(exc).__name__}: {one_line(exc)}",
               file=sys.stderr)
         return EXIT_FAILURE
+
+
+class _compile_notices:
+    """A kernel compiling during a command (nylonflex.kernels.compiling's
+    ``CompileWarning``, Numba's own signal): one line on stderr, when it starts. Other
+    warnings are shown as Python shows them. Nothing is imported here (no numba)."""
+
+    def __init__(self, command):
+        self.command = command
+
+    def __enter__(self):
+        import warnings
+
+        self._show = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if category.__name__ == "CompileWarning":
+                print(f"nylonflex {self.command}: {message}", file=sys.stderr, flush=True)
+            else:
+                self._show(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        return self
+
+    def __exit__(self, *exc):
+        import warnings
+
+        warnings.showwarning = self._show
+        return False
 
 
 def one_line(exc) -> str:

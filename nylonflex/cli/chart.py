@@ -11,7 +11,7 @@ HELP = "draw design charts from a cube"
 def add_arguments(c):
     from ..config import CHARTS
 
-    c.add_argument("cube")
+    c.add_argument("cube", nargs="?")  # "--figure fig4 CUBE" works too: see run()
     c.add_argument("--figure", nargs="+", metavar="NAME",
                    help=f"figures (default: all): {', '.join(CHARTS)} "
                         "('nylonflex list charts' says what each shows)")
@@ -48,6 +48,15 @@ def run(args) -> int:
     from ..units import InputError
     from ._common import open_cube_for, progress_bar
 
+    from ..config import CHARTS
+
+    if args.cube is None and args.figure and args.figure[-1] not in CHARTS:
+        args.cube = args.figure.pop()  # "--figure fig4 CUBE": argparse gave CUBE to --figure
+    if args.cube is None:
+        raise InputError("cube: give the cube to draw, e.g. nylonflex chart "
+                         "sweeps/fig12/cube.h5 --figure fig4")
+    if args.figure == []:
+        raise InputError(f"--figure: name at least one of {', '.join(CHARTS)}")
     ds = open_cube_for("chart", args.cube)
     out = Path(args.out) if args.out else Path(args.cube).parent
     if out.exists() and not out.is_dir():
@@ -55,7 +64,12 @@ def run(args) -> int:
     try:
         at = parse_at(args.at) if args.at else None
         coils = _coil_indices(args.coil_index) if args.coil_index else None
-        skip = lambda msg: print(f"nylonflex chart: {msg}", file=sys.stderr)  # noqa: E731
+        skipped = []
+
+        def skip(msg):
+            skipped.append(msg)
+            print(f"nylonflex chart: {msg}", file=sys.stderr)
+
         with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
             paths = draw_charts(ds, args.figure, out, args.format, on_skip=skip, at=at,
                                coil_index=coils, progress=bar, variable=args.variable,
@@ -64,4 +78,8 @@ def run(args) -> int:
             print(path)
     finally:
         ds.close()
+    if args.figure and skipped:  # asked for by name, and not drawn: not done
+        print(f"nylonflex chart: error: {len(skipped)} of the {len(args.figure)} figure(s) "
+              "asked for could not be drawn from this cube (above)", file=sys.stderr)
+        return 1
     return 0

@@ -1,4 +1,4 @@
-"""``nylonflex explore CUBE``: a local web page with sliders over a cube (INTERFACE.md)."""
+"""``nylonflex explore CUBE``: a local web page with sliders over a cube (docs/interface.md)."""
 
 from __future__ import annotations
 
@@ -22,6 +22,16 @@ def add_arguments(p):
     p.add_argument("--html", metavar="OUT.html", help="write one offline HTML file and exit")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --html file")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+
+
+_NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explore]'"
+
+
+def _has(module: str) -> bool:
+    """Whether ``module`` can be imported (the optional ``explore`` extra)."""
+    import importlib.util
+
+    return importlib.util.find_spec(module) is not None
 
 
 def port_free(port: int, host: str = "127.0.0.1") -> bool:
@@ -60,6 +70,9 @@ def run(args) -> int:
 
     ds = open_cube_for("explore", args.cube)
     if args.html:
+        if not _has("bokeh"):
+            print(_NEEDS_EXTRA.format(what="the offline file needs Bokeh"), file=sys.stderr)
+            return 1
         from ..explore_html import build_html
 
         from ..files import write_atomic
@@ -69,12 +82,11 @@ def run(args) -> int:
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
 
-    try:
-        import panel as pn
-    except ModuleNotFoundError:
-        print("nylonflex explore: failed: the explorer needs Panel and HoloViews: "
-              "pip install 'nylonflex[explore]'", file=sys.stderr)
+    if not (_has("panel") and _has("holoviews")):
+        print(_NEEDS_EXTRA.format(what="the explorer needs Panel and HoloViews"),
+              file=sys.stderr)
         return 1
+    import panel as pn
 
     from ..explore_page import build_page
 

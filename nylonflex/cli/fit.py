@@ -74,14 +74,29 @@ def fit(args):
     return fit_muscle(args.data, nylon, t_amb, t_max, args.name)
 
 
+def _shown(unit, value, spread=False):
+    """A value in the unit a user reads: temperatures [K] in degC (a spread, such as a
+    standard error, keeps its size), the rest as fitted."""
+    if unit == "K":
+        return ("degC", value) if spread else ("degC", value - 273.15)
+    return unit, value
+
+
 def format_table(res) -> str:
-    """The fit as aligned text lines."""
+    """The fit as aligned text lines (temperatures in degC; JSON stays SI)."""
     def one(v):
         return f"{v:.6g}"
+
+    def line(name, unit, v, s, c):
+        shown, v = _shown(unit, v)
+        s, lo, hi = _shown(unit, s, True)[1], _shown(unit, c[0])[1], _shown(unit, c[1])[1]
+        return (f"  {name + ' [' + shown + ']':<36}{one(v):>14}{one(s):>14}   "
+                f"[{one(lo)}, {one(hi)}]")
+
     lines = [f"{res.kind} fit: {res.model}" + (f" ({res.test})" if res.test else "")
              + f", {res.n_points} points of {res.data['path']}",
              f"  data sha256 {res.data['sha256']}",
-             f"  {'parameter':<28}{'value':>14}{'std error':>14}   95 % interval"]
+             f"  {'parameter':<36}{'value':>14}{'std error':>14}   95 % interval"]
     for key, val in res.parameters.items():
         unit = res.units.get(key, "")
         vals = val if isinstance(val, list) else [val]
@@ -89,14 +104,14 @@ def format_table(res) -> str:
         cis = res.ci95[key] if isinstance(val, list) else [res.ci95[key]]
         for i, (v, s, c) in enumerate(zip(vals, ses, cis)):
             name = f"{key}_{i + 1}" if isinstance(val, list) else key
-            lines.append(f"  {name + ' [' + unit + ']':<28}{one(v):>14}{one(s):>14}   "
-                         f"[{one(c[0])}, {one(c[1])}]")
+            lines.append(line(name, unit, v, s, c))
     for key, d in res.derived.items():
-        unit = res.units.get(key, "")
-        lines.append(f"  {key + ' [' + unit + ']':<28}{one(d['value']):>14}"
-                     f"{one(d['stderr']):>14}   [{one(d['ci95'][0])}, {one(d['ci95'][1])}]")
+        if key in res.parameters:  # tau: fitted, and listed among the derived values too
+            continue
+        lines.append(line(key, res.units.get(key, ""), d["value"], d["stderr"], d["ci95"]))
     rng = ", ".join(f"{k} {one(v[0])}-{one(v[1])}" for k, v in res.fitted_range.items())
-    lines.append(f"  RMSE {one(res.rmse)} {res.units.get('rmse', '')}, R^2 {res.r2:.6f}; "
+    rmse_unit, rmse = _shown(res.units.get("rmse", ""), res.rmse, spread=True)
+    lines.append(f"  RMSE {one(rmse)} {rmse_unit}, R^2 {res.r2:.6f}; "
                  f"fitted range (SI): {rng}; intervals: {res.uncertainty}")
     lines += [f"  note: {n}" for n in res.notes]
     return "\n".join(lines) + "\n"

@@ -1,4 +1,4 @@
-"""``nylonflex query CUBE``: print the designs asked for (INTERFACE.md)."""
+"""``nylonflex query CUBE``: print the designs asked for (docs/interface.md)."""
 
 from __future__ import annotations
 
@@ -43,6 +43,11 @@ def add_arguments(q):
     q.add_argument("--sort", metavar="NAME",
                    help=f"order by one of: {', '.join(COLUMNS)} (-NAME or NAME:desc for "
                         "descending)")
+    q.add_argument("--columns", action="append", metavar="NAME,...",
+                   help="the columns to print, e.g. radius,tip_force_max,validity ('all' for "
+                        "every one); default: a table shows the axes, the --where and --sort "
+                        "names, then limit, tip_force_max, bend_angle_max and validity; json "
+                        "and csv every column")
     q.add_argument("--limit", type=_limit, default=DEFAULT_LIMIT, metavar="N|all",
                    help=f"at most N rows (default {DEFAULT_LIMIT}; 'all' for every one)")
     q.add_argument("--format", choices=["table", "json", "csv"], default="table",
@@ -64,6 +69,7 @@ def run(args) -> int:
             res = query_cube(ds, at=parse_at(args.at) if args.at else None,
                              where=parse_where(args.where), sort=args.sort,
                              limit=args.limit, interpolate=args.interpolate,
+                             columns=args.columns,
                              progress=bar, log=lambda m: print(f"nylonflex query: {m}",
                                                                file=sys.stderr))
         if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
@@ -74,7 +80,7 @@ def run(args) -> int:
     fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
     sys.stdout.write(fmt(res))
     hidden = held_back(res)
-    if hidden and args.format != "table":  # the table says so itself
+    if hidden and args.format == "csv":  # a table and JSON say so themselves
         print(f"nylonflex query: {len(res)} rows of {res.matched} matching; {hidden} held "
               "back (--limit N for more, --limit all for every one)", file=sys.stderr)
     return 0

@@ -1,4 +1,4 @@
-"""``nylonflex sensitivity CONFIG``: Sobol' indices of design variables (INTERFACE.md)."""
+"""``nylonflex sensitivity CONFIG``: Sobol' indices of design variables (docs/interface.md)."""
 
 from __future__ import annotations
 

@@ -88,6 +88,7 @@ def _run(args, ahead) -> int:
             if ahead is not None and not cfg.charts:
                 ahead.close()
             signals.enter_context(deferred_signals(on_second=_stop_at_once))
+            unchanged = _up_to_date(cfg, out, args)
             prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
         with _progress(cfg.n_designs, args.quiet) as bar:
             sweep_file(cfg, out, resume=args.resume, workers=args.workers,
@@ -98,14 +99,42 @@ def _run(args, ahead) -> int:
         return 0
     from ._common import progress_bar
 
+    names = list(cfg.charts)
+    if unchanged:  # nothing was computed: the charts already beside it stay as they are
+        names = [n for n in names if not _chart_drawn(out.parent, n)]
+        if len(names) < len(cfg.charts):
+            log(f"charts beside {out} are up to date (the cube did not change): "
+                f"{len(cfg.charts) - len(names)} kept; 'nylonflex chart {out}' redraws them")
+        if not names:
+            return 0
     skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
     with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
         # beside the cube: only this cube's earlier charts are replaced, others skipped
-        paths = ahead.draw(out, cfg.charts, out.parent, "png", on_skip=skip,
+        paths = ahead.draw(out, names, out.parent, "png", on_skip=skip,
                            progress=bar, refuse_foreign=False)
     for path in paths:
         print(path)
     return 0
+
+
+def _up_to_date(cfg, out, args) -> bool:
+    """Whether ``out`` already holds this config's complete cube, so the sweep will have
+    nothing to do (storage decides that too; here it only spares the charts)."""
+    if getattr(args, "overwrite", False) or not out.is_file():
+        return False
+    from ..storage.reader import cube_attrs
+
+    try:
+        attrs = cube_attrs(out)
+    except Exception:  # noqa: BLE001 - not a cube: the sweep itself says so
+        return False
+    return bool(attrs) and attrs.get("complete") == "true" and \
+        attrs.get("config_sha256") == cfg.sha256
+
+
+def _chart_drawn(folder, name) -> bool:
+    """A chart ``name`` is beside the cube (``fig4.png``, or per model ``fig4_paper.png``)."""
+    return (folder / f"{name}.png").is_file() or any(folder.glob(f"{name}_*.png"))
 
 
 def _stop_at_once():

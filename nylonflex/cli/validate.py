@@ -38,8 +38,14 @@ def run(args) -> int:
                "checks": [c.to_json() for c in comps]}
         sys.stdout.write(json_text(out, indent=2))
         return 0
+    from ..variables import VARIABLES, to_display
+
     print(f"{args.config} against {table.path} ({len(table)} rows)")
     for c in comps:
+        # the RMSE in the unit the data is read in (deg, kPa), as the table quotes it
+        known = c.quantity in VARIABLES and VARIABLES[c.quantity].units == c.unit
+        rmse = float(to_display(c.quantity, c.rmse)) if known else c.rmse
+        unit = VARIABLES[c.quantity].display if known else c.unit
         print(f"  {c.quantity:<11} against {c.x_name:<9} {c.error_name.replace('_', ' ')} "
-              f"{c.error_percent:.2f} %, RMSE {c.rmse:.4g} {c.unit} ({c.x.size} points)")
+              f"{c.error_percent:.2f} %, RMSE {rmse:.4g} {unit} ({c.x.size} points)")
     return 0

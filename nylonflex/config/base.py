@@ -197,10 +197,37 @@ _TYPE_MESSAGES = {
 }
 
 
+#: What a missing required key of a sweep config is, as the message says it.
+_MISSING_HINTS = {
+    "curves": "every sweep needs its curve axes, e.g. curves: {stroke: {start: 0, stop: 0.1, "
+              "num: 51}, pressure: {start: 0, stop: 40, num: 41, units: kPa}} "
+              "(configs/fig12.yaml)",
+    "grid": "every sweep needs its design grid: radius, wall_thickness, length, coil_index, "
+            "wrap_angle (configs/fig12.yaml)",
+}
+
+
+def _misspelt(errors, e) -> str | None:
+    """An unknown key beside a missing one ``e`` that is most likely it, misspelt."""
+    import difflib
+
+    missing = str(e["loc"][-1])
+    extra = [str(x["loc"][-1]) for x in errors if x["type"] == "extra_forbidden"
+             and tuple(x["loc"][:-1]) == tuple(e["loc"][:-1])]
+    close = difflib.get_close_matches(missing, extra, n=1, cutoff=0.6)
+    return close[0] if close else None
+
+
 def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
     """One line for the first error of a validation against ``model``: the dotted field and
-    what it accepts."""
-    e = err.errors()[0]
+    what it accepts (a missing key beside a misspelling of it: the misspelling)."""
+    errors = err.errors()
+    e = errors[0]
+    if e["type"] == "missing":
+        typo = _misspelt(errors, e)
+        if typo is not None:
+            where = ".".join(str(x) for x in (*e["loc"][:-1], typo))
+            return f"{where}: unknown key; did you mean '{e['loc'][-1]}'?"
     path, tp = _walk(model, e["loc"])
     msg = e["msg"].removeprefix("Value error, ")
     got = e.get("input")
@@ -213,6 +240,8 @@ def _pydantic_message(err: ValidationError, model: type[BaseModel]) -> str:
         msg, tail = "unknown key" + (f"; accepted: {', '.join(keys)}" if keys else ""), ""
     elif kind == "missing":
         msg, tail = "missing key", ""
+        if path in _MISSING_HINTS:
+            msg += f"; {_MISSING_HINTS[path]}"
     elif kind == "literal_error":
         msg = msg.replace("Input should be", "must be one of")
     elif kind in ("union_tag_invalid", "union_tag_not_found"):

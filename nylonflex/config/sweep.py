@@ -117,7 +117,7 @@ class Limits(_Strict):
 
 
 class SweepConfig(_Strict):
-    """The sweep config of INTERFACE.md, as typed (not yet resolved to SI)."""
+    """The sweep config of docs/interface.md, as typed (not yet resolved to SI)."""
 
     name: str
     silicone: Union[str, dict[str, Any]] = "tc5005"
@@ -366,9 +366,14 @@ def apply_overrides(raw: dict, overrides) -> dict:
             nxt = node.get(part) if isinstance(node, dict) else None
             if nxt is None:
                 nxt = node[part] = {}
+            if i == 0 and part in ("silicone", "nylon") and isinstance(nxt, str):
+                # a named set: a field override keeps it ({set: tc5005, mu: [...]})
+                nxt = node[part] = {"set": nxt}
             if not isinstance(nxt, dict):
-                raise InputError(f"--set {short(key)}: {short('.'.join(parts[:i + 1]))} is "
-                                 "not a mapping")
+                where = '.'.join(parts[:i + 1])
+                raise InputError(f"--set {short(key)}: {short(where)} is {short(nxt)}, not a "
+                                 f"mapping with fields; set it whole instead, e.g. --set "
+                                 f"{short(where)}=VALUE")
             node = nxt
         try:
             parsed = load_yaml(value, f"--set {short(key)}")

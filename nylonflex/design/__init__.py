@@ -7,7 +7,9 @@
 Stages: (1) the grid: the cube's feasible designs and the best of them (one objective) or
 their non-dominated set (several); (2) with ``refine``, continuous optimisation over the
 axes with the exact model (:mod:`.refine`); (3) every reported design re-evaluated exactly
-and dropped if it violates a constraint.
+and dropped if it violates a constraint; (4) with a ``resolution``, every design snapped to
+it and re-checked exactly, and designs equal in every objective merged into one row
+(:mod:`.resolution`, a step of its own after refinement).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 from ..query import COLUMNS
 from .refine import Model, evaluate_rows, meets, refine
+from .resolution import check_fixed, merge_equal, snap
 from .search import GridScan, nondominated, scan_grid
 from .spec import DesignSpec, Objective, load_spec, parse_spec
 
@@ -50,6 +53,11 @@ class DesignResult:
         Exact model evaluations.
     dropped : int
         Reported candidates dropped because exact re-evaluation broke a constraint.
+    snapped : dict
+        With a ``resolution``: ``steps`` {axis: SI step}, ``candidates`` (on-resolution
+        designs that met every constraint exactly) and ``lost`` (designs none of whose
+        on-resolution neighbours did); with several objectives or a resolution, ``merged``
+        (rows equal in every objective merged into one, see ``alternatives``).
     """
 
     spec: DesignSpec
@@ -60,6 +68,7 @@ class DesignResult:
     evaluations: int
     dropped: int = 0
     improvement: dict = field(default_factory=dict)
+    snapped: dict = field(default_factory=dict)
 
     @property
     def feasible(self) -> bool:
@@ -157,6 +166,9 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
     ok = meets(spec, new, scan.fixed)
     dropped += int((~ok).sum())
     new = {k: v[ok] for k, v in new.items()}
+    snapped = {}
+    if spec.resolution:  # a separate step after refinement (nylonflex.design.resolution)
+        grid, new, snapped = _on_resolution(model, spec, scan, grid, new)
 
     signs = np.array([o.sign for o in spec.objectives])
 
@@ -168,9 +180,9 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
     if not multi:
         grid = {k: v[:1] for k, v in grid.items()}
         designs = _records(grid, "grid")
-        if len(new["radius"]) and len(grid["radius"]):
+        if len(new["radius"]):
             k = int(np.argmin(F(new)[:, 0]))
-            if F(new)[k, 0] < F(grid)[0, 0]:
+            if not len(grid["radius"]) or F(new)[k, 0] < F(grid)[0, 0]:
                 designs = _records({n: v[k:k + 1] for n, v in new.items()}, "refined") + designs
         if spec.refine and designs:
             name = spec.objectives[0].name
@@ -180,7 +192,7 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
         order = np.lexsort(F(grid).T[::-1]) if len(grid["radius"]) else []
         grid = {k: v[order] for k, v in grid.items()}
         designs = _records(grid, "grid")
-        if spec.refine:
+        if spec.refine or len(new["radius"]):  # new: refined, or grid designs snapped
             both = {k: np.concatenate([new[k], grid[k]]) for k in grid}
             source = ["refined"] * len(new["radius"]) + ["grid"] * len(grid["radius"])
             keep = nondominated(F(both)) if len(source) else np.zeros(0, bool)
@@ -190,8 +202,23 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
             designs = [{**{k: float(both[k][i]) for k in both}, "source": source[i]}
                        for i in idx]
             improvement = _front_gain(F(grid), F(refined_front), spec)
+    if multi or spec.resolution:
+        designs, snapped["merged"] = merge_equal(designs, spec.objectives)
     return DesignResult(spec, designs, grid, refined_front, scan, model.evaluations,
-                        dropped, improvement)
+                        dropped, improvement, snapped)
+
+
+def _on_resolution(model, spec, scan, grid, new):
+    """The grid's and the refinement's designs snapped to the spec's resolution, each
+    re-checked exactly; grid designs that had to move join the refined ones."""
+    check_fixed(spec.resolution, scan.fixed)
+    g, g_moved, g_lost = snap(model, spec, grid, scan.ranges, keep_bits=True)
+    r, _, r_lost = snap(model, spec, new, scan.ranges)
+    keep = {k: g[k][~g_moved] for k in g}
+    moved = {k: np.concatenate([r[k], g[k][g_moved]]) for k in g}
+    info = {"steps": dict(spec.resolution), "lost": g_lost + r_lost,
+            "candidates": len(g["radius"]) + len(r["radius"])}
+    return keep, moved, info
 
 
 def _front_gain(g, r, spec):

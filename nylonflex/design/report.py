@@ -9,15 +9,39 @@ import math
 
 import numpy as np
 
-from ..query import COLUMNS, _cell
+from ..query import COLUMNS, _cell, default_columns
+from ..query.format import INTEGERS
 from ..variables import VARIABLES, to_display
 
 __all__ = ["format_csv", "format_json", "format_table"]
 
 
 def _columns(res):
-    extra = [k for d in res.designs[:1] for k in d if k not in COLUMNS and k != "source"]
+    extra = [k for d in res.designs[:1] for k in d
+             if k not in COLUMNS and k not in ("source", "alternatives")]
     return [*COLUMNS, *extra]
+
+
+def _table_columns(res):
+    """A table's columns: the axes, the objectives and constrained variables, then the
+    headline ones (as ``query`` shows them), leaving out columns no design has a value in."""
+    asked = [o.name for o in res.spec.objectives] + [c.name for c in res.spec.constraints]
+    cols = [c for c in default_columns(_columns(res), asked)
+            if any(math.isfinite(float(d[c])) for d in res.designs)]
+    if any(d.get("alternatives") for d in res.designs):
+        cols.append("alternatives")
+    return cols
+
+
+def _alternatives_text(alt) -> str:
+    """``"wrap_angle 5, 8, 20 deg"``: the values of the merged designs' differing axes."""
+    parts = []
+    for name, values in alt.items():
+        unit = VARIABLES[name].display
+        parts.append(f"{name} " + ", ".join(f"{float(to_display(name, v)):.6g}"
+                                            for v in values)
+                     + ("" if unit == "1" else f" {unit}"))
+    return "; ".join(parts)
 
 
 def _shown(name, x) -> str:
@@ -63,6 +87,16 @@ def summary(res) -> list:
     if res.dropped:
         lines.append(f"{res.dropped} design(s) dropped: exact re-evaluation broke "
                      "a constraint")
+    snapped = getattr(res, "snapped", {}) or {}
+    if snapped.get("steps"):
+        steps = ", ".join(f"{n} {_shown(n, v)}" for n, v in snapped["steps"].items())
+        lines.append(f"resolution {steps}: every design snapped to it and re-checked "
+                     f"exactly ({snapped['candidates']} on-resolution candidates met every "
+                     "constraint" + (f"; {snapped['lost']} design(s) had no on-resolution "
+                                     "neighbour that does" if snapped["lost"] else "") + ")")
+    if snapped.get("merged"):
+        lines.append(f"{snapped['merged']} design(s) equal in every objective merged into "
+                     "the row listing them under 'alternatives'")
     lines.append(f"{res.evaluations} exact evaluations")
     return lines
 
@@ -91,30 +125,39 @@ def format_table(res) -> str:
         print(line, file=out)
     if not res.designs:
         return out.getvalue()
-    heads = ["source", *_columns(res)]
+    heads = ["source", *_table_columns(res)]
     units = [""] + [f"[{VARIABLES[h].display}]" if h in VARIABLES and
                     VARIABLES[h].display != "1" else "" for h in heads[1:]]
-    cells = [[d["source"]] + [_cell(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
-                              for h in heads[1:]] for d in res.designs]
+
+    def cell(h, d):
+        if h == "alternatives":
+            return _alternatives_text(d.get("alternatives") or {})
+        return _cell(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
+
+    cells = [[d["source"]] + [cell(h, d) for h in heads[1:]] for d in res.designs]
     widths = [max(len(h), len(u), *(len(r[j]) for r in cells))
               for j, (h, u) in enumerate(zip(heads, units))]
-    print("  ".join(h.rjust(w) for h, w in zip(heads, widths)), file=out)
-    print("  ".join(u.rjust(w) for u, w in zip(units, widths)), file=out)
+    just = [str.ljust if h == "alternatives" else str.rjust for h in heads]
+    print("  ".join(j(h, w) for h, w, j in zip(heads, widths, just)).rstrip(), file=out)
+    print("  ".join(j(u, w) for u, w, j in zip(units, widths, just)).rstrip(), file=out)
     for r in cells:
-        print("  ".join(c.rjust(w) for c, w in zip(r, widths)), file=out)
+        print("  ".join(j(c, w) for c, w, j in zip(r, widths, just)).rstrip(), file=out)
     return out.getvalue()
 
 
 def _value(name, x):
-    if name == "limit":
+    if name in INTEGERS:
         return int(x) if math.isfinite(x) else None
     return float(x) if math.isfinite(x) else None
 
 
 def format_json(res) -> str:
-    """``{"designs": [{...SI..., "source": ...}], "units": {...}}`` (INTERFACE.md)."""
+    """``{"designs": [{...SI..., "source": ...}], "units": {...}}`` (docs/interface.md);
+    a design into which others equal in every objective were merged lists their differing
+    axes under ``alternatives`` (``{axis: [SI values]}``)."""
     cols = _columns(res)
-    designs = [{**{k: _value(k, d[k]) for k in cols}, "source": d["source"]}
+    designs = [{**{k: _value(k, d[k]) for k in cols}, "source": d["source"],
+                **({"alternatives": d["alternatives"]} if "alternatives" in d else {})}
                for d in res.designs]
     units = {k: VARIABLES[k].units if k in VARIABLES else "1" for k in cols}
     return json.dumps({"designs": designs, "units": units}, indent=1) + "\n"
@@ -129,6 +172,7 @@ def format_csv(res) -> str:
                              for k in cols])
     for d in res.designs:
         w.writerow([d["source"]] + ["" if _value(k, d[k]) is None else
-                                    (_value(k, d[k]) if k == "limit" else repr(float(d[k])))
+                                    (_value(k, d[k]) if k in INTEGERS else
+                                     repr(float(d[k])))
                                     for k in cols])
     return out.getvalue()

@@ -13,6 +13,9 @@ A spec is a YAML mapping::
       - "radius <= 20 mm"
       - "coil_index == 1.1"
     refine: true                   # or {starts: 4, maxiter: 60}; false keeps grid points
+    resolution:                    # optional: what can be built, per axis (with units;
+      coil_index: 0.05             #   bare numbers in mm, deg): every reported design is
+      wall_thickness: 0.5 mm       #   snapped to multiples of it and re-checked exactly
 
 Every error is an :class:`~nylonflex.units.InputError` of one line naming the key.
 """
@@ -29,7 +32,7 @@ from ..variables import AXES
 __all__ = ["DesignSpec", "Objective", "load_spec", "parse_spec"]
 
 _KEYS = ("name", "cube", "grid", "silicone", "nylon", "base_thickness", "model",
-         "objectives", "constraints", "refine")
+         "objectives", "constraints", "refine", "resolution")
 #: The model variants a spec may name; the lead's evaluator brings the others.
 MODELS = ("paper",)
 #: Default refinement budget: multi-starts (one objective) or front seeds (several), and
@@ -80,6 +83,9 @@ class DesignSpec:
         SLSQP iterations per start.
     model : str
         Model variant (``"paper"``).
+    resolution : dict
+        ``{axis: step}`` [SI]: the designs reported lie on multiples of ``step``
+        (:mod:`nylonflex.design.resolution`); empty: any value.
     """
 
     name: str
@@ -92,6 +98,7 @@ class DesignSpec:
     maxiter: int
     model: str = "paper"
     raw: dict = field(default_factory=dict, compare=False, repr=False)
+    resolution: dict = field(default_factory=dict)
 
 
 def _objective(item, i) -> Objective:
@@ -143,6 +150,31 @@ def _refine(value, multi):
                          f"{MAX_REFINE_ITERATIONS:,} one design run may take; lower "
                          "refine.starts or refine.maxiter")
     return True, out[0], out[1]
+
+
+def _resolution(value) -> dict:
+    """``{axis: step}`` [SI] from ``resolution: {coil_index: 0.05, wall_thickness: 0.5 mm}``."""
+    from ..units import parse_quantity
+    from ..variables import VARIABLES
+
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise InputError("resolution: expected a mapping of axes to steps, e.g. "
+                         "{coil_index: 0.05, wall_thickness: 0.5 mm}")
+    out = {}
+    for name, step in value.items():
+        if name not in AXES:
+            raise InputError(f"resolution.{name}: unknown axis; accepted: {', '.join(AXES)}")
+        v = VARIABLES[name]
+        if isinstance(step, bool) or not isinstance(step, (int, float, str)):
+            raise InputError(f"resolution.{name}: expected a step like 0.5"
+                             f"{'' if v.display == '1' else ' ' + v.display}, got {step!r}")
+        si = parse_quantity(step, f"resolution.{name}", v.kind, v.display)
+        if not si > 0 or not si < float("inf"):
+            raise InputError(f"resolution.{name}: the step must be > 0, got {step!r}")
+        out[str(name)] = float(si)
+    return out
 
 
 def parse_spec(raw, source: str = "spec") -> DesignSpec:
@@ -213,7 +245,8 @@ def parse_spec(raw, source: str = "spec") -> DesignSpec:
     refine, starts, maxiter = _refine(raw.get("refine", True), len(objectives) > 1)
     return DesignSpec(name=name, cube=cube, sweep=sweep, objectives=objectives,
                       constraints=constraints, refine=refine, starts=starts, maxiter=maxiter,
-                      model=model, raw=dict(raw))
+                      model=model, raw=dict(raw),
+                      resolution=_resolution(raw.get("resolution")))
 
 
 def load_spec(path) -> DesignSpec:

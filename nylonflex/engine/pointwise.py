@@ -18,7 +18,8 @@ from contextlib import contextmanager
 import numpy as np
 
 from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
-                         check_shear_modulus, nylon_parameters, silicone_parameters)
+                         check_shear_modulus, nylon_parameters, silicone_kind,
+                         silicone_parameters)
 from ..physics._formula import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
@@ -179,7 +180,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
                   supply_voltage=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
-    The compiled :func:`evaluate` with INTERFACE.md's positional signature: floats (and an
+    The compiled :func:`evaluate` with docs/interface.md's positional signature: floats (and an
     int ``limit``) for scalar input, arrays of the broadcast shape otherwise. Arguments,
     units and errors as :func:`evaluate`; docs/model.md s. 8.
     """
@@ -244,7 +245,9 @@ def _silicone_arrays(silicone):
     if np.any(np.abs(alpha) > SILICONE_RANGES["alpha"]):
         raise ValueError(f"silicone.alpha: each term must be in "
                          f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
-    check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1))
+    name = base.get("set") if isinstance(base, Mapping) else None
+    check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1), kind=silicone_kind(base),
+                        name=name if isinstance(name, str) else None)
     return mu, alpha
 
 

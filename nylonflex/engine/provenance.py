@@ -1,4 +1,4 @@
-"""Global attributes that say how a cube was made (INTERFACE.md, "The cube")."""
+"""Global attributes that say how a cube was made (docs/interface.md, "The cube")."""
 
 from __future__ import annotations
 

@@ -1,45 +1,44 @@
-"""Compile the kernels before the work that needs them, with a notice while that takes time.
+"""Compile the kernels before the work that needs them, with a notice when they compile.
 
 The first run after installing (or after the model's sources change) compiles the Numba
-kernels, several seconds that would otherwise be counted as compute and leave the user
+kernels, seconds to minutes that would otherwise be counted as compute and leave the user
 looking at a silent terminal. :func:`warm_up_grid` and :func:`warm_up_points` call the
 kernels once on a one-design problem; a later run loads them from Numba's cache in a
-fraction of a second. The notice is a callback: the engine never prints.
+fraction of a second. Whether they compile is Numba's own signal (its ``numba:compile``
+event, :mod:`nylonflex.kernels.compiling`), never a timer: a warm run on a busy machine
+prints nothing, a cold one names each kernel it compiles with a measured estimate. The
+notice is a callback: the engine never prints.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import threading
 import time
+from contextlib import nullcontext
 
 from ..config import ResolvedConfig
 
 __all__ = ["COMPILE_NOTICE", "warm_up_grid", "warm_up_points"]
 
-#: The line a caller shows while the kernels compile.
-COMPILE_NOTICE = ("compiling the model's kernels (first run, or the model changed; cached "
-                  "for later runs: a few seconds, not counted in the timings)...")
+#: How every compile notice begins (the rest names the kernel and its estimate).
+COMPILE_NOTICE = "compiling "
 
 
-def _timed(call, notice, after):
-    """Run ``call()``; if it is still running after ``after`` [s], call ``notice`` once.
+def _timed(call, notice, after=None):
+    """Run ``call()`` with the compile notices going to ``notice`` (None: a
+    :class:`~nylonflex.kernels.compiling.CompileWarning`).
 
-    Returns the seconds ``call`` took, or 0.0 when no notice was due (a warm cache).
+    Returns the seconds ``call`` took when a kernel compiled in it, else 0.0 (a warm
+    cache). ``after`` is ignored (the notice once waited for a timer).
     """
-    timer = None
-    if notice is not None:
-        timer = threading.Timer(after, notice, args=(COMPILE_NOTICE,))
-        timer.daemon = True
-        timer.start()
+    from ..kernels.compiling import compile_seconds, notices_to
+
+    before = sum(compile_seconds().values())
     t0 = time.perf_counter()
-    try:
+    with notices_to(notice) if notice is not None else nullcontext():
         call()
-    finally:
-        if timer is not None:
-            timer.cancel()
     seconds = time.perf_counter() - t0
-    return seconds if seconds >= after else 0.0
+    return seconds if sum(compile_seconds().values()) > before else 0.0
 
 
 def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
@@ -53,14 +52,15 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     parallel : bool
         Warm the threaded kernel (local runs) or the serial one.
     notice : callable, optional
-        Receives :data:`COMPILE_NOTICE` once if the warm-up lasts over ``after`` seconds.
+        Receives one line per kernel family that really compiles (Numba's signal), with
+        an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
     after : float
-        Seconds [s] before the notice.
+        Ignored (kept for callers of the timer it replaced).
 
     Returns
     -------
     float
-        Seconds [s] spent compiling (0.0 when the kernels were ready within ``after``).
+        Seconds [s] the warm-up took when a kernel compiled, else 0.0 (a warm cache).
     """
     from .grid import compute_slab
 
@@ -78,14 +78,15 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     settings : dict, optional
         Keyword arguments of :func:`~nylonflex.engine.pointwise.evaluate` (materials).
     notice : callable, optional
-        Receives :data:`COMPILE_NOTICE` once if the warm-up lasts over ``after`` seconds.
+        Receives one line per kernel family that really compiles (Numba's signal), with
+        an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
     after : float
-        Seconds [s] before the notice.
+        Ignored (kept for callers of the timer it replaced).
 
     Returns
     -------
     float
-        Seconds [s] spent compiling (0.0 when the kernels were ready within ``after``).
+        Seconds [s] the warm-up took when a kernel compiled, else 0.0 (a warm cache).
     """
     import numpy as np
 

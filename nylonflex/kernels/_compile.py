@@ -186,3 +186,7 @@ def jit_kernel(func=None, *, parallel=False):
         return numba.njit(parallel=parallel, **JIT_OPTIONS)(f)
 
     return wrap if func is None else wrap(func)
+
+
+# Numba's compile events as a notice (before any kernel can compile): kernels/compiling.py
+from . import compiling  # noqa: E402,F401

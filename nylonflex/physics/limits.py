@@ -45,7 +45,7 @@ COOLED_FRACTION = 0.05
 #: Relative shortfall below the free stroke that counts as load-limited [-].
 LOAD_RTOL = 1e-9
 
-#: The names :func:`design_limits` returns, in the cube's order (INTERFACE.md).
+#: The names :func:`design_limits` returns, in the cube's order (docs/interface.md).
 DESIGN_VARIABLES = (
     "usable_stroke",
     "limit",

@@ -15,6 +15,11 @@ A query picks designs three ways, which combine:
 * ``--sort NAME`` (``--sort=-NAME`` or ``--sort NAME:desc`` descending; ties keep grid
   order) and ``--limit N``.
 
+``--columns NAME,...`` picks the columns; by default a table shows the axes, the variables
+``--where`` tests and ``--sort`` orders by, then :data:`HEADLINE` (``limit``,
+``tip_force_max``, ``bend_angle_max``, ``validity`` by flag name), leaving out any column
+no row has a value in; JSON and CSV carry every column.
+
 The cube is read in slabs of radii, so memory stays bounded on a cube of any size; only the
 matching rows (at most ``--limit``) are kept, and every match is counted, so that the
 output can say how many rows it held back.
@@ -23,14 +28,17 @@ output can say how many rows it held back.
 from __future__ import annotations
 
 from ..variables import AXES, DESIGN, VARIABLES  # noqa: F401  (names the tests use)
-from .format import (_cell, _describe_at, _records, _sig3, _unit, format_csv,  # noqa: F401
-                     format_json, format_table, held_back, rows_note)
+from .format import (_cell, _describe_at, _records, _sig3, _unit, flag_names,  # noqa: F401
+                     format_csv, format_json, format_table, held_back, rows_note,
+                     shown_columns)
 from .parse import (_FIELDS, _LIMIT_WORDS, _MODEL_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
-                    INTERPOLATED, OPTIONAL, Condition, _parse_sort, _quantity, parse_at,
-                    parse_where)
+                    HEADLINE, INTERPOLATED, OPTIONAL, Condition, _parse_sort, _quantity,
+                    default_columns, parse_at, parse_columns, parse_where)
 from .scan import (_GRID_RTOL, _SLAB_VALUES, QueryResult, _exact_rows,  # noqa: F401
                    _exact_settings, _locate, _select_model, _slab_rows, _sorted, at_value,
                    query_cube)
 
-__all__ = ["EXACT", "GRID", "INTERPOLATED", "Condition", "QueryResult", "format_csv", "format_json", "format_table",
-           "held_back", "parse_at", "parse_where", "query_cube", "rows_note"]
+__all__ = ["EXACT", "GRID", "HEADLINE", "INTERPOLATED", "Condition", "QueryResult",
+           "default_columns", "flag_names", "format_csv", "format_json", "format_table",
+           "held_back", "parse_at", "parse_columns", "parse_where", "query_cube", "rows_note",
+           "shown_columns"]

@@ -1,4 +1,8 @@
-"""The output of ``nylonflex query``: aligned text in display units, JSON and CSV in SI."""
+"""The output of ``nylonflex query``: aligned text in display units, JSON and CSV in SI.
+
+Every format prints the flags as whole numbers (JSON and CSV) or their names (a table:
+``limit`` as ``stroke``/``strength``/..., ``validity`` as ``valid`` or its flag names).
+"""
 
 from __future__ import annotations
 
@@ -10,7 +14,7 @@ import math
 import numpy as np
 
 from ..variables import AXES, DESIGN, MODEL, VARIABLES, to_display
-from .parse import EXACT, OPTIONAL
+from .parse import EXACT, OPTIONAL, default_columns
 
 
 def _var(name):
@@ -34,9 +38,40 @@ def _sig3(x) -> str:
     return f"{x:.2e}"
 
 
+def _flag_meanings(name) -> dict:
+    """``{bit: flag name}`` of a bit-field variable (``validity``), from its CF attributes."""
+    attrs = VARIABLES[name].attrs()
+    return dict(zip((int(v) for v in attrs["flag_masks"]), attrs["flag_meanings"].split()))
+
+
+def flag_names(x) -> str:
+    """``validity`` as its flag names: ``"valid"`` for 0, ``"self_contact+..."`` for the
+    bits set, ``"unknown"`` for NaN (docs/model.md s. 17)."""
+    if x is None or not np.isfinite(x):
+        return "unknown"
+    bits = int(x)
+    if bits == 0:
+        return "valid"
+    names = [meaning for bit, meaning in _flag_meanings("validity").items() if bits & bit]
+    rest = bits & ~sum(_flag_meanings("validity"))
+    return "+".join(names + ([f"bits {rest}"] if rest else []))
+
+
+#: Variables that hold whole numbers (flags and bit fields): printed as integers.
+INTEGERS = ("limit", "validity")
+
+
+def _integer(x):
+    """A flag's value as an int, None when unknown (NaN)."""
+    x = float(x)
+    return int(x) if math.isfinite(x) else None
+
+
 def _cell(name, x) -> str:
     if name == "model":
         return str(x)
+    if name == "validity":
+        return flag_names(x)
     if name == "limit":
         return {0.0: "stroke", 1.0: "strength", 2.0: "supply", 3.0: "load"}.get(
             float(x), "boundary") \
@@ -60,7 +95,28 @@ def _describe_at(res) -> str:
     elif res.interpolated:
         note += (" linearly in " + ", ".join(res.interpolated)
                  + " between grid points (--interpolate; the exact model may differ)")
+        if getattr(res, "flags", None):
+            note += f"; limit and validity: {res.flags}"
     return ", ".join(parts) + f": {note}"
+
+
+def _all_nan(res, name) -> bool:
+    x = res.data[name]
+    return name != "model" and len(x) > 0 and not np.isfinite(np.asarray(x, float)).any()
+
+
+def shown_columns(res, fmt="table") -> tuple:
+    """The columns a format prints: those ``--columns`` named; else, for a table, the
+    axes, the asked-for variables and the headline ones (:func:`default_columns`), and for
+    JSON and CSV every column. A table leaves out a column no row has a value in
+    (``heating_time`` without a supply) unless ``--columns`` named it."""
+    if res.chosen is not None:
+        return (("model",) if "model" in res.columns else ()) + res.chosen
+    if fmt != "table":
+        return res.columns
+    names = res.columns if getattr(res, "every", False) else \
+        default_columns(res.columns, res.asked)
+    return tuple(n for n in names if not _all_nan(res, n))
 
 
 def format_table(res) -> str:
@@ -69,7 +125,11 @@ def format_table(res) -> str:
     n = len(res)
     if res.single and n == 1:
         print(f"design at {_describe_at(res)}", file=out)
-        for name in [*DESIGN, *(c for c in res.columns if c in OPTIONAL)]:
+        names = [*DESIGN, *(c for c in res.columns if c in OPTIONAL)] \
+            if res.chosen is None else [c for c in res.chosen if c not in AXES]
+        for name in names:
+            if res.chosen is None and _all_nan(res, name):
+                continue  # heating_time without a supply
             x = res.data[name][0]
             unit = _unit(name)
             text = _cell(name, x)
@@ -86,7 +146,7 @@ def format_table(res) -> str:
         return out.getvalue()
     if res.at:
         print(f"at {_describe_at(res)}", file=out)
-    heads = list(res.columns)
+    heads = list(shown_columns(res, "table"))
     units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
     cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
     widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
@@ -118,34 +178,46 @@ def rows_note(res) -> str:
     return shown
 
 
-def _json_value(x):
+def _json_value(name, x):
+    if name == "model":
+        return str(x)
+    if name in INTEGERS:
+        return _integer(x)
     x = float(x)
     return x if math.isfinite(x) else None
 
 
 def _records(res):
-    units = {name: _var(name).units for name in res.columns}
+    """One dict per design: its ``point`` (an ``--at`` query) and SI values by column."""
+    columns = shown_columns(res, "json")
     records = []
     for i in range(len(res)):
-        rec = {}
-        if res.point:
-            rec["point"] = res.point
-        for name in res.columns:
-            x = res.data[name][i]
-            if name == "model":
-                rec[name] = str(x)
-                continue
-            rec[name] = (None if not np.isfinite(x) else int(x)) if name == "limit" \
-                else _json_value(x)
-        rec["units"] = units
+        rec = {"point": res.point} if res.point else {}
+        rec.update({name: _json_value(name, res.data[name][i]) for name in columns})
         records.append(rec)
     return records
 
 
 def format_json(res) -> str:
-    """One JSON object for one design, else a list; SI values with a ``units`` map."""
-    records = _records(res)
-    doc = records[0] if res.single and len(records) == 1 else records
+    """One JSON object (docs/interface.md): ``{"designs": [{...}, ...], "units": {...},
+    "matching": N, "shown": M}``; SI values, ``limit`` and ``validity`` as integers (their
+    meanings under ``flags``), null where unknown."""
+    columns = shown_columns(res, "json")
+    doc = {"designs": _records(res),
+           "units": {name: _var(name).units for name in columns},
+           "matching": res.matched if res.matched is not None else len(res),
+           "shown": len(res)}
+    if res.point:
+        doc["point"] = res.point
+    flags = {}
+    if "limit" in columns:
+        attrs = VARIABLES["limit"].attrs()
+        flags["limit"] = dict(zip((str(int(v)) for v in attrs["flag_values"]),
+                                  attrs["flag_meanings"].split()))
+    if "validity" in columns:
+        flags["validity"] = {str(k): v for k, v in _flag_meanings("validity").items()}
+    if flags:
+        doc["flags"] = flags
     return json.dumps(doc, indent=1) + "\n"
 
 
@@ -153,18 +225,14 @@ def format_csv(res) -> str:
     """CSV in SI, one row per design; the header names the units (``radius [m]``)."""
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
+    columns = shown_columns(res, "csv")
     head = ([] if not res.point else ["point"]) + \
-        [n if n == "model" else f"{n} [{VARIABLES[n].units}]" for n in res.columns]
+        [n if n == "model" else f"{n} [{VARIABLES[n].units}]" for n in columns]
     w.writerow(head)
     for i in range(len(res)):
         row = [] if not res.point else [res.point]
-        for name in res.columns:
-            x = res.data[name][i]
-            if name == "model":
-                row.append(str(x))
-            elif name == "limit":
-                row.append("" if not np.isfinite(x) else int(x))
-            else:
-                row.append("" if not np.isfinite(x) else repr(float(x)))
+        for name in columns:
+            x = _json_value(name, res.data[name][i])
+            row.append("" if x is None else x if isinstance(x, (str, int)) else repr(x))
         w.writerow(row)
     return out.getvalue()

@@ -14,6 +14,9 @@ COLUMNS = (*AXES, *DESIGN)
 #: Columns a cube has only when its sweep asked for them (``requirements``).
 OPTIONAL = ("feasibility",)
 _FIELDS = ", ".join(COLUMNS + OPTIONAL)
+#: What a table shows after the axes and the variables a query tests or sorts by (the
+#: limit, the two headline performance numbers and the validity flags, by name).
+HEADLINE = ("limit", "tip_force_max", "bend_angle_max", "validity")
 #: How an ``--at`` design was found: on the grid, by the exact model, interpolated.
 GRID, EXACT, INTERPOLATED = "grid point", "exact model", "interpolated"
 _LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limited": 1,
@@ -122,3 +125,39 @@ def _parse_sort(text):
         raise InputError(f"--sort: unknown name {name!r}; accepted: {_FIELDS} "
                          "(prefix '-' for descending)")
     return name, descending
+
+
+def parse_columns(text):
+    """Parse ``--columns "radius,tip_force_max"`` into a tuple of names (``"all"``: every
+    column, returned as the string ``"all"``; None: the format's default).
+
+    Raises
+    ------
+    InputError
+        An unknown name, a name given twice, or nothing named.
+    """
+    if text is None:
+        return None
+    texts = [text] if isinstance(text, str) else list(text)
+    names = [p.strip() for t in texts for p in str(t).split(",") if p.strip()]
+    if names == ["all"]:
+        return "all"
+    if not names:
+        raise InputError(f"--columns: expected NAME,... or 'all'; names: {_FIELDS}")
+    for name in names:
+        if name not in COLUMNS + OPTIONAL:
+            raise InputError(f"--columns: unknown name {name!r}; accepted: {_FIELDS}, or all")
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise InputError(f"--columns: {twice} given twice; name each column once")
+    return tuple(names)
+
+
+def default_columns(available, asked=()) -> tuple:
+    """A table's columns: the axes, the ``asked`` names (tested by ``--where`` or sorted
+    by), then :data:`HEADLINE`; only the ``available`` ones, each once, ``model`` first."""
+    out = []
+    for name in ("model", *AXES, *asked, *HEADLINE):
+        if name in available and name not in out:
+            out.append(name)
+    return tuple(out)

@@ -13,7 +13,7 @@ import numpy as np
 from ..units import InputError, from_si
 from ..variables import AXES, DESIGN, VARIABLES
 from .parse import (_MODEL_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
-                    _parse_sort, parse_at)
+                    _parse_sort, parse_at, parse_columns)
 
 # Values this close (relative to the axis span) to a grid value are that grid value.
 _GRID_RTOL = 1e-6
@@ -56,7 +56,8 @@ class QueryResult:
     Attributes
     ----------
     data : dict of str to numpy.ndarray
-        One array per column of :data:`COLUMNS`, SI.
+        One array per column of :data:`COLUMNS`, SI; ``limit`` and ``validity`` hold
+        whole numbers (NaN: unknown).
     point : str or None
         ``"grid point"``, ``"exact model"`` or ``"interpolated"`` for an ``--at`` query,
         else None.
@@ -69,10 +70,20 @@ class QueryResult:
         The query named one design (all five axes in ``--at``).
     """
 
-    def __init__(self, data, point, interpolated, matched, single, at, columns=COLUMNS):
+    def __init__(self, data, point, interpolated, matched, single, at, columns=COLUMNS,
+                 chosen=None, asked=(), flags=None, every=False):
         self.data, self.point, self.interpolated = data, point, interpolated
         self.matched, self.single, self.at = matched, single, at
         self.columns = tuple(columns)  # COLUMNS and the cube's OPTIONAL ones
+        #: the columns ``--columns`` named (None: the format's default)
+        self.chosen = None if chosen is None else tuple(chosen)
+        #: ``--columns all``: every column (a table still leaves out the all-NaN ones)
+        self.every = every
+        #: the names ``--where`` tests and ``--sort`` orders by (a table shows them)
+        self.asked = tuple(asked)
+        #: with ``--interpolate``: where ``limit`` and ``validity`` came from, "exact
+        #: model" or "unknown where the grid points disagree"; None otherwise
+        self.flags = flags
 
     def __len__(self):
         return len(self.data[COLUMNS[0]])
@@ -106,8 +117,11 @@ def _slab_rows(ds, at_loc, r0, r1):
         if name == "length":
             sub["tip_force_max"] = sub["tip_force_max"] / length
             sub["bend_angle_max"] = sub["bend_angle_max"] * length
-        # a limit between two grid points is known only where both agree
+        # a flag is never interpolated: between two grid points it is known only where
+        # both agree (query_cube then takes it from the exact model where it can)
         sub["limit"] = a["limit"].where(~mixed)
+        if "validity" in sub:
+            sub["validity"] = a["validity"].where(a["validity"] == b["validity"])
     # a cube of several models: the model is the last (fastest) axis of the rows
     dims = [d for d in (*AXES, "model") if d in sub.dims]
     shape = [sub.sizes[d] for d in dims]
@@ -275,7 +289,7 @@ def radius_slabs(ds, at_loc) -> list[tuple[int, int]]:
 
 
 def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=False,
-               progress=None, log=None) -> QueryResult:
+               columns=None, progress=None, log=None) -> QueryResult:
     """Designs of a cube selected by ``--at``, filtered by ``--where``, sorted, limited.
 
     Parameters
@@ -293,6 +307,12 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     interpolate : bool, default False
         Between grid points, interpolate the cube linearly instead of evaluating the
         exact model (:func:`nylonflex.evaluate`) with the cube's materials and settings.
+        The flags ``limit`` and ``validity`` are never interpolated: they come from the
+        exact model at each design, or, where the cube's provenance cannot give it (a
+        cube of several models), are unknown (NaN) wherever the grid points disagree.
+    columns : str or sequence of str, optional
+        The columns to show (``--columns``; ``"all"`` or None: the format's default,
+        :func:`nylonflex.query.default_columns` for a table).
     progress : callable, optional
         Called as ``progress(done, total)`` [slabs] after each slab of the scan.
     log : callable, optional
@@ -311,6 +331,9 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     if isinstance(at, (str, list, tuple)):
         at = parse_at(at)
     at = dict(at or {})
+    chosen = parse_columns(columns)
+    every = chosen == "all"
+    chosen = None if every else chosen
     ds, where = _select_model(ds, where)
     conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
@@ -323,11 +346,22 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                              "'requirements' (docs/uncertainty.md)")
     if limit is not None and limit < 0:
         raise InputError(f"--limit: must be 0 or more, got {limit}")
+    for name in chosen or ():
+        if name in OPTIONAL and name not in ds:
+            raise InputError(f"--columns: the cube has no {name}; sweep a config with "
+                             "'requirements' (docs/uncertainty.md)")
     at_loc = {name: _locate(ds, name, value) for name, value in at.items()}
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
-    if exact and log is not None:
+    flags = None
+    if off_grid and interpolate:  # the flags from the exact model, when it can be had
+        try:
+            settings = _exact_settings(ds)
+            flags = EXACT
+        except InputError:
+            flags = "unknown where the grid points disagree"
+    if settings is not None and log is not None:
         from ..engine.warmup import warm_up_points
 
         warm_up_points(settings, notice=log)
@@ -353,6 +387,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
         else:
             rows = _slab_rows(ds, at_loc, r0, r1)
+        if flags == EXACT:
+            rows = _exact_flags(rows, settings)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
@@ -374,8 +410,25 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     point = None
     if at_loc:
         point = (EXACT if exact else INTERPOLATED) if off_grid else GRID
+    asked = [c.name for c in conditions] + ([sort_name] if sort_name else [])
     return QueryResult(kept, point, off_grid, matched, single=len(at_loc) == len(AXES),
-                       at=at, columns=columns)
+                       at=at, columns=columns, chosen=chosen, asked=asked, flags=flags,
+                       every=every)
+
+
+def _exact_flags(rows, settings):
+    """``rows`` with ``limit`` and ``validity`` from the exact model at each design (an
+    interpolated row's flags: a flag between two grid points is not their mean)."""
+    from ..engine.pointwise import evaluate
+
+    if not len(rows[AXES[0]]):
+        return rows
+    out = evaluate(*(rows[name] for name in AXES), **settings)
+    rows = dict(rows)
+    for name in ("limit", "validity"):
+        if name in rows and name in out:
+            rows[name] = np.asarray(out[name], dtype=float).reshape(-1)
+    return rows
 
 
 def _select_model(ds, where):

@@ -49,7 +49,7 @@ class SensitivityResult:
     at: dict = field(default_factory=dict)
 
     def to_json(self) -> dict:
-        """INTERFACE.md's document: ``{"outputs": {NAME: {"first": {PARAM: value}, ...}}}``
+        """docs/interface.md's document: ``{"outputs": {NAME: {"first": {PARAM: value}, ...}}}``
         plus what was computed (``parameters``, ``designs``, ``samples``, ``at`` SI)."""
         clean = lambda x: None if not np.isfinite(x) else float(x)
         return {"outputs": {o: {k: {p: clean(v) for p, v in d[k].items()} for k in _KEYS}

@@ -1,0 +1,84 @@
+"""The compile notice (issue 25): said when Numba really compiles a kernel, never otherwise.
+
+The signal is Numba's ``numba:compile`` event, raised only on a cache miss; a function
+compiled here poses as a nylonflex kernel (its module is the control kernels'), so the
+test compiles for real in well under a second.
+"""
+
+import json
+import warnings
+
+import numba
+import pytest
+
+import nylonflex as nf
+from nylonflex.kernels import compiling
+
+
+@pytest.fixture
+def fresh(monkeypatch, tmp_path):
+    """No family noticed yet in this process, and the estimates in a temporary file."""
+    monkeypatch.setattr(compiling, "_NOTICED", set())
+    monkeypatch.setattr(compiling, "_SECONDS", {})
+    monkeypatch.setattr(compiling, "_record_path", lambda: str(tmp_path / "seconds.json"))
+    return tmp_path / "seconds.json"
+
+
+def _kernel():
+    def posing(x):
+        return x + 1
+
+    posing.__module__ = "nylonflex.kernels.control"  # the family of the closed loop
+    return numba.njit(cache=False)(posing)
+
+
+def test_a_real_compile_notices_once_with_an_estimate_and_records_it(fresh):
+    seen = []
+    kernel = _kernel()
+    with compiling.notices_to(seen.append):
+        kernel(1)
+        kernel(2)  # compiled already: no event
+        _kernel()(3)  # another compile of the same family: no second line
+    assert len(seen) == 1 and seen[0].startswith("compiling the closed-loop kernels")
+    assert f"about {compiling.MEASURED['control']:.0f} s" in seen[0]  # nothing recorded yet
+    recorded = json.loads(fresh.read_text())["control"]
+    assert recorded >= 0 and compiling.compile_seconds()["control"] > 0
+    compiling._NOTICED.clear()
+    with compiling.notices_to(seen.append):
+        _kernel()(4)
+    assert f"it took {recorded:.0f} s here last time" in seen[1]  # this machine's figure
+
+
+def test_the_python_api_gets_a_warning(fresh):
+    with pytest.warns(nf.CompileWarning, match="compiling the closed-loop kernels"):
+        _kernel()(1)
+
+
+def test_no_notice_for_functions_that_are_not_nylonflex_kernels(fresh):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a notice would raise
+        numba.njit(cache=False)(lambda x: x * 2)(3)
+    assert compiling.compile_seconds() == {}
+
+
+def test_the_cli_prints_the_warning_as_one_line(capsys, monkeypatch):
+    from nylonflex import cli
+
+    def run(args):
+        warnings.warn("compiling the grid kernel (sweeps) ...", nf.CompileWarning)
+        return 0
+
+    monkeypatch.setattr(cli._module("info"), "run", run)
+    assert cli.main(["info", "x.h5"]) == 0
+    assert capsys.readouterr().err == "nylonflex info: compiling the grid kernel (sweeps) ...\n"
+
+
+def test_each_kernel_family_is_known():
+    from nylonflex.kernels import bytes as codec
+    from nylonflex.kernels import control, design
+
+    assert compiling.family(design.design_slab_parallel) == "grid"
+    assert compiling.family(design.design_points_serial) == "pointwise"
+    assert compiling.family(control.closed_loop) == "control"
+    assert compiling.family(codec._shuffle_bytes_jit) == "codec"
+    assert set(compiling.MEASURED) == set(compiling.FAMILIES)
