@@ -44,6 +44,10 @@ class DesignSpecModel(_Strict):
     objectives: Union[list[Union[_Objective, str]], _Objective, str]
     constraints: Union[list[str], str] = []
     refine: Union[bool, _Refine] = True
+    #: per axis, the step a design is built to: a number (the axis's display unit) or
+    #: "0.5 mm" (nylonflex.design.resolution)
+    resolution: dict[Literal["radius", "wall_thickness", "length", "coil_index",
+                             "wrap_angle"], Union[float, str]] | None = None
 
 
 def _models() -> dict:

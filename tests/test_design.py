@@ -357,8 +357,8 @@ def test_resolution_snaps_between_multiples_in_display_units():
 
     # the refined values issue 25 saw: coil index 1.3989, wall 4.00006 mm
     assert _neighbours("coil_index", 1.3989, 0.05, 1.1, 1.7) == [1.35, 1.4]
-    # as "4.5 mm" converts when typed in a config: 4.5 * 1e-3
-    assert _neighbours("wall_thickness", 4.00006e-3, 0.5e-3, 1e-3, 6e-3) == [4e-3, 4.5 * 1e-3]
+    # as "4.5 mm" converts when typed in a config: the float nearest 4.5e-3 (issue 24)
+    assert _neighbours("wall_thickness", 4.00006e-3, 0.5e-3, 1e-3, 6e-3) == [4e-3, 4.5e-3]
     assert _neighbours("wall_thickness", 4e-3, 0.5e-3, 1e-3, 6e-3) == [4e-3]
     assert _neighbours("coil_index", 1.69, 0.05, 1.1, 1.7) == [1.65, 1.7]
     assert _neighbours("coil_index", 1.72, 0.05, 1.1, 1.7) == [1.7]  # 1.75: off the grid

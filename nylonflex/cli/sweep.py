@@ -128,8 +128,9 @@ def _up_to_date(cfg, out, args) -> bool:
         attrs = cube_attrs(out)
     except Exception:  # noqa: BLE001 - not a cube: the sweep itself says so
         return False
-    return bool(attrs) and attrs.get("complete") == "true" and \
-        attrs.get("config_sha256") == cfg.sha256
+    from ..variables import is_complete
+
+    return bool(attrs) and is_complete(attrs) and attrs.get("config_sha256") == cfg.sha256
 
 
 def _chart_drawn(folder, name) -> bool:
