@@ -214,3 +214,24 @@ def test_cli_bad_input_is_one_line_and_exit_2(args, match, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1
     assert err[0].startswith("nylonflex fe: error: ") and __import__("re").search(match, err[0])
+
+
+def test_a_pressure_the_solve_cannot_reach_is_nan_with_partial(monkeypatch):
+    """A body folding onto itself stalls the solve (the twin has no contact): with
+    ``partial`` the pressures beyond are NaN, the ones below solved; without, an error."""
+    from nylonflex.fe import solve as solve_mod
+
+    real = felupe.newtonraphson
+
+    def stalls_above(*args, items, **kw):
+        if items[-1].results.pressure > 1500.0:
+            raise ValueError("stand-in for a Newton failure")
+        return real(*args, items=items, **kw)
+
+    monkeypatch.setattr(felupe, "newtonraphson", stalls_above)
+    body = body_mesh(A, T, L, mesh="rough")
+    sil = silicone_parameters("tc5005")
+    out = solve_mod.solve_bend(body, sil.mu, sil.alpha, [3000.0, 1000.0], partial=True)
+    assert np.isnan(out[0]) and np.isfinite(out[1]) and out[1] > 0
+    with pytest.raises(solve_mod.FESolveError, match="did not converge"):
+        solve_mod.solve_bend(body, sil.mu, sil.alpha, [3000.0])

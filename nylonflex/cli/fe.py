@@ -93,11 +93,10 @@ def parse_pressures(text):
 
 
 def run(args) -> int:
-    import json
-
     import numpy as np
 
     from ..engine import bend_angle
+    from ..units import json_text
     from ..fe import fe_bend, require_felupe
     from ..variables import MODELS
     from ._common import progress_bar
@@ -120,7 +119,7 @@ def run(args) -> int:
                "models": {m: v.tolist() for m, v in analytic.items()},
                "units": {"design": "m", "pressure": "Pa", "bend_angle": "rad",
                          "discretisation_error": "1", "models": "rad"}}
-        print(json.dumps(out, indent=1, allow_nan=False))
+        sys.stdout.write(json_text(out))
         return 0
     names = list(analytic)
     head = f"{'pressure':>9} {'FE':>8} {'error':>6} " + " ".join(f"{n:>16}" for n in names)
@@ -132,9 +131,13 @@ def run(args) -> int:
         cells = []
         for n in names:
             v = np.degrees(analytic[n][i])
-            ratio = f"({fe / v:.2f})" if v > 0 else "(-)"
+            ratio = f"({fe / v:.2f})" if v > 0 and np.isfinite(fe) else "(-)"
             cells.append(f"{v:9.2f} {ratio:>6}")
-        print(f"{p / 1e3:9.3f} {fe:8.2f} {100 * res['discretisation_error'][i]:6.2f} "
-              + " ".join(f"{c:>16}" for c in cells))
+        err = 100 * res["discretisation_error"][i]
+        fe_text = f"{fe:8.2f}" if np.isfinite(fe) else f"{'-':>8}"
+        err_text = f"{err:6.2f}" if np.isfinite(err) else f"{'-':>6}"
+        print(f"{p / 1e3:9.3f} {fe_text} {err_text} " + " ".join(f"{c:>16}" for c in cells))
+    if not np.all(np.isfinite(res["bend_angle"])):
+        print("-: not reached (the body folds onto itself; the FE twin models no contact)")
     sys.stdout.flush()
     return 0

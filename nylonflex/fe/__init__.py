@@ -103,7 +103,9 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
     dict
         ``pressure`` [Pa], ``bend_angle`` [rad] and ``discretisation_error`` [1] (the
         Richardson estimate |theta_h - theta_2h| / (r^p - 1) / |theta_h| against the next
-        coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given.
+        coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given; NaN
+        where the solve could not reach the pressure (the body folds onto itself: the twin
+        models no contact).
 
     Raises
     ------
@@ -135,10 +137,11 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         return call
 
     angles = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=mesh), mu, alpha, p,
-                        progress=report(0.0, share))
+                        progress=report(0.0, share), partial=True)
     coarser = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=_COARSER[mesh]), mu,
-                         alpha, p, progress=report(share, 1.0 - share))
+                         alpha, p, progress=report(share, 1.0 - share), partial=True)
     factor = REFINEMENT ** ORDER - 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
         err = np.where(angles != 0, np.abs(angles - coarser) / factor / np.abs(angles), 0.0)
+    err[np.isnan(angles) | np.isnan(coarser)] = np.nan
     return {"pressure": p, "bend_angle": angles, "discretisation_error": err, "mesh": mesh}

@@ -86,13 +86,14 @@ def _extrapolate(history, p):
     return out
 
 
-def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None):
+def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=False):
     """Bend angles [rad] of ``body`` at each of ``pressures`` [Pa] (ascending, >= 0).
 
     ``mu``, ``alpha``: the Ogden set (nylonflex's convention) [Pa], [-]. ``progress`` is
     called as ``progress(p, angle, iterations)`` after every converged increment. Returns an array of
     the angles, in the order of ``pressures``. Raises :class:`FESolveError` when an
-    increment cannot converge.
+    increment cannot converge; with ``partial`` the pressures not reached get NaN instead
+    (a body folding past its base, which the twin does not model as contact, stalls so).
     """
     import felupe as fem
 
@@ -136,6 +137,9 @@ def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None):
                 u.values[:] = history[-1][1]
                 step *= 0.5
                 if step < MIN_STEP * mu0:
+                    if partial:
+                        angles[order[np.searchsorted(targets[order], target):]] = np.nan
+                        return angles
                     raise FESolveError(f"the FE solve did not converge at {p_next:.4g} Pa")
                 continue
             now = _section_angles(body.points, u.values, probes)

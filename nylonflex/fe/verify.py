@@ -163,6 +163,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     from ..files import write_atomic
     from ..engine import bend_angle
     from ..storage import open_cube
+    from ..units import json_text
     from . import MESH_NAMES, require_felupe
 
     if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
@@ -207,7 +208,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     if progress is not None:
         progress(len(done), total)
     for k, res in _map(todo, workers, scheduler):
-        write_atomic(parts / f"design-{k:04d}.json", json.dumps(res).encode(), what="verify")
+        write_atomic(parts / f"design-{k:04d}.json", json_text(res).encode(), what="verify")
         done[k] = res
         if progress is not None:
             progress(len(done), total)
@@ -217,8 +218,9 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     coords = {"design": np.arange(n), "level": np.array(FRACTIONS)}
     data = {a: ("design", np.array([r[a] for r in rows])) for a in AXES}
     pressure = np.array([r["pressures"] for r in rows])
-    fe = np.array([done[k]["bend_angle"] for k in range(n)])
-    err = np.array([done[k]["discretisation_error"] for k in range(n)])
+    # null (JSON) where the FE could not reach a pressure: NaN
+    fe = np.array([done[k]["bend_angle"] for k in range(n)], dtype=float)
+    err = np.array([done[k]["discretisation_error"] for k in range(n)], dtype=float)
     data["pressure"] = (("design", "level"), pressure)
     data["fe_bend_angle"] = (("design", "level"), fe)
     data["discretisation_error"] = (("design", "level"), err)
