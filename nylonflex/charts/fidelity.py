@@ -47,6 +47,7 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
     ys = np.asarray(to_display(y, fid[y].values), dtype=float)
     norm = mcolors.TwoSlopeNorm(vmin=0.4, vcenter=1.0, vmax=1.6)
     mappable = None
+    missing = False
     for ax, model in zip(axes[0], models):
         r = fid["ratio"].sel(model=model).sel(level=lv, method="nearest").values.astype(float)
         ok = np.isfinite(r)
@@ -63,7 +64,8 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
         mappable = ax.scatter(xs[ok], ys[ok], c=r[ok], cmap="RdBu", norm=norm, s=42,
                               edgecolors="0.2", linewidths=0.5)
         if (~ok).any():
-            ax.scatter(xs[~ok], ys[~ok], marker="x", color="0.5", s=30, label="no FE angle")
+            ax.scatter(xs[~ok], ys[~ok], marker="x", color="0.5", s=30)
+            missing = True
         within = np.mean(np.abs(r[ok] - 1) <= BANDS[0]) * 100 if ok.any() else 0.0
         med = np.median(r[ok]) if ok.any() else float("nan")
         ax.set_title(f"{model}\nmedian {med:.2f}, {within:.0f} % within 10 %")
@@ -74,6 +76,7 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
     cbar = fig.colorbar(mappable, ax=axes[0].tolist(), shrink=0.9)
     cbar.set_label("model / FE bend angle [1]")
     fig.suptitle(f"Model / FE bend angle: {fid.sizes['design']} designs at {lv:g} of their p*, "
-                 f"FE mesh {fid.attrs.get('fe_mesh', '?')}; lines at 0.75, 0.9, 1.1, 1.25",
-                 fontsize=10)
+                 f"FE mesh {fid.attrs.get('fe_mesh', '?')}; lines at 0.75, 0.9, 1.1, 1.25"
+                 + ("\nx: no FE angle (the body folds past its base: the twin has no contact)"
+                    if missing else ""), fontsize=10)
     return fig
