@@ -77,6 +77,6 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
     cbar.set_label("model / FE bend angle [1]")
     fig.suptitle(f"Model / FE bend angle: {fid.sizes['design']} designs at {lv:g} of their p*, "
                  f"FE mesh {fid.attrs.get('fe_mesh', '?')}; lines at 0.75, 0.9, 1.1, 1.25"
-                 + ("\nx: no FE angle (the body folds past its base: the twin has no contact)"
+                 + ("\nx: no FE angle (the FE solve stalled at a large bend)"
                     if missing else ""), fontsize=10)
     return fig

@@ -138,6 +138,6 @@ def run(args) -> int:
         err_text = f"{err:6.2f}" if np.isfinite(err) else f"{'-':>6}"
         print(f"{p / 1e3:9.3f} {fe_text} {err_text} " + " ".join(f"{c:>16}" for c in cells))
     if not np.all(np.isfinite(res["bend_angle"])):
-        print("-: not reached (the body folds onto itself; the FE twin models no contact)")
+        print("-: not reached: the FE solve stalled (at large bends; docs/fidelity.md, status)")
     sys.stdout.flush()
     return 0

@@ -104,8 +104,8 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         ``pressure`` [Pa], ``bend_angle`` [rad] and ``discretisation_error`` [1] (the
         Richardson estimate |theta_h - theta_2h| / (r^p - 1) / |theta_h| against the next
         coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given; NaN
-        where the solve could not reach the pressure (the body folds onto itself: the twin
-        models no contact).
+        where the solve could not reach the pressure (it stalls at large bends:
+        docs/fidelity.md).
 
     Raises
     ------

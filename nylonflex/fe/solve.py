@@ -93,7 +93,7 @@ def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=F
     called as ``progress(p, angle, iterations)`` after every converged increment. Returns an array of
     the angles, in the order of ``pressures``. Raises :class:`FESolveError` when an
     increment cannot converge; with ``partial`` the pressures not reached get NaN instead
-    (a body folding past its base, which the twin does not model as contact, stalls so).
+    (the solve stalls at large bends; docs/fidelity.md).
     """
     import felupe as fem
 
