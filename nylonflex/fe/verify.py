@@ -12,7 +12,6 @@ ratio to FE, with provenance.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -160,7 +159,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     import xarray as xr
 
     from .. import __version__
-    from ..files import write_atomic
+    from ..files import replacing, write_atomic
     from ..engine import bend_angle
     from ..storage import open_cube
     from ..units import json_text
@@ -252,9 +251,8 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
                       "model_of_cube": plan["model"], "silicone": json.dumps(sil),
                       "Conventions": "CF-1.8"})
     path = fidelity_path(cube)
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-    out.to_netcdf(tmp, engine="h5netcdf")
-    os.replace(tmp, path)
+    with replacing(path, what="verify", inputs=(cube,)) as tmp:
+        out.to_netcdf(tmp, engine="h5netcdf")
     return path
 
 
