@@ -1,7 +1,7 @@
 """The FE twin's model: FElupe bodies, loads and boundary conditions on a :class:`BodyMesh`.
 
-- **Silicone**: the Ogden set in FElupe's convention (:func:`felupe_ogden`) on every cell,
-  nearly incompressible (the distortional part in the set's constants, a volumetric penalty
+- **Silicone**: the Ogden set in FElupe's convention (:func:`felupe_ogden`) on every cell
+  (FElupe's ``ogden`` energy with a hand-written tangent, :mod:`.ogden`), nearly incompressible (the distortional part in the set's constants, a volumetric penalty
   of bulk modulus ``BULK_RATIO`` mu0 on cell-wise constant pressure and volume fields: u-p-J
   hexahedra, FElupe's :class:`~felupe.SolidBodyNearlyIncompressible`).
 - **Strain-limiting layer**: a skin of fibres along z in the bottom cell layer, of axial
@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import BodyMesh
+from .ogden import OgdenIsochoric
 
 __all__ = ["BULK_RATIO", "SKIN_RATIO", "WRAP_RATIO", "FibreMaterial", "build_model",
            "felupe_ogden"]
@@ -99,7 +100,7 @@ def build_model(body: BodyMesh, mu, alpha):
     mesh = fem.Mesh(body.points, body.cells, "hexahedron")
     region = fem.RegionHexahedron(mesh)
     field = fem.FieldContainer([fem.Field(region, dim=3)])
-    silicone = fem.Hyperelastic(fem.ogden, mu=mu_f, alpha=alpha_f)
+    silicone = OgdenIsochoric(mu_f, alpha_f)
     items = [fem.SolidBodyNearlyIncompressible(silicone, field, bulk=BULK_RATIO * mu0)]
     # fibres: the skin (axial and across) and the wrap (hoop)
     skin_k = 0.5 * SKIN_RATIO * mu0 * (a + t + b) / body.skin_thickness
