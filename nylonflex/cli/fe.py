@@ -98,6 +98,7 @@ def run(args) -> int:
     from ..engine import bend_angle
     from ..units import json_text
     from ..fe import fe_bend, require_felupe
+    from ..fe.verify import ANGLE_MODELS
     from ..variables import MODELS
     from ._common import progress_bar
 
@@ -111,7 +112,7 @@ def run(args) -> int:
     analytic = {m: np.asarray(bend_angle(res["pressure"], design["radius"],
                                          design["wall_thickness"], design["length"],
                                          model=m, **kw), dtype=float).reshape(-1)
-                for m in MODELS if m in ("paper", "cauchy_moment", "lateral_pressure")}
+                for m in MODELS if m in ANGLE_MODELS}
     if args.format == "json":
         out = {"design": design, "silicone": kw["silicone"], "mesh": args.mesh,
                "pressure": res["pressure"].tolist(), "bend_angle": res["bend_angle"].tolist(),

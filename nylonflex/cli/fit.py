@@ -1,10 +1,11 @@
-"""``nylonflex fit silicone|stroke|thermal|muscle DATA``: fit a set, write its material file."""
+"""``nylonflex fit silicone|stroke|thermal|muscle DATA``: fit a set, write its material file;
+``nylonflex fit fe``: fit ``fe_calibrated``'s correction to FE runs of the twin."""
 
 from __future__ import annotations
 
 import sys
 
-HELP = "fit a silicone or nylon muscle set to bench data"
+HELP = "fit a silicone or nylon muscle set to bench data, or fe_calibrated to the FE twin"
 DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
 as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md.
 
@@ -13,15 +14,16 @@ as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md
       --out fits/ecoflex50.yaml --chart fits/
   nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
   nylonflex fit thermal step.csv --voltage 5V --muscle-length 300mm
-  nylonflex fit muscle force.csv"""
+  nylonflex fit muscle force.csv
+  nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]"""
 
-KINDS = ("silicone", "stroke", "thermal", "muscle")
+KINDS = ("silicone", "stroke", "thermal", "muscle", "fe")
 
 
 def add_arguments(p):
     p.add_argument("kind", choices=KINDS, help="what to fit")
-    p.add_argument("data", help="data file (CSV with units in the header, or a Soft Robotics "
-                   "Materials Database file)")
+    p.add_argument("data", nargs="?", help="data file (CSV with units in the header, or a "
+                   "Soft Robotics Materials Database file); none for 'fe'")
     p.add_argument("--model", default="ogden2",
                    help="silicone: ogden1|ogden2|ogden3|neo_hookean|yeoh2 (default ogden2)")
     p.add_argument("--test", default="uniaxial", choices=["uniaxial", "planar"],
@@ -42,6 +44,12 @@ def add_arguments(p):
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--chart", metavar="DIR", help="draw data, fit and residuals into DIR")
     p.add_argument("--format", choices=["table", "json"], default="table")
+    p.add_argument("--designs", type=int, default=48,
+                   help="fe: training designs (default 48, at most 500)")
+    p.add_argument("--workers", type=int, default=1, help="fe: local processes (default 1)")
+    p.add_argument("--mesh", default="coarse", metavar="coarse|default|fine",
+                   help="fe: the FE mesh (default coarse, Richardson-extrapolated)")
+    p.add_argument("--seed", type=int, default=0, help="fe: the sample's seed (default 0)")
 
 
 def _q(text, field, kind, unit):
@@ -117,7 +125,86 @@ def format_table(res) -> str:
     return "\n".join(lines) + "\n"
 
 
+def run_fe(args) -> int:
+    """``fit fe``: the training runs (journaled beside --out), the fit, its JSON file."""
+    import json
+    import os
+    from datetime import datetime, timezone
+    from pathlib import Path
+
+    import numpy as np
+
+    from .. import __version__
+    from ..fe import MESH_NAMES, require_felupe
+    from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
+    from ..fe.verify import MAX_DESIGNS
+    from ..files import refuse_special, write_atomic
+    from ..units import InputError, json_text
+    from ._common import progress_bar
+
+    if args.data is not None:
+        raise InputError(f"fit fe: takes no data file (got {args.data!r}); the FE twin "
+                         "makes the data")
+    if not 1 <= args.designs <= MAX_DESIGNS:
+        raise InputError(f"--designs: must be in [1, {MAX_DESIGNS}], got {args.designs}")
+    if not 1 <= args.workers <= 64:
+        raise InputError(f"--workers: must be in [1, 64], got {args.workers}")
+    if args.mesh not in MESH_NAMES:
+        raise InputError(f"--mesh: must be one of {', '.join(MESH_NAMES)}, got {args.mesh!r}")
+    out = Path(args.out or "fe_calibration.json")
+    refuse_special(out, "--out", [])
+    if os.path.lexists(out) and not args.overwrite:
+        raise InputError(f"--out {out}: exists; give --overwrite to replace it")
+    require_felupe()
+    plan = training_plan(args.designs, args.seed, args.mesh)
+    parts = out.with_name(out.name + ".parts")
+    with progress_bar("fit fe", unit="design", quiet=False, delay=0.0) as bar:
+        done = run_training(parts, plan, workers=args.workers, progress=bar,
+                            log=lambda m: print(f"nylonflex fit fe: {m}", file=sys.stderr))
+    res = fit_correction(plan, done)
+    doc = {"model": "fe_calibrated",
+           "correction": "M = (M_P + p Q_L) exp(c0 + c1 x + c2 x^2), x = ln(t/a)",
+           "coefficients": res["coefficients"],
+           "provenance": {"command": "nylonflex fit fe " + " ".join(sys.argv[3:]),
+                          "nylonflex_version": __version__,
+                          "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                          "mesh": args.mesh, "seed": args.seed,
+                          "training_ranges_m": {k: list(v) for k, v in TRAINING_RANGES.items()},
+                          "silicone": plan["silicone"],
+                          "target_angles_deg": plan["target_angles_deg"]},
+           "fit": {k: v for k, v in res.items() if k != "coefficients"},
+           "training": [{**d, "fe_bend_angle": done[k]["bend_angle"],
+                         "coarser_bend_angle": done[k]["coarser_bend_angle"]}
+                        for k, d in enumerate(plan["designs"])]}
+    write_atomic(out, json_text(doc, indent=1).encode(), what="fit fe")
+    if args.format == "json":
+        sys.stdout.write(json_text(doc, indent=2))
+        return 0
+
+    def line(name, r):
+        r = np.asarray(r)
+        within = int(np.sum(np.abs(r - 1) <= 0.1))
+        return (f"  {name:<26} median {np.median(r):.3f}, range {r.min():.3f}-{r.max():.3f}, "
+                f"within 10 %: {within} of {r.size}")
+
+    c = res["coefficients"]
+    print(f"fe_calibrated  exp({c[0]:+.4f} {c[1]:+.4f} x {c[2]:+.4f} x^2), x = ln(t/a)")
+    print(f"  {res['designs_used']} designs, {res['points']} FE angles (mesh {args.mesh}, "
+          "Richardson-extrapolated)")
+    print(line("lateral_pressure / FE", res["lateral_over_fe"]))
+    print(line("fe_calibrated / FE", res["calibrated_over_fe"]))
+    print(line("leave-one-out / FE", res["loo_calibrated_over_fe"]))
+    print(f"wrote {out}")
+    return 0
+
+
 def run(args) -> int:
+    if args.kind == "fe":
+        return run_fe(args)
+    from ..units import InputError as _InputError
+
+    if args.data is None:
+        raise _InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
     from ..calibration import write_material_file
     from ..units import InputError, json_text
     from . import warn

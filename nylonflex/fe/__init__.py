@@ -105,7 +105,8 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         Richardson estimate |theta_h - theta_2h| / (r^p - 1) / |theta_h| against the next
         coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given; NaN
         where the solve could not reach the pressure (it stalls at large bends:
-        docs/fidelity.md).
+        docs/fidelity.md); ``coarser_bend_angle`` [rad], the next coarser mesh's angles the
+        estimate is taken from.
 
     Raises
     ------
@@ -144,4 +145,5 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
     with np.errstate(invalid="ignore", divide="ignore"):
         err = np.where(angles != 0, np.abs(angles - coarser) / factor / np.abs(angles), 0.0)
     err[np.isnan(angles) | np.isnan(coarser)] = np.nan
-    return {"pressure": p, "bend_angle": angles, "discretisation_error": err, "mesh": mesh}
+    return {"pressure": p, "bend_angle": angles, "discretisation_error": err, "mesh": mesh,
+            "coarser_bend_angle": coarser}

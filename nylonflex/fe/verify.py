@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
+from .runs import journaled_runs
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
            "fidelity_summary", "run_verify", "sample_designs"]
@@ -108,32 +109,6 @@ def _solve(task):
             "discretisation_error": res["discretisation_error"].tolist()}
 
 
-def _map(tasks, workers, scheduler):
-    """Yield (index, result) as the tasks finish: local processes, or a Dask cluster."""
-    if scheduler:
-        try:
-            from distributed import Client, as_completed
-        except ImportError:
-            raise InputError("--scheduler: needs dask's distributed: pip install "
-                             "'nylonflex[dask]'") from None
-        with Client(scheduler, timeout=30, set_as_default=False) as client:
-            futures = {client.submit(_solve, t, pure=False): i for i, t in tasks}
-            for fut in as_completed(futures):
-                yield futures[fut], fut.result()
-        return
-    if workers <= 1:
-        for i, t in tasks:
-            yield i, _solve(t)
-        return
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
-        futures = {ex.submit(_solve, t): i for i, t in tasks}
-        for fut in as_completed(futures):
-            yield futures[fut], fut.result()
-
-
 def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", seed=0,
                progress=None, log=None) -> Path:
     """Verify a cube against the FE twin; returns the fidelity dataset's path.
@@ -159,7 +134,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     import xarray as xr
 
     from .. import __version__
-    from ..files import replacing, write_atomic
+    from ..files import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
     from ..units import json_text
@@ -180,37 +155,11 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     finally:
         ds.close()
     parts = _parts(cube)
-    if parts.is_symlink():
-        raise InputError(f"{parts}: is a symbolic link; nylonflex does not write through links")
-    parts.mkdir(exist_ok=True)
-    plan_file = parts / "plan.json"
-    text = json.dumps(plan, sort_keys=True, indent=1)
-    if plan_file.exists() and not plan_file.is_symlink():
-        if plan_file.read_text() != text:
-            raise InputError(f"{parts}: holds the runs of another verify (other designs, "
-                             f"mesh or cube); delete it to start again")
-    else:
-        write_atomic(plan_file, text.encode(), what="verify")
+    tasks = [(d, plan["silicone"], mesh) for d in plan["designs"]]
+    done = journaled_runs(parts, plan, tasks, _solve, workers=workers, scheduler=scheduler,
+                          progress=progress, log=log, what="verify")
     sil = plan["silicone"]
-    done = {}
-    for k in range(len(plan["designs"])):
-        f = parts / f"design-{k:04d}.json"
-        if f.is_file() and not f.is_symlink():
-            try:
-                done[k] = json.loads(f.read_text())
-            except ValueError:
-                pass  # a damaged run is solved again
-    if done and log is not None:
-        log(f"resuming: {len(done)} of {len(plan['designs'])} FE runs already done")
-    todo = [(k, (d, sil, mesh)) for k, d in enumerate(plan["designs"]) if k not in done]
     total = len(plan["designs"])
-    if progress is not None:
-        progress(len(done), total)
-    for k, res in _map(todo, workers, scheduler):
-        write_atomic(parts / f"design-{k:04d}.json", json_text(res).encode(), what="verify")
-        done[k] = res
-        if progress is not None:
-            progress(len(done), total)
     # the dataset: design x level (the fractions of p*)
     n, m = total, len(FRACTIONS)
     rows = plan["designs"]
