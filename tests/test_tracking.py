@@ -220,9 +220,11 @@ def test_killed_tracking_sweep_resumes_bit_for_bit(tmp_path):
 
     raw = _sweep_of(_control(), {"radius": {"start": 5, "stop": 20, "num": 16,
                                             "units": "mm"},
-                                 "coil_index": {"values": [1.3, 1.7]}})
+                                 "coil_index": {"values": [1.3, 1.7]},
+                                 "length": {"values": [70, 90], "units": "mm"}})
+    # a long pressure curve makes the slabs of 1 MB hold one radius each
     raw["curves"] = {"stroke": {"start": 0, "stop": 0.1, "num": 51},
-                     "pressure": {"start": 0, "stop": 25, "num": 2001, "units": "kPa"}}
+                     "pressure": {"start": 0, "stop": 25, "num": 40001, "units": "kPa"}}
     raw["slab_megabytes"] = 1.0
     raw["tracking"]["duration"] = "50 s"
     cfg = parse_config(raw)
