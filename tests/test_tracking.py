@@ -247,3 +247,26 @@ def test_killed_tracking_sweep_resumes_bit_for_bit(tmp_path):
             np.testing.assert_array_equal(ds[name].values, want[name].values,
                                           err_msg=f"{which} {name}")
         ds.close()
+
+
+@pytest.mark.slow
+def test_design_answers_the_tracking_question_and_simulate_agrees():
+    # "the largest tip force with a full range of motion that tracks a 0.04 Hz, 30 deg sine
+    # within 2 deg at 12 V" over the figure-12 grid (configs/design_tracking.yaml), and
+    # nylonflex simulate of the answer (configs/control.yaml with its design) agrees
+    from nylonflex.design import load_spec, run_design
+
+    ds = nf.run_sweep(nf.load_config("configs/fig12_tracking.yaml"))
+    res = run_design(load_spec("configs/design_tracking.yaml"), cube=ds)
+    best = res.designs[0]
+    assert best["range_fraction"] >= 1.0 and best["tracking_rms_error"] <= math.radians(2.0)
+    feasible = (ds["range_fraction"] >= 1) & (ds["tracking_rms_error"] <= math.radians(2.0)) \
+        & (ds["validity"] == 0)
+    assert best["tip_force_max"] == pytest.approx(
+        float(ds["tip_force_max"].where(feasible).max()), rel=1e-12)
+    design = {k: f"{best[k]!r} {'rad' if k == 'wrap_angle' else 'm'}" for k in
+              ("radius", "wall_thickness", "length", "wrap_angle")}
+    design.update(coil_index=best["coil_index"], base_thickness="wall")
+    sim = run_simulation(parse_sim_config(_control(design=design)))
+    assert sim.attrs["rms_error"] <= math.radians(2.0)
+    assert sim.attrs["rms_error"] == pytest.approx(best["tracking_rms_error"], rel=1e-9)
