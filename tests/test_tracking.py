@@ -164,6 +164,21 @@ def test_without_tracking_the_cube_is_unchanged():
     assert tracked.sha256 != plain.sha256
 
 
+def test_info_config_gives_back_the_tracking_block():
+    # nylonflex info CUBE --config: the rebuilt config resolves to the same hash, with a PI,
+    # a relative reference and a bandwidth search
+    from nylonflex.engine.provenance import provenance, runnable_config
+
+    raw = _sweep_of(_control(controller={"kind": "pi", "proportional_band": "8 deg",
+                                         "integral_time": "15 s"}))
+    raw["tracking"]["reference"] = {"kind": "sine", "relative_to": "bend_angle_max",
+                                    "mean": 0.6, "amplitude": 0.2, "frequency": "0.04 Hz"}
+    raw["tracking"]["bandwidth"] = {"error": "2 deg"}
+    cfg = parse_config(raw)
+    back = parse_config(yaml.safe_load(runnable_config(provenance(cfg))))
+    assert back.tracking == cfg.tracking and back.sha256 == cfg.sha256
+
+
 @pytest.mark.parametrize("edit, match", [
     (lambda r: r.pop("supply"), r"^tracking: needs a supply"),
     (lambda r: r.update(model=["paper", "paper_eq10"]), r"^tracking: the closed loop is the "
@@ -221,10 +236,11 @@ def test_killed_tracking_sweep_resumes_bit_for_bit(tmp_path):
     raw = _sweep_of(_control(), {"radius": {"start": 5, "stop": 20, "num": 16,
                                             "units": "mm"},
                                  "coil_index": {"values": [1.3, 1.7]},
-                                 "length": {"values": [70, 90], "units": "mm"}})
-    # a long pressure curve makes the slabs of 1 MB hold one radius each
+                                 "wall_thickness": {"values": [1.5, 2, 2.5, 3], "units": "mm"},
+                                 "length": {"values": [60, 70, 80, 90], "units": "mm"}})
+    # a long pressure curve makes the slabs of 1 MB hold two radii each
     raw["curves"] = {"stroke": {"start": 0, "stop": 0.1, "num": 51},
-                     "pressure": {"start": 0, "stop": 25, "num": 40001, "units": "kPa"}}
+                     "pressure": {"start": 0, "stop": 25, "num": 2001, "units": "kPa"}}
     raw["slab_megabytes"] = 1.0
     raw["tracking"]["duration"] = "50 s"
     cfg = parse_config(raw)

@@ -17,7 +17,7 @@ from typing import Literal
 from ..units import InputError, from_si
 from .base import Count, Number, _Strict, check_range, range_error
 
-__all__ = ["Tracking", "TrackingSpec", "resolve_tracking"]
+__all__ = ["Tracking", "TrackingSpec", "resolve_tracking", "tracking_section"]
 
 #: Most samples of one design's run (duration / step): 1e6 is 10,000 s at 10 ms.
 _MAX_SAMPLES = 1_000_000
@@ -279,3 +279,36 @@ def resolve_tracking(t: Tracking, supply_voltage, models, t_amb: float,
                         proportional_band=band, integral_time=ti, noise=noise,
                         seed=int(t.sensor.seed), table_points=int(t.estimator.table_points),
                         filter_time_constant=tau, rms_from=rms_from, bandwidth=bw, **ref)
+
+
+def tracking_section(d: dict) -> dict:
+    """A ``tracking:`` section (typed, SI units spelled out) that resolves to the SI spec
+    ``d`` (:meth:`TrackingSpec.to_dict`) exactly: ``nylonflex info CUBE --config``."""
+    q = lambda x, unit: f"{float(x)!r} {unit}"  # noqa: E731 - factor 1: the same float
+    rel = d["relative_to"] != "absolute"
+    ang = (lambda x: float(x)) if rel else (lambda x: q(x, "rad"))
+    if d["kind"] == "sine":
+        ref = {"kind": "sine", "mean": ang(d["mean"]), "amplitude": ang(d["amplitude"]),
+               "frequency": q(d["frequency"], "Hz"), "phase": q(d["phase"], "rad")}
+    else:
+        ref = {"kind": "step", "initial": ang(d["initial"]), "final": ang(d["final"]),
+               "at": q(d["at"], "s")}
+    if rel:
+        ref["relative_to"] = d["relative_to"]
+    ctl = {"kind": d["controller"], "hysteresis": q(d["hysteresis"], "rad")}
+    if d["controller"] == "pi":
+        ctl.update(proportional_band=q(d["proportional_band"], "rad"),
+                   integral_time=q(d["integral_time"], "s"))
+    out = {"duration": q(d["duration"], "s"), "step": q(d["step"], "s"), "reference": ref,
+           "controller": ctl, "sensor": {"noise": q(d["noise"], "Pa"), "seed": d["seed"]},
+           "estimator": {"table_points": d["table_points"],
+                         "filter_time_constant": q(d["filter_time_constant"], "s")},
+           "rms_from": q(d["rms_from"], "s")}
+    if d.get("initial_temperature") is not None:
+        out["initial_temperature"] = q(d["initial_temperature"], "K")
+    b = d.get("bandwidth")
+    if b is not None:
+        out["bandwidth"] = {"error": q(b["error"], "rad"), "low": q(b["low"], "Hz"),
+                            "high": q(b["high"], "Hz"), "iterations": b["iterations"],
+                            "periods": b["periods"]}
+    return out
