@@ -29,11 +29,6 @@ from .control import _duty, angle_table, estimate_angle, plant_angle
 __all__ = ["kappa_tables", "kappa_tables_serial", "run_loop", "track_slab_parallel",
            "track_slab_serial"]
 
-#: Rows of the tracking kernel's output: rms error [rad], highest temperature [K], energy
-#: [J], bandwidth [Hz].
-OUT_ROWS = 4
-
-
 def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig, w_phi,
                   rtol, out_kappa, out_slope):
     """kappa(k dp) [1/m] and d kappa/dp [1/(m Pa)], dp = p_max[i, j] / (points - 1), of
