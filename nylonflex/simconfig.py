@@ -137,7 +137,10 @@ class Estimator(_Strict):
 
 
 class Controller(_Strict):
+    kind: Literal["bang_bang", "pi"] = None
     hysteresis: Quantity = None
+    proportional_band: Quantity = None   # PI: the error that drives the duty 0 -> 1
+    integral_time: Quantity = None       # PI: T_i
 
 
 class Metrics(_Strict):
@@ -264,6 +267,9 @@ class ActuatorSpec:
     hysteresis: float
     reference: Reference
     rms_from: float
+    controller: str = "bang_bang"  # or "pi" (docs/model.md s. 19)
+    proportional_band: float = math.inf  # PI [rad]
+    integral_time: float = math.inf  # PI [s]
 
 
 @dataclass(frozen=True)
@@ -306,7 +312,9 @@ def _resolved_doc(cfg: SimConfig) -> dict:
             "sensor": {"noise": a.noise, "seed": a.seed},
             "estimator": {"table_points": a.table_points,
                           "filter_time_constant": a.filter_time_constant},
-            "controller": {"hysteresis": a.hysteresis},
+            "controller": {"hysteresis": a.hysteresis} if a.controller == "bang_bang" else
+            {"kind": "pi", "hysteresis": a.hysteresis,
+             "proportional_band": a.proportional_band, "integral_time": a.integral_time},
             "reference": {"kind": a.reference.kind,
                           **{k: (list(map(float, v)) if isinstance(v, (list, tuple,
                                                                       np.ndarray)) else v)
@@ -446,8 +454,20 @@ def _actuator(top: SimConfigModel, own: _Loop, path: str, duration: float, index
                                duration)
     else:  # the sine's first period is the warm-up from ambient (docs/model.md section 10)
         rms_from = min(1.0 / ref.params["frequency"], duration) if ref.kind == "sine" else 0.0
+    pi = {}
+    if ctl.get("kind") == "pi":
+        for key, kind, unit, what in (("proportional_band", "angle", "deg", "e.g. 10 deg"),
+                                      ("integral_time", "time", "s", "e.g. 20 s")):
+            if ctl.get(key) is None:
+                raise InputError(f"{pre}controller.{key}: missing for kind: pi; give {what}")
+            pi[key] = check_range(ctl[key], f"{pre}controller.{key}", kind, unit, 0.0,
+                                  _FULL_TURN if kind == "angle" else 1e6, lo_open=True)
+        pi["controller"] = "pi"
+    elif ctl.get("proportional_band") is not None or ctl.get("integral_time") is not None:
+        raise InputError(f"{pre}controller: proportional_band and integral_time are for "
+                         "kind: pi")
     return ActuatorSpec(
-        name=name, silicone=sil, nylon=ny, initial_temperature=t0, reference=ref,
+        name=name, **pi, silicone=sil, nylon=ny, initial_temperature=t0, reference=ref,
         noise=check_range(sensor["noise"], f"{pre}sensor.noise", "pressure", "kPa", 0.0,
                           100e3),
         seed=_integer(sensor["seed"], f"{pre}sensor.seed", 0, 2**32 - 1) + index,

@@ -215,7 +215,7 @@ def run_simulation(cfg: SimConfig):
     n, m = len(cfg.actuators), cfg.n_steps
     t = np.arange(m) * cfg.step
     per = {k: [] for k in ("lm", "r", "c", "loss", "tamb", "t0", "scale", "gamma", "beta",
-                           "tg", "sg", "dpp", "dpe", "band", "keep")}
+                           "tg", "sg", "dpp", "dpe", "band", "keep", "gain", "istep")}
     plants, slopes, ests, refs, noises, reach = [], [], [], [], [], []
     for a in cfg.actuators:
         ny = a.nylon
@@ -235,7 +235,9 @@ def run_simulation(cfg: SimConfig):
                          ("sg", ny.sigma_g), ("dpp", dpp), ("dpe", dpe),
                          ("band", 0.5 * a.hysteresis),
                          ("keep", math.exp(-cfg.step / a.filter_time_constant)
-                          if a.filter_time_constant > 0 else 0.0)):
+                          if a.filter_time_constant > 0 else 0.0),
+                         ("gain", 1.0 / a.proportional_band),
+                         ("istep", cfg.step / a.integral_time)):
             per[key].append(val)
         plants.append(plant)
         slopes.append(slope)
@@ -252,7 +254,9 @@ def run_simulation(cfg: SimConfig):
                       arr["scale"], arr["gamma"], arr["beta"], arr["tg"], arr["sg"])
     tables = AngleTables(arr["dpp"], _pad(plants, 0.0), _pad(slopes, 0.0), arr["dpe"],
                          _pad(ests, 0.0))
-    control = Control(arr["band"], arr["keep"], reference, noise)
+    kind = np.array([int(a.controller == "pi") for a in cfg.actuators], dtype=np.int64)
+    control = Control(arr["band"], arr["keep"], reference, noise, kind, arr["gain"],
+                      arr["istep"])
     out = SimOut(outs["temperature"], outs["stroke"], outs["pressure"], outs["bend_angle"],
                  outs["bend_angle_estimate"], outs["voltage"], outs["current"], outs["power"])
     tic = time.perf_counter()

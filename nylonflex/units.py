@@ -41,6 +41,7 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "min": ("time", 60.0, 0.0),
     "h": ("time", 3600.0, 0.0),
     "Hz": ("frequency", 1.0, 0.0),
+    "J": ("energy", 1.0, 0.0),
     "V": ("voltage", 1.0, 0.0),
     "W": ("power", 1.0, 0.0),
     "A": ("current", 1.0, 0.0),

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY", "UNCERTAIN",
+__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY", "TRACKING",
+           "UNCERTAIN",
            "VARIABLES", "Variable", "display_label", "quantile_name", "range_text",
            "slab_done_attrs", "to_display"]
 
@@ -240,6 +241,24 @@ UNCERTAIN = {v.name: v for v in [
        lo=0.0, hi=1.0),
 ]}
 
+#: Variables of a sweep with ``tracking:``: the figure-9 closed loop of every design against
+#: the config's reference (docs/model.md s. 19); the cube holds them only then.
+TRACKING = {v.name: v for v in [
+    _v("tracking_rms_error", AXES, "rad", "RMS tracking error",
+       "RMS of bend angle minus reference from tracking.rms_from on, the closed loop of "
+       "nylonflex simulate (docs/model.md s. 10, 19)", "deg", "angle"),
+    _v("tracking_max_temperature", AXES, "K", "highest muscle temperature while tracking",
+       "largest sampled muscle temperature of the closed loop (docs/model.md s. 19)", "degC",
+       "temperature"),
+    _v("tracking_energy", AXES, "J", "electric energy while tracking",
+       "electric energy the supply puts into the muscle over the run (docs/model.md s. 19)",
+       "J", "energy"),
+    _v("tracking_bandwidth", AXES, "Hz", "tracking bandwidth",
+       "highest sine frequency whose RMS error stays within tracking.bandwidth.error, by a "
+       "bracketed search; 0 when the lowest fails, the highest when it passes (docs/model.md "
+       "s. 19)", "Hz", "frequency"),
+]}
+
 #: The string coordinate of a cube of several model variants (docs/model.md s. 16).
 MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each slice "
            "(docs/model.md s. 16)", "1", "dimensionless", "str")
@@ -248,7 +267,7 @@ MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each 
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
                "1 where this radius's slab is in the cube", "1", "dimensionless", "int8")
 
-VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN}
+VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN, **TRACKING}
 
 
 def is_complete(attrs) -> bool:

@@ -187,6 +187,33 @@ def test_hysteresis_band_holds_and_switches_less():
     assert flips(band) < flips(plain) / 5
 
 
+def test_pi_duty_follows_its_law_sample_by_sample():
+    # docs/model.md s. 19: u = clip((e + I)/B, 0, 1), I += e dt/T_i unless saturated in the
+    # error's direction; the muscle sees sqrt(u) V (mean power u V^2/R)
+    band, ti, dt = 8 * DEG, 15.0, 0.01
+    ds = _run(_base(reference={"kind": "sine", "mean": 60, "amplitude": 20,
+                               "frequency": "0.04 Hz"},
+                    controller={"kind": "pi", "proportional_band": "8 deg",
+                                "integral_time": "15 s"}))
+    err = ds["bend_angle_reference"].values - ds["bend_angle_estimate"].values
+    integral, duty = 0.0, []
+    for e in err:  # the law, written out plainly
+        u = (e + integral) / band
+        d = min(max(u, 0.0), 1.0)
+        if not ((u >= 1.0 and e >= 0.0) or (u <= 0.0 and e <= 0.0)):
+            integral += e * dt / ti
+        duty.append(d)
+    np.testing.assert_allclose(ds["voltage"].values, 12.0 * np.sqrt(duty), rtol=1e-12,
+                               atol=1e-12)
+    assert np.any((np.array(duty) > 0) & (np.array(duty) < 1))  # a duty, not on/off
+
+
+def test_bang_bang_is_unchanged_by_the_pi_machinery():
+    # a duty of 1 is the bang-bang's voltage to the bit: V or 0, nothing in between
+    ds = _run(_base())
+    assert set(np.unique(ds["voltage"].values)) <= {0.0, 12.0}
+
+
 def test_shared_supply_sags_over_internal_resistance():
     # two muscles always on, in parallel on E = 9 V behind 2 ohm:
     # V = E / (1 + r_int (1/R1 + 1/R2)), R = r' l_m
@@ -352,6 +379,11 @@ def test_cli_gripper_draws_pressures(tmp_path, capsys):
      "supply.internal_resistance"),
     ({"sensor": {"noise": "-1 kPa"}}, "sensor.noise"),
     ({"controller": {"hysteresis": "1 mm"}}, "controller.hysteresis"),
+    ({"controller": {"kind": "pi", "integral_time": "10 s"}}, "controller.proportional_band"),
+    ({"controller": {"kind": "pi", "proportional_band": "5 deg", "integral_time": "0 s"}},
+     "controller.integral_time"),
+    ({"controller": {"integral_time": "10 s"}}, "controller"),
+    ({"controller": {"kind": "pid"}}, "controller.kind"),
     ({"initial_temperature": "10 degC"}, "initial_temperature"),
     ({"actuators": [{"name": "x", "desing": {}}]}, "actuators[0].desing"),
     ({"speed": 3}, "speed"),

@@ -296,9 +296,10 @@ def test_the_console_script_waits_for_a_thread_left_running(tmp_path):
 
 
 # ------------------------------------------------------------------- schema (issue 24)
-SCHEMA_EXAMPLES = {"sweep": ("fig12", "fig12_uncertain", "fig12_fitted", "big20m"),
+SCHEMA_EXAMPLES = {"sweep": ("fig12", "fig12_uncertain", "fig12_fitted", "big20m",
+                             "fig12_tracking"),
                    "simulate": ("control", "step", "gripper"),
-                   "design": ("design_force", "design_front")}
+                   "design": ("design_force", "design_front", "design_tracking")}
 
 
 @pytest.mark.parametrize("kind", list(SCHEMA_EXAMPLES))

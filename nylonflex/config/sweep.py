@@ -38,6 +38,7 @@ from .base import (
     check_run_name,
     range_error,
 )
+from .tracking import Tracking, TrackingSpec, resolve_tracking
 from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
 
 __all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", "cube_bytes",
@@ -133,6 +134,7 @@ class SweepConfig(_Strict):
     requirements: list[str] = []
     model: Union[str, list[str]] = "paper"
     supply: Supply | None = None
+    tracking: Tracking | None = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -159,6 +161,7 @@ class ResolvedConfig:
     requirements: tuple[str, ...] = ()
     models: tuple[str, ...] = ("paper",)
     supply_voltage: float | None = None
+    tracking: "TrackingSpec | None" = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -199,6 +202,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["model"] = list(cfg.models)
     if cfg.supply_voltage is not None:
         doc["supply_voltage"] = cfg.supply_voltage
+    if cfg.tracking is not None:  # only then: cubes without tracking keep their hash
+        doc["tracking"] = cfg.tracking.to_dict()
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -292,12 +297,15 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                          "sweep each variant on its own")
     uncertainty = None if cfg.uncertainty is None else \
         resolve_uncertainty(cfg.uncertainty, silicone, nylon, raw)
+    models, voltage = _models(cfg.model), _supply(cfg.supply)
+    tracking = None if cfg.tracking is None else \
+        resolve_tracking(cfg.tracking, voltage, models, nylon.t_amb, nylon.t_max)
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
-                          requirements=requirements, models=_models(cfg.model),
-                          supply_voltage=_supply(cfg.supply))
+                          requirements=requirements, models=models,
+                          supply_voltage=voltage, tracking=tracking)
 
 
 def _models(model) -> tuple[str, ...]:

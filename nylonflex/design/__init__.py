@@ -23,7 +23,7 @@ import numpy as np
 from ..query import COLUMNS
 from .refine import Model, evaluate_rows, meets, refine
 from .resolution import check_fixed, merge_equal, snap
-from .search import GridScan, nondominated, scan_grid
+from .search import CUBE_ONLY, GridScan, nondominated, scan_grid
 from .spec import DesignSpec, Objective, load_spec, parse_spec
 
 __all__ = ["DesignResult", "DesignSpec", "Objective", "load_spec", "nondominated",
@@ -159,6 +159,8 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
 
     # every reported design, exactly, once more; drop any that breaks a constraint
     grid = evaluate_rows(model, scan.best)
+    # the cube-only columns (tracking_*) of grid designs come from the cube
+    grid.update({k: v for k, v in scan.best.items() if k in CUBE_ONLY})
     ok = meets(spec, grid, scan.fixed)
     dropped = int((~ok).sum())
     grid = {k: v[ok] for k, v in grid.items()}

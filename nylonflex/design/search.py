@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..query import COLUMNS, _locate, _slab_rows, at_value
+from ..variables import TRACKING
 from ..query.scan import radius_slabs
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
@@ -102,6 +103,11 @@ class GridScan:
     reasons: list
 
 
+#: Columns a cube may hold that the exact pointwise model does not compute: the closed loop
+#: of each grid design (docs/model.md s. 19). Reported from the cube, at grid points only.
+CUBE_ONLY = tuple(TRACKING)
+
+
 def _shown(name, x) -> str:
     unit = VARIABLES[name].display
     return f"{float(to_display(name, x)):.4g}" + ("" if unit == "1" else f" {unit}")
@@ -116,7 +122,7 @@ def _take(rows, index):
 
 
 def _concat(a, b):
-    return {k: np.concatenate([a[k], b[k]]) for k in COLUMNS}
+    return {k: np.concatenate([a[k], b[k]]) for k in a}
 
 
 def scan_grid(ds, spec, keep: int = 1) -> GridScan:
@@ -143,7 +149,8 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
         raise InputError(f"{missing[0]}: this cube holds no {missing[0]} (heating_time needs a "
                          "sweep with supply:; feasibility one with requirements:)")
     ranges = {a: (float(ds[a].values.min()), float(ds[a].values.max())) for a in AXES}
-    empty = {k: np.empty(0) for k in COLUMNS}
+    # the columns of every row, and the cube-only ones this cube has (tracking_*)
+    empty = {k: np.empty(0) for k in (*COLUMNS, *(n for n in CUBE_ONLY if n in ds))}
     fixed = fixed_axes(spec)
     at_loc, reasons = {}, []
     for name, value in fixed.items():

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..query import COLUMNS, Condition
+from ..variables import TRACKING
 from ..units import InputError
 from ..variables import AXES
 
@@ -43,7 +44,7 @@ DEFAULT_MAXITER = 60
 #: budget of several objectives (40 x 60); the accepted maximum of each (1000 x 10,000) ran
 #: past 120 s on a 128,000-design cube.
 MAX_REFINE_ITERATIONS = 20_000
-_OBJECTIVE_NAMES = tuple(n for n in COLUMNS if n != "limit")
+_OBJECTIVE_NAMES = tuple(n for n in COLUMNS if n != "limit") + tuple(TRACKING)
 
 
 @dataclass(frozen=True)
@@ -243,6 +244,11 @@ def parse_spec(raw, source: str = "spec") -> DesignSpec:
         raise InputError("constraints: expected a list of strings like \"radius <= 20 mm\"")
     constraints = tuple(_constraint(c, i) for i, c in enumerate(constraints))
     refine, starts, maxiter = _refine(raw.get("refine", True), len(objectives) > 1)
+    loop = [n for n in (*names, *(c.name for c in constraints)) if n in TRACKING]
+    if loop and (refine or raw.get("resolution")):
+        raise InputError(f"refine: {loop[0]} comes from the closed loop of grid designs in "
+                         "the cube (docs/model.md s. 19), not from the exact model that "
+                         "refines and snaps; give refine: false and no resolution")
     return DesignSpec(name=name, cube=cube, sweep=sweep, objectives=objectives,
                       constraints=constraints, refine=refine, starts=starts, maxiter=maxiter,
                       model=model, raw=dict(raw),

@@ -31,11 +31,14 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
     quantiles and feasibility only with ``uncertainty``/``requirements``.
     """
     from .sampled import uncertain_variables
+    from .tracking import tracking_variables
 
     out = {n: (v, v.dims_for(cfg.models)) for n, v in {**DESIGN, **CURVES}.items()
            if cfg.supply_voltage is not None or n not in SUPPLY_ONLY}
     # a sampled sweep's quantiles and feasibility (docs/uncertainty.md)
     out.update({n: (v, v.dims) for n, v in uncertain_variables(cfg).items()})
+    # the closed loop of every design (docs/model.md s. 19)
+    out.update({n: (v, v.dims) for n, v in tracking_variables(cfg).items()})
     return out
 
 
@@ -249,6 +252,10 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
         from .sampled import slab_statistics
 
         arrays.update(slab_statistics(cfg, i0, i1, arrays, parallel=parallel))
+    if cfg.tracking is not None:  # docs/model.md s. 19
+        from .tracking import slab_tracking
+
+        arrays.update(slab_tracking(cfg, i0, i1, arrays, parallel=parallel))
     return arrays
 
 

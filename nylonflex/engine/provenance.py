@@ -265,6 +265,10 @@ def runnable_config(attrs) -> str:
         out["uncertainty"] = _uncertainty_spec(doc["uncertainty"])
     if doc.get("requirements"):
         out["requirements"] = list(doc["requirements"])
+    if "tracking" in doc:  # docs/model.md s. 19
+        from ..config.tracking import tracking_section
+
+        out["tracking"] = tracking_section(doc["tracking"])
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
     out["charts"] = []

@@ -20,8 +20,11 @@ EXAMPLES = {
     "fig12_uncertain": "sweep with uncertainty and requirements: quantiles and feasibility",
     "fig12_fitted": "sweep with a fitted silicone (configs/fits/ecoflex_0050_ogden2.yaml)",
     "big20m": "sweep: 20 million designs, for clusters and memory checks",
+    "fig12_tracking": "sweep with tracking: the closed loop of figure 9 for every design",
     "design_force": "design: the largest tip force with a full range (needs sweeps/fig12)",
     "design_front": "design: the Pareto front of force and size (needs sweeps/fig12)",
+    "design_tracking": "design: the largest force that tracks the figure-9 sine within 2 deg "
+                       "(needs sweeps/fig12_tracking)",
     "control": "simulate: the closed loop of figure 9 (nylonflex simulate configs/control.yaml)",
     "step": "simulate: a step response with rise time and overshoot",
     "gripper": "simulate: three actuators on one 9 V battery",

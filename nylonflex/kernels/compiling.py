@@ -42,6 +42,7 @@ FAMILIES = {
     "pointwise": "the pointwise kernel (nylonflex.evaluate, design_limits, sampled sweeps, "
                  "design, query --at)",
     "control": "the closed-loop kernels (simulate)",
+    "tracking": "the tracking kernels (sweeps with tracking:)",
     "codec": "the cube codec's byte shuffle",
 }
 
@@ -49,9 +50,11 @@ FAMILIES = {
 #: empty cache (NUMBA_CACHE_DIR a new folder): CPU seconds, what an idle machine takes;
 #: the wall time was 3-5 times that with the machine shared (load average 7-8: grid 83 s,
 #: pointwise 77 s, control 37 s). Quoted until this machine has its own figure.
-MEASURED = {"grid": 26.0, "pointwise": 16.0, "control": 8.0, "codec": 1.0}
+MEASURED = {"grid": 26.0, "pointwise": 16.0, "control": 8.0, "codec": 1.0,
+            "tracking": 20.0}  # tracking: an estimate, not yet measured cold
 
-_KERNEL_MODULES = {"nylonflex.kernels.control": "control", "nylonflex.kernels.bytes": "codec"}
+_KERNEL_MODULES = {"nylonflex.kernels.control": "control", "nylonflex.kernels.bytes": "codec",
+                   "nylonflex.kernels.tracking": "tracking"}
 _STATE = threading.local()
 _LOCK = threading.Lock()
 _SINK: list = []            # the installed notice callables, innermost last

@@ -18,6 +18,8 @@ formula is written twice.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..physics.bending import _curvature, _material_moment, _pressure_moment
@@ -138,6 +140,60 @@ def _switch(on, estimate, reference, half_band):
 
 
 @jit_kernel
+def _duty(kind, on, integral, estimate, reference, half_band, gain, integral_step):
+    """The controller: the fraction of the step the supply is on [-], and its new state.
+
+    Parameters
+    ----------
+    kind : int
+        0 bang-bang with hysteresis (:func:`_switch`), 1 PI.
+    on : bool
+        The bang-bang state of the last sample.
+    integral : float
+        The PI's integral term, (1/T_i) times the integrated error [rad].
+    estimate, reference : float
+        Estimated and reference angle [rad].
+    half_band : float
+        Half the bang-bang hysteresis band [rad].
+    gain : float
+        PI: 1 / proportional band [1/rad]: the duty is gain (e + integral), clipped to
+        [0, 1].
+    integral_step : float
+        PI: dt / T_i [-].
+
+    Returns
+    -------
+    duty, on, integral : float, bool, float
+        Bang-bang: duty 1.0 or 0.0. PI: the clipped duty; the integral only integrates
+        while the duty is not saturated in the error's direction (conditional
+        integration, against windup).
+
+    Notes
+    -----
+    docs/model.md s. 19: a duty u over the step is PWM faster than the step (and far faster
+    than the muscle's time constant): the mean power u V^2/R, held as the voltage
+    sqrt(u) V in the exact step of eq. (3).
+    """
+    if kind == 0:
+        on = _switch(on, estimate, reference, half_band)
+        return (1.0 if on else 0.0), on, integral
+    error = reference - estimate
+    u = gain * (error + integral)
+    if u >= 1.0:
+        duty = 1.0
+        if error < 0.0:
+            integral += integral_step * error
+    elif u <= 0.0:
+        duty = 0.0
+        if error > 0.0:
+            integral += integral_step * error
+    else:
+        duty = u
+        integral += integral_step * error
+    return duty, duty > 0.0, integral
+
+
+@jit_kernel
 def closed_loop(supply, muscles, tables_, control, out):
     """Step the closed loop of ``n`` actuators on one supply through ``m`` samples.
 
@@ -164,7 +220,9 @@ def closed_loop(supply, muscles, tables_, control, out):
     control : :class:`~.records.Control`
         ``half_band`` (n,) half the hysteresis band [rad]; ``filter_keep`` (n,)
         exp(-dt/tau_f) of the estimate's first-order filter, 0 for none [-]; ``reference``
-        (n, m) [rad] and ``noise`` (n, m) additive pressure-sensor noise [Pa] at each sample.
+        (n, m) [rad] and ``noise`` (n, m) additive pressure-sensor noise [Pa] at each sample;
+        ``kind`` (n,) int64, 0 bang-bang, 1 PI; ``gain`` (n,) [1/rad] and ``integral_step``
+        (n,) dt/T_i [-] of a PI (:func:`_duty`).
     out : :class:`~.records.SimOut`, arrays (n, m)
         Written: temperature [K], stroke [-], pressure [Pa], angle [rad], estimate [rad],
         voltage [V], current [A] and electric power [W] at each sample; the voltage is the
@@ -174,7 +232,7 @@ def closed_loop(supply, muscles, tables_, control, out):
     (muscle_length, r_per_len, c_per_len, loss_per_len, t_amb, t_start, stroke_scale, gamma,
      beta, t_g, sigma_g) = muscles
     plant_step, plant_angles, plant_slopes, table_step, tables = tables_
-    half_band, filter_keep, reference, noise = control
+    half_band, filter_keep, reference, noise, kind, gain, integral_step = control
     (out_temperature, out_stroke, out_pressure, out_angle, out_estimate, out_voltage,
      out_current, out_power) = out
     n = muscle_length.shape[0]
@@ -182,6 +240,8 @@ def closed_loop(supply, muscles, tables_, control, out):
     temperature = t_start.copy()
     estimate = np.zeros(n)
     on = np.zeros(n, dtype=np.bool_)
+    duty = np.zeros(n)
+    integral = np.zeros(n)
     resistance = r_per_len * muscle_length
     for k in range(m):
         conductance = 0.0
@@ -195,9 +255,11 @@ def closed_loop(supply, muscles, tables_, control, out):
                 estimate[j] = raw
             else:
                 estimate[j] = raw + filter_keep[j] * (estimate[j] - raw)
-            on[j] = _switch(on[j], estimate[j], reference[j, k], half_band[j])
+            duty[j], on[j], integral[j] = _duty(kind[j], on[j], integral[j], estimate[j],
+                                                reference[j, k], half_band[j], gain[j],
+                                                integral_step[j])
             if on[j]:
-                conductance += 1.0 / resistance[j]
+                conductance += duty[j] / resistance[j]
             out_temperature[j, k] = t_j
             out_stroke[j, k] = s
             out_pressure[j, k] = p
@@ -206,7 +268,7 @@ def closed_loop(supply, muscles, tables_, control, out):
         # the switched-on muscles are in parallel on the supply
         terminal = supply_voltage / (1.0 + internal_resistance * conductance)
         for j in range(n):
-            v = terminal if on[j] else 0.0
+            v = terminal * math.sqrt(duty[j]) if on[j] else 0.0
             out_voltage[j, k] = v
             out_current[j, k] = v / resistance[j]
             out_power[j, k] = v * v / resistance[j]

@@ -72,8 +72,10 @@ AngleTables = namedtuple("AngleTables", "plant_step plant_angles plant_slopes ta
                                         "tables")
 
 #: Per actuator: half hysteresis band [rad], filter factor [-], reference [rad] and sensor
-#: noise [Pa] at each sample.
-Control = namedtuple("Control", "half_band filter_keep reference noise")
+#: noise [Pa] at each sample; the controller ``kind`` (int64, 0 bang-bang, 1 PI), the PI's
+#: ``gain`` [1/rad] and ``integral_step`` dt/T_i [-].
+Control = namedtuple("Control", "half_band filter_keep reference noise kind gain "
+                                "integral_step")
 
 #: Outputs (n, m): temperature, stroke, pressure, angle, estimate, voltage, current, power.
 SimOut = namedtuple("SimOut", "temperature stroke pressure angle estimate voltage current "

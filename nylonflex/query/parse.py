@@ -7,12 +7,12 @@ import re
 import numpy as np
 
 from ..units import InputError, parse_quantity
-from ..variables import AXES, DESIGN, VARIABLES
+from ..variables import AXES, DESIGN, TRACKING, VARIABLES
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
-#: Columns a cube has only when its sweep asked for them (``requirements``).
-OPTIONAL = ("feasibility",)
+#: Columns a cube has only when its sweep asked for them (``requirements``, ``tracking:``).
+OPTIONAL = ("feasibility", *TRACKING)
 _FIELDS = ", ".join(COLUMNS + OPTIONAL)
 #: What a table shows after the axes and the variables a query tests or sorts by (the
 #: limit, the two headline performance numbers and the validity flags, by name).

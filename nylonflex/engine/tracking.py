@@ -1,0 +1,137 @@
+"""The ``tracking:`` variables of a slab: the figure-9 closed loop of every design
+(docs/model.md s. 19), through :mod:`nylonflex.kernels.tracking`.
+
+Each design's loop is ``nylonflex simulate``'s for that design alone (one actuator, the
+sweep's supply, no internal resistance): the same top pressure and estimator table, the
+same sensor noise sequence (the seed's), controller and thermal step. Only the plant's
+angle table differs in its grid: one curvature table per (radius, wall) of the slab, on
+:data:`PLANT_POINTS` points up to the highest pressure of its designs, instead of 513
+points up to each design's own (both within 1e-9 of the curvature solve).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..config import ResolvedConfig
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
+from ..physics.chamber import P_ATM, chamber_pressure
+from ..physics.nylon import _stroke_scale, stroke
+from ..physics.thermal import steady_temperature
+from ..physics.wrap import muscle_length
+from ..variables import TRACKING
+
+__all__ = ["PLANT_POINTS", "slab_tracking", "tracking_variables"]
+
+#: Points of each (radius, wall)'s curvature table: four times the density of
+#: ``nylonflex simulate``'s 513 over a design's own range.
+PLANT_POINTS = 2049
+
+#: Strokes from here on are refused by ``nylonflex simulate`` (Boyle and the wrap mean
+#: nothing): such designs get NaN.
+_STROKE_CAP = 0.5
+
+
+def tracking_variables(cfg: ResolvedConfig) -> dict:
+    """Registry entries of the variables ``cfg``'s ``tracking:`` adds (none without it);
+    ``tracking_bandwidth`` only with ``tracking.bandwidth``."""
+    spec = cfg.tracking
+    if spec is None:
+        return {}
+    return {n: v for n, v in TRACKING.items()
+            if n != "tracking_bandwidth" or spec.bandwidth is not None}
+
+
+def sensor_noise(spec, samples: int) -> np.ndarray:
+    """The pressure-sensor noise at each sample [Pa]: ``nylonflex simulate``'s sequence of
+    the seed (a single actuator's), extended to ``samples``."""
+    if spec.noise > 0:
+        return np.random.default_rng(spec.seed).normal(0.0, spec.noise, samples)
+    return np.zeros(samples)
+
+
+def _longest_run(spec) -> int:
+    """Samples of the longest run: the main one, or the bandwidth's at its lowest f."""
+    m = spec.n_steps
+    if spec.bandwidth is not None:
+        b = spec.bandwidth
+        m = max(m, int(math.floor((1.0 + b["periods"]) / b["low"] / spec.step + 1e-9)) + 1)
+    return m
+
+
+def top_pressure(cfg: ResolvedConfig, lm, coil_index) -> np.ndarray:
+    """The highest gauge pressure each design reaches [Pa], the top of its estimator table:
+    ``nylonflex simulate``'s, at T = max(T(0), T_ss(supply)); NaN where that stroke is at
+    least 0.5 (simulate refuses those). ``lm`` [m] and ``coil_index`` broadcast."""
+    ny, spec = cfg.nylon, cfg.tracking
+    t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
+    r = ny.resistance_per_length * lm
+    v = cfg.supply_voltage * r / (r + 0.0)  # simulate's terminal voltage, no source resistance
+    top = np.maximum(t0, steady_temperature(v, lm, ny))
+    s_top = np.asarray(stroke(top, coil_index, ny), float)
+    p = np.asarray(chamber_pressure(np.minimum(s_top, _STROKE_CAP)), float) * (1.0 + 1e-9)
+    return np.where(s_top < _STROKE_CAP, np.maximum(p, 1.0), np.nan)
+
+
+def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
+                  parallel: bool = True) -> dict:
+    """The tracking variables of the radii [i0, i1), shape (radius, wall, length, coil,
+    wrap) each.
+
+    ``nominal`` is the slab's grid-kernel result (``bend_angle_max`` scales a reference
+    relative to it). ``parallel=False`` (Dask workers) runs the serial kernels.
+    """
+    from ..kernels import tracking as kt
+
+    spec, ny = cfg.tracking, cfg.nylon
+    ax = cfg.axes
+    a = np.ascontiguousarray(ax["radius"][i0:i1])
+    t, L, C, psi = ax["wall_thickness"], ax["length"], ax["coil_index"], ax["wrap_angle"]
+    grid = np.meshgrid(a, t, L, C, psi, indexing="ij", sparse=True)
+    base = None if cfg.base_thickness is None else float(cfg.base_thickness)
+    lm = np.ascontiguousarray(np.broadcast_to(
+        muscle_length(grid[0], grid[1], grid[2], grid[4], grid[3], base, ny),
+        (len(a), len(t), len(L), len(C), len(psi))), dtype=float)
+    p_top = np.ascontiguousarray(top_pressure(cfg, lm, grid[3]))
+    with np.errstate(all="ignore"):
+        p_group = np.ascontiguousarray(np.nanmax(p_top.reshape(len(a), len(t), -1), axis=2)
+                                       if p_top.size else np.zeros((len(a), len(t))))
+    scale = np.array([float(_stroke_scale(c, np.asarray(ny.coil_index_table),
+                                          np.asarray(ny.stroke_max_table), ny.t_amb,
+                                          ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
+                      for c in C])
+    if spec.relative_to == "bend_angle_max":
+        ref_scale = np.ascontiguousarray(nominal["bend_angle_max"], dtype=float)
+    else:
+        ref_scale = np.ones(lm.shape)
+    mu, alpha = cfg.silicone.arrays()
+    nodes = quadrature_nodes()
+    kappa = np.empty((len(a), len(t), PLANT_POINTS))
+    slope = np.empty_like(kappa)
+    (kt.kappa_tables if parallel else kt.kappa_tables_serial)(
+        p_group, a, t, -1.0 if base is None else base, mu, alpha, *nodes, NEWTON_RTOL,
+        kappa, slope)
+    t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
+    muscle = (ny.resistance_per_length, ny.heat_capacity_per_length,
+              ny.heat_loss_per_length, ny.t_amb, t0, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    keep = math.exp(-spec.step / spec.filter_time_constant) \
+        if spec.filter_time_constant > 0 else 0.0
+    settings = (spec.step, spec.n_steps, float(cfg.supply_voltage), P_ATM,
+                spec.table_points, int(spec.controller == "pi"), 0.5 * spec.hysteresis,
+                1.0 / spec.proportional_band, spec.step / spec.integral_time, keep)
+    reference = (0 if spec.kind == "sine" else 1, spec.mean, spec.amplitude, spec.frequency,
+                 spec.phase, spec.initial, spec.final, spec.at, spec.rms_from)
+    b = spec.bandwidth
+    bandwidth = (0, 0.0, 1.0, 1.0, 0, 1) if b is None else \
+        (1, b["error"], b["low"], b["high"], b["iterations"], b["periods"])
+    out = np.empty((4, lm.size))
+    kernel = kt.track_slab_parallel if parallel else kt.track_slab_serial
+    kernel((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
+           kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
+           bandwidth, sensor_noise(spec, _longest_run(spec)), out)
+    names = ("tracking_rms_error", "tracking_max_temperature", "tracking_energy",
+             "tracking_bandwidth")
+    return {name: out[k].reshape(lm.shape) for k, name in enumerate(names)
+            if name in tracking_variables(cfg)}

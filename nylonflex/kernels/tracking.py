@@ -1,0 +1,257 @@
+"""Numba kernels of the per-design closed loop of a ``tracking:`` sweep (docs/model.md s. 19).
+
+The loop of each design is ``nylonflex simulate``'s (:func:`.control.closed_loop`, one
+actuator, no internal resistance): the same stroke, pressure, estimator table, controller
+(:func:`.control._duty`) and exact thermal step, sample by sample in the same order; only
+the time series are not kept, the metrics are summed as the loop goes. Private, unchecked
+(:mod:`nylonflex.engine.tracking` validates and shapes):
+
+- :func:`kappa_tables` tabulates the curvature kappa(p) and its slope once per (radius,
+  wall) of a slab (the angle is kappa L, so every length shares it), up to the highest
+  pressure any of its designs reaches;
+- :func:`track_slab_parallel` / :func:`track_slab_serial` (Dask workers) run every
+  design's loop, and its bandwidth search, one design per iteration.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from ..physics.chamber import _gauge_pressure
+from ..physics.nylon import _stroke_shape
+from ..physics.thermal import _temperature_step
+from ._compile import jit_kernel
+from .control import _duty, angle_table, estimate_angle, plant_angle
+
+__all__ = ["kappa_tables", "kappa_tables_serial", "run_loop", "track_slab_parallel",
+           "track_slab_serial"]
+
+def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig, w_phi,
+                  rtol, out_kappa, out_slope):
+    """kappa(k dp) [1/m] and d kappa/dp [1/(m Pa)], dp = p_max[i, j] / (points - 1), of
+    every (radius i, wall j); ``base`` <= 0 means b = t. NaN rows where p_max is NaN."""
+    na, nt = p_max.shape
+    points = out_kappa.shape[2]
+    for q in prange(na * nt):
+        i = q // nt
+        j = q % nt
+        b = wall[j] if base <= 0.0 else base
+        if p_max[i, j] > 0.0:
+            angle_table(p_max[i, j] / (points - 1), radius[i], wall[j], b, 1.0, mu, alpha,
+                        x_base, w_base, phi_trig, w_phi, rtol, out_kappa[i, j],
+                        out_slope[i, j])
+        else:
+            out_kappa[i, j, :] = np.nan
+            out_slope[i, j, :] = np.nan
+
+
+kappa_tables = jit_kernel(_kappa_tables, parallel=True)
+kappa_tables_serial = jit_kernel(_kappa_tables, parallel=False)
+
+
+@jit_kernel
+def run_loop(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t_amb, t_start,
+             scale, gamma, beta, t_g, sigma_g, length, plant_step, kappa, kappa_slope,
+             est_step, est, kind, half_band, gain, integral_step, filter_keep, noise,
+             ref_kind, mean, amplitude, frequency, phase, initial, final, at, rms_from):
+    """One design's closed loop over ``m`` samples: (rms error [rad], highest sampled
+    temperature [K], electric energy [J]).
+
+    The sample order is :func:`.control.closed_loop`'s: read the pressure, estimate,
+    switch, record, then step eq. (3) at the held voltage. ``ref_kind`` 0: the sine
+    mean + amplitude sin(2 pi f t + phase) [rad]; 1: the step from ``initial`` to
+    ``final`` [rad] at ``at`` [s]. The RMS is over the samples t_k >= rms_from (NaN when
+    none); ``noise`` (m,) [Pa] is added to each pressure reading.
+    """
+    temperature = t_start
+    estimate = 0.0
+    on = False
+    integral = 0.0
+    resistance = r_per_len * lm
+    sq = 0.0
+    count = 0
+    t_top = -math.inf
+    energy = 0.0
+    for k in range(m):
+        t_k = k * dt
+        s = scale * _stroke_shape(temperature, t_amb, gamma, beta, t_g, sigma_g)
+        p = _gauge_pressure(s, p_atm)
+        raw = estimate_angle(p + noise[k], est_step, est)
+        if k == 0:
+            estimate = raw
+        else:
+            estimate = raw + filter_keep * (estimate - raw)
+        if ref_kind == 0:
+            ref = mean + amplitude * math.sin(2.0 * np.pi * frequency * t_k + phase)
+        else:
+            ref = final if t_k >= at else initial
+        duty, on, integral = _duty(kind, on, integral, estimate, ref, half_band, gain,
+                                   integral_step)
+        if temperature > t_top:
+            t_top = temperature
+        if t_k >= rms_from - 1e-12:
+            err = length * plant_angle(p, plant_step, kappa, kappa_slope) - ref
+            sq += err * err
+            count += 1
+        v = voltage * math.sqrt(duty) if on else 0.0
+        energy += v * v / resistance
+        temperature = _temperature_step(temperature, v, dt, lm, t_amb, r_per_len, c_per_len,
+                                        loss_per_len)
+    rms = math.sqrt(sq / count) if count > 0 else math.nan
+    return rms, t_top, energy * dt
+
+
+@jit_kernel
+def _bandwidth(dt, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t_amb, t_start,
+               scale, gamma, beta, t_g, sigma_g, length, plant_step, kappa, kappa_slope,
+               est_step, est, kind, half_band, gain, integral_step, filter_keep, noise,
+               mean, amplitude, error, low, high, iterations, periods):
+    """Highest sine frequency [Hz] whose RMS error (after the first period, over
+    ``periods`` more) is at most ``error`` [rad]: bisection in log frequency between
+    ``low`` and ``high``, ``iterations`` halvings; 0 when ``low`` fails, ``high`` when it
+    passes. A run at f lasts (1 + periods)/f."""
+    lo = low
+    hi = high
+    for trial in range(iterations + 2):
+        if trial == 0:
+            f = low
+        elif trial == 1:
+            f = high
+        else:
+            f = math.sqrt(lo * hi)
+        m = int(math.floor((1.0 + periods) / f / dt + 1e-9)) + 1
+        if m > noise.shape[0]:
+            m = noise.shape[0]
+        rms, _, _ = run_loop(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len,
+                             t_amb, t_start, scale, gamma, beta, t_g, sigma_g, length,
+                             plant_step, kappa, kappa_slope, est_step, est, kind, half_band,
+                             gain, integral_step, filter_keep, noise, 0, mean, amplitude, f,
+                             0.0, 0.0, 0.0, 0.0, 1.0 / f)
+        ok = rms <= error  # NaN fails
+        if trial == 0:
+            if not ok:
+                return 0.0
+        elif trial == 1:
+            if ok:
+                return high
+        elif ok:
+            lo = f
+        else:
+            hi = f
+    return lo
+
+
+@jit_kernel
+def _one_design(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t_amb,
+                t_start, scale, gamma, beta, t_g, sigma_g, radius, wall, base, length, p_top,
+                points, mu, alpha, x_base, w_base, phi_trig, w_phi, rtol, plant_step, kappa,
+                kappa_slope, kind, half_band, gain, integral_step, filter_keep, noise,
+                ref_kind, mean, amplitude, frequency, phase, initial, final, at, rms_from,
+                bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods):
+    """(rms error, highest temperature, energy, bandwidth) of one design; NaN when its
+    ``p_top`` is NaN. Its estimator table is ``nylonflex simulate``'s: ``points`` angles
+    on p_top / (points - 1), from the same curvature solve (:func:`.control.angle_table`)."""
+    if not p_top > 0.0:
+        return math.nan, math.nan, math.nan, math.nan
+    est = np.empty(points)
+    scratch = np.empty(points)
+    est_step = p_top / (points - 1)
+    angle_table(est_step, radius, wall, base, length, mu, alpha, x_base, w_base, phi_trig,
+                w_phi, rtol, est, scratch)
+    rms, t_top, energy = run_loop(dt, m, voltage, p_atm, lm, r_per_len, c_per_len,
+                                  loss_per_len, t_amb, t_start, scale, gamma, beta, t_g,
+                                  sigma_g, length, plant_step, kappa, kappa_slope, est_step,
+                                  est, kind, half_band, gain, integral_step, filter_keep,
+                                  noise, ref_kind, mean, amplitude, frequency, phase, initial,
+                                  final, at, rms_from)
+    bandwidth = math.nan
+    if bw_on:
+        bandwidth = _bandwidth(dt, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len,
+                               t_amb, t_start, scale, gamma, beta, t_g, sigma_g, length,
+                               plant_step, kappa, kappa_slope, est_step, est, kind,
+                               half_band, gain, integral_step, filter_keep, noise, mean,
+                               amplitude, bw_error, bw_low, bw_high, bw_iterations,
+                               bw_periods)
+    return rms, t_top, energy, bandwidth
+
+
+def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, muscle,
+                silicone, nodes, rtol, settings, reference, bandwidth, noise, out):
+    """Every design's tracking metrics into ``out`` (4, n), designs in C order of the
+    slab's (radius, wall, length, coil, wrap).
+
+    Parameters
+    ----------
+    axes : tuple
+        (radius, wall, length) arrays [m] and the base thickness [m] (<= 0: b = t).
+    lm, p_top, ref_scale : ndarray, shape (na, nt, nl, nc, nw)
+        Muscle length [m]; the highest pressure the design reaches [Pa] (its estimator
+        table's top; NaN: no tracking); the factor of the reference angles (1, or theta*
+        [rad] for angles relative to it).
+    scale : ndarray (nc,)
+        Stroke scale s_max(C)/s_ref(T_max) [-].
+    p_group : ndarray (na, nt)
+        Top of each (radius, wall)'s curvature table [Pa].
+    kappa, kappa_slope : ndarray (na, nt, points)
+        :func:`kappa_tables` on the spacing p_group / (points - 1).
+    muscle : tuple
+        r' [ohm/m], c' [J/(K m)], lambda' [W/(K m)], T_amb, T(0) [K], gamma [1/K], beta
+        [-], T_g, sigma_g [K].
+    silicone, nodes : tuple
+        Ogden (mu [Pa], alpha [-]); the quadrature nodes and weights.
+    rtol : float
+        Tolerance of the curvature solve [-].
+    settings : tuple
+        dt [s], samples, supply [V], p_atm [Pa], estimator points, controller kind (0
+        bang-bang, 1 PI), half band [rad], PI gain [1/rad], dt/T_i [-], filter factor [-].
+    reference : tuple
+        kind (0 sine, 1 step), mean, amplitude [rad or -], frequency [Hz], phase [rad],
+        initial, final [rad or -], at, rms_from [s].
+    bandwidth : tuple
+        enabled (0/1), error [rad], low, high [Hz], iterations, periods.
+    noise : ndarray
+        Sensor noise at each sample [Pa], as long as the longest run.
+    out : ndarray (4, n)
+        Written: rms error [rad], highest temperature [K], energy [J], bandwidth [Hz].
+    """
+    radius, wall, length, base = axes
+    r_per_len, c_per_len, loss_per_len, t_amb, t_start, gamma, beta, t_g, sigma_g = muscle
+    mu, alpha = silicone
+    x_base, w_base, phi_trig, w_phi = nodes
+    (dt, m, voltage, p_atm, points, kind, half_band, gain, integral_step,
+     filter_keep) = settings
+    ref_kind, mean, amplitude, frequency, phase, initial, final, at, rms_from = reference
+    bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods = bandwidth
+    na, nt, nl, nc, nw = lm.shape
+    plant_points = kappa.shape[2]
+    n = na * nt * nl * nc * nw
+    for q in prange(n):
+        i = q // (nt * nl * nc * nw)
+        j = (q // (nl * nc * nw)) % nt
+        li = (q // (nc * nw)) % nl
+        ci = (q // nw) % nc
+        wi = q % nw
+        b = wall[j] if base <= 0.0 else base
+        g = ref_scale[i, j, li, ci, wi]
+        # one call, no branch in the prange body (writes after a branch were lost)
+        res = _one_design(dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len, c_per_len,
+                          loss_per_len, t_amb, t_start, scale[ci], gamma, beta, t_g, sigma_g,
+                          radius[i], wall[j], b, length[li], p_top[i, j, li, ci, wi], points,
+                          mu, alpha, x_base, w_base, phi_trig, w_phi, rtol,
+                          p_group[i, j] / (plant_points - 1), kappa[i, j], kappa_slope[i, j],
+                          kind, half_band, gain, integral_step, filter_keep, noise, ref_kind,
+                          g * mean, g * amplitude, frequency, phase, g * initial, g * final,
+                          at, rms_from, bw_on, bw_error, bw_low, bw_high, bw_iterations,
+                          bw_periods)
+        out[0, q] = res[0]
+        out[1, q] = res[1]
+        out[2, q] = res[2]
+        out[3, q] = res[3]
+
+
+#: Threaded (Numba prange) and serial (Dask workers) compilations of the same loop.
+track_slab_parallel = jit_kernel(_track_slab, parallel=True)
+track_slab_serial = jit_kernel(_track_slab, parallel=False)
