@@ -23,7 +23,8 @@ import numpy as np
 import yaml
 from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
 
-from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
+from ..materials import Cooling, Nylon, Silicone, cooling_parameters, nylon_parameters, \
+    silicone_parameters
 from ..requirements import parse_requirements
 from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
@@ -133,6 +134,7 @@ class SweepConfig(_Strict):
     requirements: list[str] = []
     model: Union[str, list[str]] = "paper"
     supply: Supply | None = None
+    cooling: Union[str, dict[str, Any], None] = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -159,6 +161,7 @@ class ResolvedConfig:
     requirements: tuple[str, ...] = ()
     models: tuple[str, ...] = ("paper",)
     supply_voltage: float | None = None
+    cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -199,6 +202,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["model"] = list(cfg.models)
     if cfg.supply_voltage is not None:
         doc["supply_voltage"] = cfg.supply_voltage
+    if cfg.cooling is not None:
+        doc["cooling"] = cfg.cooling.to_dict()
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -297,7 +302,23 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
                           requirements=requirements, models=_models(cfg.model),
-                          supply_voltage=_supply(cfg.supply))
+                          supply_voltage=_supply(cfg.supply),
+                          cooling=_cooling(cfg.cooling, nylon))
+
+
+def _cooling(cooling, nylon: Nylon) -> Cooling | None:
+    """The cooling set of a config's ``cooling`` (docs/model.md s. 9), or None; refused
+    beside a nylon set whose heat loss is fitted (a ``fit thermal`` file's value wins)."""
+    if cooling is None:
+        return None
+    try:
+        env = cooling_parameters(cooling)
+    except ValueError as err:
+        raise InputError(str(err)) from None
+    if "nylonflex fit" in str(nylon.sources.get("heat_loss_per_length", "")):
+        raise InputError("cooling: the nylon set's heat_loss_per_length is fitted (a fit "
+                         "thermal file); leave out cooling: or the fitted value")
+    return env
 
 
 def _models(model) -> tuple[str, ...]:
