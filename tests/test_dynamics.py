@@ -196,3 +196,41 @@ def test_a_sweep_with_a_supply_stores_the_dynamics_and_one_without_does_not(tmp_
         np.testing.assert_allclose(ds[name].values, ev[name], rtol=1e-12, err_msg=name)
     with pytest.raises(InputError, match="cooling: must be one of"):
         parse_config({**raw, "cooling": "breeze"})
+
+
+def _small_supply_cube():
+    from nylonflex.config import parse_config
+
+    return nf.run_sweep(parse_config({
+        "name": "dyn_charts", "supply": {"voltage": 12},
+        "grid": {"radius": {"values": [5, 10, 15], "units": "mm"},
+                 "wall_thickness": {"values": [1, 2], "units": "mm"},
+                 "length": {"values": [90], "units": "mm"},
+                 "coil_index": {"values": [1.1, 1.7]},
+                 "wrap_angle": {"values": [5, 8, 20], "units": "deg"}},
+        "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                   "pressure": {"start": 0, "stop": 40, "num": 3, "units": "kPa"}}}))
+
+
+def test_dynamic_charts_draw_into_a_given_axes_or_their_own_figure():
+    from matplotlib.figure import Figure
+
+    from nylonflex.charts import CHARTS, cycle_rate_lines, cycle_rate_map, force_rate
+
+    ds = _small_supply_cube()
+    for f in (cycle_rate_map, cycle_rate_lines, force_rate):
+        assert CHARTS[f.__name__] is f
+        fig = f(ds)
+        assert isinstance(fig, Figure)
+        host = Figure()
+        ax = host.add_subplot()
+        assert f(ds, ax=ax) is host
+        assert ax.get_ylabel() in ("wrap angle [deg]", "cycle rate [Hz]",
+                                   "maximum tip force [N]")
+    # the front of force_rate: the largest force among designs at least as fast
+    fig = force_rate(ds)
+    line = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("largest")][0]
+    assert max(line.get_ydata()) == pytest.approx(float(ds["tip_force_max"].max()))
+    plain = ds.drop_vars(list(DYNAMIC))
+    with pytest.raises(InputError, match="cycle_rate: the cube has none"):
+        cycle_rate_map(plain)

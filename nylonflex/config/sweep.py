@@ -46,7 +46,9 @@ __all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", 
 
 #: Figures a sweep config may name under ``charts``.
 CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
-          "feasibility_map", "compare")
+          "feasibility_map", "compare",
+          # with a supply (issue 29; docs/model.md s. 19)
+          "cycle_rate_map", "cycle_rate_lines", "force_rate")
 
 
 
