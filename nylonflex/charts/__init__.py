@@ -51,7 +51,7 @@ NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
          "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
          "design_map": ("radius", "wall_thickness"),
          "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",),
-         "cycle_rate_map": ("radius", "wall_thickness"), "cycle_rate_lines": ("radius",),
+         "cycle_rate_map": ("radius", "wrap_angle"), "cycle_rate_lines": ("radius",),
          "force_rate": ()}
 
 #: Charts of the per-design dynamics: only for a cube with a supply (docs/model.md s. 19).

@@ -71,7 +71,8 @@ def cycle_rate_map(ds, *, ax=None, x="radius", y="wrap_angle", radius=None,
     ax : matplotlib.axes.Axes, optional
         Draw here; default a new figure.
     x, y : str
-        The two axes of the map (names of :data:`nylonflex.variables.AXES`).
+        The two axes of the map (names of :data:`nylonflex.variables.AXES`); default
+        radius and wrap angle (the wrap angle sets the muscle length, which sets the rate).
     radius, wall_thickness, length, coil_index, wrap_angle : float, optional
         The fixed axes [SI]; default nearest 15 mm, 2 mm, 90 mm, 1.7 and 8 deg.
 
@@ -161,8 +162,10 @@ def cycle_rate_lines(ds, *, ax=None, wall_thickness=None, length=None, wrap_angl
 
 
 def force_rate(ds, *, ax=None, coil_index=None, length=None, wrap_angle=None):
-    """Tip force against cycle rate of every design (or a slice), with the front of the
-    largest force at each rate or faster.
+    """Tip force against cycle rate of every design, with the front of the largest force.
+
+    The front is the largest force among the designs at each rate or faster; ``length``
+    and ``wrap_angle`` may fix a slice.
 
     Parameters
     ----------
