@@ -234,3 +234,38 @@ def test_dynamic_charts_draw_into_a_given_axes_or_their_own_figure():
     plain = ds.drop_vars(list(DYNAMIC))
     with pytest.raises(InputError, match="cycle_rate: the cube has none"):
         cycle_rate_map(plain)
+
+
+def test_a_fit_thermal_file_replaces_both_constants_and_refuses_a_cooling_set(tmp_path):
+    # docs/model.md s. 9: a fitted lambda' and a measured r' replace the set's, r' then the
+    # same at every coil index (resistance_coil_index 0); cooling: beside it is refused
+    from nylonflex.calibration import fit_thermal
+    from nylonflex.config import parse_config
+    from nylonflex.material_files import write_material_file
+
+    lm, v, r_meas, lam, cap = 0.3, 5.0, 40.0, 0.05, 0.45
+    t = np.linspace(0.0, 60.0, 40)
+    t_ss = NY.t_amb + v ** 2 / (r_meas * lam * lm)
+    temp = t_ss + (NY.t_amb - t_ss) * np.exp(-t * lam / cap)
+    csv = tmp_path / "t.csv"
+    csv.write_text("time [s],temperature [K]\n" + "\n".join(f"{float(a)!r},{float(b)!r}"
+                                                            for a, b in zip(t, temp)))
+    fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
+    ny = nylon_parameters({"file": str(write_material_file(fit, tmp_path / "n.yaml"))})
+    assert ny.heat_loss_per_length == pytest.approx(lam, rel=1e-6)
+    assert ny.resistance_coil_index == 0.0
+    for c in (1.1, 1.7):
+        assert float(thermal.coil_resistance_per_length(c, ny)) == pytest.approx(
+            r_meas / lm, rel=1e-12)
+    raw = {"name": "fitted", "nylon": {"file": str(tmp_path / "n.yaml")},
+           "grid": {"radius": {"values": [10], "units": "mm"},
+                    "wall_thickness": {"values": [2], "units": "mm"},
+                    "length": {"values": [90], "units": "mm"},
+                    "coil_index": {"values": [1.3]},
+                    "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                      "pressure": {"start": 0, "stop": 40, "num": 3, "units": "kPa"}}}
+    assert parse_config(raw).cooling is None
+    with pytest.raises(InputError, match="cooling: the nylon set's heat_loss_per_length is "
+                                         "fitted"):
+        parse_config({**raw, "cooling": "still_air"})
