@@ -170,7 +170,11 @@ def read_material_set(kind: str, path, table: dict, known=()) -> tuple[str, dict
         params = dict(table[base])
         params["sources"] = dict(params.get("sources", {}))
         for key in set(known) & set(doc):
-            params[key] = doc[key]
+            # a thermal fit writes its derived constants with their intervals:
+            # {value, stderr, ci95}; the set takes the value
+            value = doc[key]
+            params[key] = value["value"] if isinstance(value, dict) and "value" in value \
+                else value
             sources[key] = note
         sources = {**params["sources"], **sources}
     rng = (doc.get("fitted_range") or {})

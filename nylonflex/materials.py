@@ -26,6 +26,9 @@ ZERO_CELSIUS = 273.15  # [K]
 
 __all__ = [
     "NYLON_PARAMETERS",
+    "COOLING_PARAMETERS",
+    "Cooling",
+    "cooling_parameters",
     "SILICONE_PARAMETERS",
     "WALL_STRETCH_RANGE",
     "WALL_STRETCH_RANGE",
@@ -133,6 +136,7 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
         "coil_index_table": (1.1, 1.3, 1.5, 1.7),
         "stroke_max_table": (0.054, 0.068, 0.083, 0.097),
         "tensile_strength_table": (100e6, 85e6, 73e6, 65e6),
+        "resistance_coil_index": 1.7,
         "description": "silver-coated nylon 6,6 sewing thread, self-coiled",
         "sources": {
             "fibre_diameter": "S: Sun et al., Soft Robotics 2021 (Shieldex 4-ply after twisting)",
@@ -146,11 +150,16 @@ NYLON_PARAMETERS: dict[str, dict[str, Any]] = {
             "sigma_g": "D: same fit",
             "t_amb": "P: room temperature",
             "t_max": "P: below the 160-200 degC annealing temperature",
-            "resistance_per_length": "S: the paper, 0.15 ohm/mm",
+            "resistance_per_length": "S: the paper, 0.15 ohm/mm, which its 12 V, 160 mA supply "
+            "of the 0.503 m muscle of its second example (C = 1.7) confirms (75 ohm)",
+            "resistance_coil_index": "D: the coil index of the paper's driven actuator (its "
+            "second example); at another C, r' scales with the thread per length of a "
+            "close-wound coil, sqrt((pi C)^2 + 1) (docs/model.md s. 9)",
             "heat_capacity_per_length": "D: rho = 1300 kg/m3, c_p = 1267 J/(kg K) (Sun et al., "
             "IROS 2018) for a coiled 4-ply thread",
-            "heat_loss_per_length": "K: so that the paper's 12 V supply (160 mA, 1.92 W: the "
-            "0.503 m muscle of its second example) holds the muscle near t_max (151.5 degC); "
+            "heat_loss_per_length": "K: back-calculated from the paper's operating point, its "
+            "12 V supply (160 mA, 1.92 W) on the 0.503 m muscle of its second example held "
+            "near t_max: 1.92 W / (0.503 m x 125 K) = 0.0305 (151.5 degC at 0.03); "
             "free convection in still air gives 3.1 times more (set silver_nylon66_still_air, "
             "docs/model.md s. 9)",
             "stiffness": "P: order of magnitude for a 60 mm self-coiled thread",
@@ -181,6 +190,89 @@ NYLON_PARAMETERS["silver_nylon66_still_air"] = {
     },
 }
 
+#: Cooling environments of the muscle (docs/model.md s. 9): the fluid around it and its
+#: speed across it [m/s] (0: free convection). The heat loss per length lambda' is computed
+#: from the cited correlation at the muscle's outer diameter d_f (C + 1), linearised at the
+#: operating point T_s = t_max (``physics/thermal.py::convection_loss_per_length``). A
+#: config picks one by name (``cooling: still_air``) or overrides the speed
+#: (``cooling: {set: forced_air, speed: 5}``); without ``cooling:`` the nylon set's own
+#: ``heat_loss_per_length`` holds.
+COOLING_PARAMETERS: dict[str, dict[str, Any]] = {
+    "still_air": {
+        "fluid": "air", "speed": 0.0,
+        "description": "still air at 1 atm, free convection",
+        "sources": {"speed": "D: free convection from a horizontal cylinder, Churchill & Chu, "
+                    "Int. J. Heat Mass Transfer 18:1049-1053, 1975; air, Incropera et al. "
+                    "6th ed. Table A.4"},
+    },
+    "forced_air": {
+        "fluid": "air", "speed": 2.0,
+        "description": "air at 1 atm blown across the muscle at 2 m/s (a desk fan)",
+        "sources": {"speed": "P: 2 m/s, a desk fan; D: cross flow over a cylinder, Churchill & "
+                    "Bernstein, J. Heat Transfer 99:300-306, 1977; air, Incropera Table A.4"},
+    },
+    "still_water": {
+        "fluid": "water", "speed": 0.0,
+        "description": "still water, free convection (the surface must stay below boiling)",
+        "sources": {"speed": "D: Churchill & Chu 1975 as for still air; saturated water, "
+                    "Incropera et al. 6th ed. Table A.6"},
+    },
+}
+
+
+@dataclass(frozen=True)
+class Cooling:
+    """A cooling environment (docs/model.md s. 9).
+
+    Attributes
+    ----------
+    fluid : str
+        ``"air"`` or ``"water"`` (the property tables of ``physics/thermal.py``).
+    speed : float
+        Speed of the fluid across the muscle [m/s], >= 0; 0 is free convection.
+    """
+
+    fluid: str
+    speed: float
+    name: str = "custom"
+    description: str = ""
+    sources: Mapping[str, str] = field(default_factory=dict, compare=False)
+
+    def to_dict(self) -> dict:
+        """The set's name, fluid and speed (for YAML provenance and the config hash)."""
+        return {"name": self.name, "fluid": self.fluid, "speed": self.speed}
+
+
+def cooling_parameters(cooling) -> Cooling:
+    """The named cooling environment, or ``{"set": name, "speed": m/s}`` (speed overridden).
+
+    Raises
+    ------
+    ValueError
+        Unknown set or field, or a speed outside [0, 100] m/s.
+    """
+    if isinstance(cooling, Cooling):
+        return cooling
+    over = {}
+    if isinstance(cooling, Mapping):
+        over = {k: v for k, v in cooling.items() if k != "set"}
+        cooling = cooling.get("set")
+    if cooling not in COOLING_PARAMETERS:
+        raise ValueError(f"cooling: must be one of {', '.join(COOLING_PARAMETERS)}, "
+                         f"got {short(cooling)}")
+    p = {**COOLING_PARAMETERS[cooling]}
+    for key, value in over.items():
+        if key != "speed":
+            raise ValueError(f"cooling.{key}: unknown field; a cooling set takes set and speed")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+                not (np.isfinite(value) and 0.0 <= value <= 100.0):
+            raise ValueError(f"cooling.speed: must be a number in [0, 100] m/s, got "
+                             f"{short(value)}")
+        p["speed"] = float(value)
+    return Cooling(p["fluid"], float(p["speed"]), name=cooling,
+                   description=p.get("description", ""), sources=dict(p.get("sources", {})))
+
+
 #: Unit of every field of a material set, as the code (and a config override) takes it.
 FIELD_UNITS = {
     "mu": "Pa", "alpha": "1",
@@ -189,7 +281,8 @@ FIELD_UNITS = {
     "resistance_per_length": "ohm/m", "heat_capacity_per_length": "J/(K m)",
     "heat_loss_per_length": "W/(K m)", "stiffness": "N/m", "damping": "N s/m",
     "thermal_force_coefficient": "N/K", "coil_index_table": "1", "stroke_max_table": "1",
-    "tensile_strength_table": "Pa",
+    "tensile_strength_table": "Pa", "resistance_coil_index": "1",
+    "speed": "m/s",
 }
 
 
@@ -364,6 +457,10 @@ class Nylon:
         Eq. (1) constants k [N/m], b_d [N s/m], c [N/K].
     coil_index_table, stroke_max_table, tensile_strength_table : tuple of float
         Coil index C [-], its maximum stroke s_max [-] and tensile strength sigma_u [Pa].
+    resistance_coil_index : float
+        Coil index C_r [-] at which ``resistance_per_length`` holds; at another C, r' scales
+        by sqrt((pi C)^2 + 1) / sqrt((pi C_r)^2 + 1) (docs/model.md s. 9). 0: r' is the
+        same at every coil index.
     """
 
     fibre_diameter: float
@@ -384,6 +481,7 @@ class Nylon:
     coil_index_table: tuple[float, ...]
     stroke_max_table: tuple[float, ...]
     tensile_strength_table: tuple[float, ...]
+    resistance_coil_index: float = 0.0
     name: str = "custom"
     description: str = ""
     sources: Mapping[str, str] = field(default_factory=dict, compare=False)
@@ -404,11 +502,14 @@ class Nylon:
 
 
 def _values(material) -> dict:
-    # stretch_range is the fit's provenance, like its sources: not part of the config hash
+    # stretch_range is the fit's provenance, like its sources: not part of the config hash;
+    # resistance_coil_index 0 (r' the same at every C, as before issue 30) is left out so
+    # that such a set hashes as it did
     return {f.name: (list(v) if isinstance(v, tuple) else v)
             for f in fields(material) if f.name not in ("description", "sources",
                                                         "stretch_range")
-            for v in (getattr(material, f.name),)}
+            for v in (getattr(material, f.name),)
+            if not (f.name == "resistance_coil_index" and v == 0.0)}
 
 
 def _resolve(kind, table, value, overrides):
@@ -544,6 +645,7 @@ NYLON_RANGES = {
     "coil_index_table": (1.0, 50.0, ""),
     "stroke_max_table": (1e-4, 0.9, ""),
     "tensile_strength_table": (1e6, 1e10, "Pa"),
+    "resistance_coil_index": (0.0, 50.0, ""),
 }
 #: Accepted Ogden constants: each |mu_i| [Pa], each |alpha_i| [-] (non-zero), and the
 #: initial shear modulus 1/2 sum mu_i alpha_i [Pa].
@@ -584,7 +686,7 @@ def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
     for f in fields(Nylon):
         if f.name in ("name", "description", "sources"):
             continue
-        v = p[f.name]
+        v = p.get(f.name, f.default) if f.name == "resistance_coil_index" else p[f.name]
         try:
             if f.name.endswith("_table"):
                 kwargs[f.name] = tuple(float(x) for x in v)

@@ -342,9 +342,10 @@ def top_temperature(cfg: SimConfig, a: ActuatorSpec) -> float:
     [T_amb, max(T(0), T_ss(E))] (with others on, the supply only sags).
     """
     lm = actuator_muscle_length(a)
-    r = float(muscle_resistance(lm, a.nylon))
+    r = float(muscle_resistance(lm, a.nylon, coil_index=a.coil_index))
     v = cfg.supply_voltage * r / (r + cfg.internal_resistance)
-    return max(a.initial_temperature, float(steady_temperature(v, lm, a.nylon)))
+    return max(a.initial_temperature,
+               float(steady_temperature(v, lm, a.nylon, coil_index=a.coil_index)))
 
 
 # ---------------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ from . import __version__
 from .physics.bending import NEWTON_RTOL, quadrature_nodes
 from .physics.chamber import P_ATM, chamber_pressure
 from .physics.nylon import _stroke_scale, nylon_force_limit, stroke
+from .physics.thermal import coil_resistance_per_length
 from .physics.wrap import nylon_force
 from .simconfig import (  # noqa: F401 - the config layer's names, importable from here too
     DEFAULTS,
@@ -228,7 +229,7 @@ def run_simulation(cfg: SimConfig):
         p_top = float(chamber_pressure(s_top)) * (1.0 + 1e-9)
         dpp, plant, slope, dpe, est = _tables(a, max(p_top, 1.0))
         reach.append(plant[-1])
-        for key, val in (("lm", lm), ("r", ny.resistance_per_length),
+        for key, val in (("lm", lm), ("r", float(coil_resistance_per_length(a.coil_index, ny))),
                          ("c", ny.heat_capacity_per_length), ("loss", ny.heat_loss_per_length),
                          ("tamb", ny.t_amb), ("t0", a.initial_temperature), ("scale", scale),
                          ("gamma", ny.gamma), ("beta", ny.beta), ("tg", ny.t_g),

@@ -102,11 +102,13 @@ _FLAGS = {"limit": ((0, 1, 2, 3),
           "slab_done": ((0, 1), "missing done")}
 
 #: CF flag masks and meanings of the bit-field variables (docs/model.md s. 17).
-_MASKS = {"validity": ((1, 2, 4, 8),
-                       "self_contact stretch_beyond_fit under_one_turn chamber_closes")}
+_MASKS = {"validity": ((1, 2, 4, 8, 16),
+                       "self_contact stretch_beyond_fit under_one_turn chamber_closes "
+                       "efficiency_beyond_bound")}
 
 #: Variables that are in a cube only when its config gives a supply.
-SUPPLY_ONLY = ("heating_time",)
+SUPPLY_ONLY = ("heating_time", "cycle_time", "cycle_rate", "heating_energy", "mechanical_work",
+               "efficiency")
 
 #: CF standard names (CF standard name table) where CF has one for a cube variable: the
 #: two flag variables say the status and the quality of each design's values. The design
@@ -197,10 +199,25 @@ DESIGN = {v.name: v for v in [
        "of its value at T*, eq. (3) with V = 0 (docs/model.md s. 15)", "s", "time"),
     _m("heating_time", AXES, "s", "heating time", "time at the supply voltage from ambient "
        "until the free stroke is 95 % of its value at T* (docs/model.md s. 15)", "s", "time"),
+    # per-design dynamics with a supply (issue 29; docs/model.md s. 20)
+    _m("cycle_time", AXES, "s", "cycle time", "heating at the supply from ambient to 95 % of "
+       "the working stroke, then cooling to 5 % of it, eq. (3) (docs/model.md s. 20)", "s",
+       "time"),
+    _m("cycle_rate", AXES, "Hz", "cycle rate", "1 / cycle_time, full strokes a second "
+       "(docs/model.md s. 20)", "Hz", "frequency"),
+    _m("heating_energy", AXES, "J", "heating energy", "electrical energy of one stroke, "
+       "V^2/R times the heating time (docs/model.md s. 20)", "J", "energy"),
+    _m("mechanical_work", AXES, "J", "mechanical work", "work of the muscle on the chamber "
+       "over the usable stroke, l_m int_0^s* F_n ds (docs/model.md s. 20)", "mJ", "energy"),
+    _m("efficiency", AXES, "1", "efficiency", "mechanical_work / heating_energy; validity "
+       "bit 16 above 1.32 %, the best measured for coiled polymer muscles (docs/model.md "
+       "s. 20)", "1", "dimensionless"),
     _m("validity", AXES, "1", "validity flags", "bits: 1 self_contact, 2 stretch_beyond_fit, "
-       "4 under_one_turn, 8 chamber_closes; 0 a clean design (docs/model.md s. 17)", "1",
+       "4 under_one_turn, 8 chamber_closes, 16 efficiency_beyond_bound; 0 a clean design "
+       "(docs/model.md s. 17, 19)", "1",
        "dimensionless", "int8"),
 ]}
+assert tuple(DESIGN)[-1] == "validity"
 
 CURVES = {v.name: v for v in [
     _m("nylon_force", ["radius", "wall_thickness", "coil_index", "wrap_angle", "stroke"], "N",

@@ -51,8 +51,10 @@ def test_chart_names_are_the_configs():
     assert tuple(charts.CHARTS) == CHARTS
 
 
-# charts of a plain cube; feasibility_map needs a sampled cube (tests/test_uncertainty.py)
-PLAIN_CHARTS = tuple(n for n in CHARTS if n != "feasibility_map")
+# charts of a plain cube; feasibility_map needs a sampled cube (tests/test_uncertainty.py),
+# the dynamics charts a supply (tests/test_dynamics.py)
+PLAIN_CHARTS = tuple(n for n in CHARTS if n != "feasibility_map"
+                     and n not in charts.DYNAMIC_CHARTS)
 
 
 @pytest.mark.parametrize("name", PLAIN_CHARTS)

@@ -20,7 +20,7 @@ from nylonflex.design import nondominated, parse_spec, run_design
 from nylonflex.query import Condition
 from nylonflex.sweep import run_sweep
 from nylonflex.units import InputError
-from nylonflex.variables import AXES, DESIGN, VARIABLES, to_display
+from nylonflex.variables import AXES, DESIGN, SUPPLY_ONLY, VARIABLES, to_display
 
 SMALL = {
     "name": "small",
@@ -167,8 +167,9 @@ def res_summary(res):
 
 
 # ---------------------------------------------------------------------------- property
-# heating_time is in a cube only with a supply (asked of this one, it is refused)
-_NAMES = [n for n in [*AXES, *DESIGN] if n not in ("limit", "heating_time")]
+# heating_time and the dynamics are in a cube only with a supply (asked of this one, they
+# are refused)
+_NAMES = [n for n in [*AXES, *DESIGN] if n != "limit" and n not in SUPPLY_ONLY]
 
 
 @st.composite

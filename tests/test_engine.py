@@ -117,9 +117,15 @@ def test_the_grid_engine_writes_the_cube_the_code_wrote_before_the_rewrite():
     # rewrite) from reference_cube.yaml; every variable it has must come out the same:
     # integers (flags) and coordinates identical, floats within 1e-12 relative since the
     # node tables and curve-started Newton of issue 17 (largest difference seen: 6e-15)
+    # Issue 30 made r' depend on the coil index; a muscle set with resistance_coil_index 0
+    # (the same r' at every C, as 0.1.0 had it) must still write that cube and hash:
+    import dataclasses
+
     import xarray as xr
 
     cfg = nf.load_config(DATA / "reference_cube.yaml")
+    cfg = dataclasses.replace(cfg, nylon=dataclasses.replace(cfg.nylon,
+                                                             resistance_coil_index=0.0))
     new = nf.run_sweep(cfg)
     with xr.open_dataset(DATA / "reference_cube.h5", engine="h5netcdf") as old:
         for name in old.variables:
@@ -139,6 +145,36 @@ def test_the_grid_engine_writes_the_cube_the_code_wrote_before_the_rewrite():
                                   np.interp(cfg.axes["coil_index"],
                                             cfg.nylon.coil_index_table,
                                             cfg.nylon.stroke_max_table))
+
+
+def test_the_default_muscle_set_moves_only_resistance_and_heating_voltage_by_coil_index():
+    # Issue 30: the default set's r' = 0.15 ohm/mm holds at C = 1.7 and scales by the thread
+    # per length of a close-wound coil, sqrt((pi C)^2 + 1) (docs/model.md s. 9). Without a
+    # supply that moves R = r' l_m by the ratio and V* = sqrt(R P) by its square root against
+    # the same set with one r' for every C (resistance_coil_index 0, the cubes before issue
+    # 30), and nothing else: heating power, cooling time and the design variables do not
+    # depend on R.
+    import dataclasses
+
+    cfg = nf.load_config(DATA / "reference_cube.yaml")
+    flat = dataclasses.replace(cfg, nylon=dataclasses.replace(cfg.nylon,
+                                                              resistance_coil_index=0.0))
+    new, old = nf.run_sweep(cfg), nf.run_sweep(flat)
+    c = cfg.axes["coil_index"]
+    ratio = (np.sqrt((np.pi * c) ** 2 + 1) / np.sqrt((np.pi * 1.7) ** 2 + 1))[:, None]
+    for name in old.data_vars:
+        expected = old[name].values
+        if name == "resistance":
+            np.testing.assert_allclose(new[name].values, expected * ratio, rtol=1e-15)
+        elif name == "heating_voltage":
+            np.testing.assert_allclose(new[name].values, expected * np.sqrt(ratio),
+                                       rtol=1e-15)
+        else:
+            np.testing.assert_array_equal(new[name].values, expected, err_msg=name)
+    # at the paper's coil index (1.7) the old values bit for bit
+    np.testing.assert_array_equal(new["resistance"].values[..., -1, :],
+                                  old["resistance"].values[..., -1, :])
+    assert new.attrs["config_sha256"] != old.attrs["config_sha256"]
 
 
 def test_array_pool_hands_back_what_was_given_back():

@@ -16,7 +16,9 @@ NAMES = {"usable_stroke", "limit", "pressure_max", "torque_max", "tip_force_max"
          "bend_angle_max", "range_fraction", "nylon_force_max", "nylon_use",
          # issue 10: heating, supply and validity
          "muscle_length", "resistance", "heating_power", "heating_voltage", "cooling_time",
-         "heating_time", "validity"}
+         "heating_time", "validity",
+         # issue 29: the dynamics with a supply (docs/model.md s. 20)
+         "cycle_time", "cycle_rate", "heating_energy", "mechanical_work", "efficiency"}
 
 
 def test_returns_every_design_variable_of_the_cube_table():

@@ -93,6 +93,19 @@ def test_each_design_of_a_grid_is_its_own_simulation():
         assert got == pytest.approx(sim.attrs["rms_error"], rel=1e-9)
 
 
+def test_each_coil_index_is_its_own_simulation():
+    # r'(C) differs by coil index (docs/model.md s. 9): the sweep's loop of each C heats
+    # with that C's resistance, as simulate of that design does
+    sim_raw = _control()
+    coils = [1.1, 1.7]
+    ds = nf.run_sweep(parse_config(_sweep_of(sim_raw, {"coil_index": {"values": coils}})))
+    for i, c in enumerate(coils):
+        sim = run_simulation(parse_sim_config(_control(design__coil_index=c)))
+        for var, key in (("tracking_rms_error", "rms_error"), ("tracking_energy", "energy")):
+            got = float(ds[var].values.reshape(-1)[i])
+            assert got == pytest.approx(sim.attrs[key], rel=1e-9)
+
+
 def test_reference_relative_to_the_designs_range():
     # mean 0.6, amplitude 0.2 of theta*: the same as simulate with those angles in radians
     sim_raw = _control()

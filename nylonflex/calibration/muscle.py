@@ -278,7 +278,9 @@ def fit_thermal(data, voltage, muscle_length=None, resistance=None, nylon="silve
         fields.update(heat_loss_per_length=out["heat_loss_per_length"]["value"],
                       heat_capacity_per_length=out["heat_capacity_per_length"]["value"])
         if resistance is not None:
+            # measured on this muscle: the same r' at every coil index (docs/model.md s. 9)
             fields["resistance_per_length"] = r / muscle_length
+            fields["resistance_coil_index"] = 0.0
     fit = res(sol.x) + y
     rmse, r2 = statistics(y, fit)
     return FitResult(

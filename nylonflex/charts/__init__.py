@@ -27,10 +27,12 @@ from ..variables import VARIABLES, to_display
 from ._common import FORMATS, _RC, _figure, _grid_value, _plt  # noqa: F401
 from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
+from .dynamics import cycle_rate_lines, cycle_rate_map, force_rate
 from .fig12 import fig12a, fig12b, fig12c
 from .maps import design_map, feasibility_map
 
-__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "design_map",
+__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "cycle_rate_lines",
+           "cycle_rate_map", "design_map", "force_rate",
            "draw_charts", "feasibility_map", "fig4", "fig6", "fig7", "fig12a", "fig12b",
            "fig12c"]
 
@@ -38,7 +40,9 @@ __all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "design_
 #: Chart name -> function, the names a config's ``charts`` list accepts.
 CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
           "fig6": fig6, "fig7": fig7, "design_map": design_map,
-          "feasibility_map": feasibility_map, "compare": compare}
+          "feasibility_map": feasibility_map, "compare": compare,
+          "cycle_rate_map": cycle_rate_map, "cycle_rate_lines": cycle_rate_lines,
+          "force_rate": force_rate}
 assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 
 
@@ -46,12 +50,19 @@ assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
 NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
          "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
          "design_map": ("radius", "wall_thickness"),
-         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",)}
+         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",),
+         "cycle_rate_map": ("radius", "wrap_angle"), "cycle_rate_lines": ("radius",),
+         "force_rate": ()}
+
+#: Charts of the per-design dynamics: only for a cube with a supply (docs/model.md s. 20).
+DYNAMIC_CHARTS = ("cycle_rate_map", "cycle_rate_lines", "force_rate")
 
 
 def _unmet(ds, name):
     if name == "feasibility_map" and "feasibility" not in ds:
         return "feasibility_map skipped: the cube has no feasibility (no 'requirements')"
+    if name in DYNAMIC_CHARTS and "cycle_rate" not in ds:
+        return f"{name} skipped: the cube has no cycle_rate (its sweep had no 'supply')"
     short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
     return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
             "has 1") if short else None
@@ -60,7 +71,8 @@ def _unmet(ds, name):
 #: Drawing time of each chart relative to fig4's (the fig12 cube, this machine): the drawing
 #: processes take the longest first, so that none is left drawing alone at the end.
 COST = {"design_map": 4.0, "feasibility_map": 4.0, "fig12c": 3.2, "fig12b": 2.3,
-        "fig12a": 1.9, "fig7": 1.5, "fig6": 1.5, "compare": 1.2, "fig4": 1.0}
+        "fig12a": 1.9, "fig7": 1.5, "fig6": 1.5, "compare": 1.2, "fig4": 1.0,
+        "cycle_rate_map": 2.0, "force_rate": 2.0, "cycle_rate_lines": 1.2}
 assert set(COST) == set(CHARTS), "every chart needs a drawing cost"
 
 
@@ -204,7 +216,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         nylonflex did not write for this cube.
     """
     if not names:  # every chart the cube can show (feasibility only with requirements)
-        names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
+        names = [n for n in CHARTS if (n != "feasibility_map" or "feasibility" in ds)
+                 and (n not in DYNAMIC_CHARTS or "cycle_rate" in ds)]
     names = list(names)
     unknown = [n for n in names if n not in CHARTS]
     if unknown:

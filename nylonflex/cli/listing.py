@@ -43,15 +43,26 @@ def _materials(out):
                 source = m.sources.get(field, "")
                 print(f"    {field + unit:<34} {show(value):<28} {source}", file=out)
         print(file=out)
+    from ..materials import COOLING_PARAMETERS, cooling_parameters
+
+    print("cooling sets (config key 'cooling:'; {set: NAME, speed: VALUE} in m/s; without "
+          "it the nylon set's heat_loss_per_length holds):", file=out)
+    for name in COOLING_PARAMETERS:
+        env = cooling_parameters(name)
+        print(f"  {name}: {env.description}; fluid {env.fluid}, speed {env.speed:g} m/s  "
+              f"{env.sources.get('speed', '')}", file=out)
+    print(file=out)
 
 
 def _charts(out):
-    from ..charts import CHARTS, NEEDS
+    from ..charts import CHARTS, DYNAMIC_CHARTS, NEEDS
 
     print("charts (config 'charts:' list, 'nylonflex chart CUBE --figure NAME'):", file=out)
     for name, func in CHARTS.items():
-        print(f"  {name:<11} {_first_line(func.__doc__)} (needs 2+ values of "
-              f"{' and '.join(NEEDS[name])})", file=out)
+        needs = [f"2+ values of {' and '.join(NEEDS[name])}"] if NEEDS[name] else []
+        needs += ["a supply"] if name in DYNAMIC_CHARTS else []
+        print(f"  {name:<11} {_first_line(func.__doc__)} (needs {', '.join(needs)})",
+              file=out)
 
 
 def _variables(out):

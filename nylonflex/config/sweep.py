@@ -23,7 +23,8 @@ import numpy as np
 import yaml
 from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
 
-from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
+from ..materials import Cooling, Nylon, Silicone, cooling_parameters, nylon_parameters, \
+    silicone_parameters
 from ..requirements import parse_requirements
 from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
@@ -46,7 +47,9 @@ __all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", 
 
 #: Figures a sweep config may name under ``charts``.
 CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
-          "feasibility_map", "compare")
+          "feasibility_map", "compare",
+          # with a supply (issue 29; docs/model.md s. 20)
+          "cycle_rate_map", "cycle_rate_lines", "force_rate")
 
 
 
@@ -135,6 +138,7 @@ class SweepConfig(_Strict):
     model: Union[str, list[str]] = "paper"
     supply: Supply | None = None
     tracking: Tracking | None = None
+    cooling: Union[str, dict[str, Any], None] = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -162,6 +166,7 @@ class ResolvedConfig:
     models: tuple[str, ...] = ("paper",)
     supply_voltage: float | None = None
     tracking: "TrackingSpec | None" = None
+    cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -204,6 +209,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["supply_voltage"] = cfg.supply_voltage
     if cfg.tracking is not None:  # only then: cubes without tracking keep their hash
         doc["tracking"] = cfg.tracking.to_dict()
+    if cfg.cooling is not None:
+        doc["cooling"] = cfg.cooling.to_dict()
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -300,12 +307,31 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     models, voltage = _models(cfg.model), _supply(cfg.supply)
     tracking = None if cfg.tracking is None else \
         resolve_tracking(cfg.tracking, voltage, models, nylon.t_amb, nylon.t_max)
+    if tracking is not None and cfg.cooling is not None:
+        raise InputError("cooling: not with tracking: yet (the closed loop, like nylonflex "
+                         "simulate, uses the muscle set's own heat loss); leave one out")
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
                           requirements=requirements, models=models,
-                          supply_voltage=voltage, tracking=tracking)
+                          supply_voltage=voltage, tracking=tracking,
+                          cooling=_cooling(cfg.cooling, nylon))
+
+
+def _cooling(cooling, nylon: Nylon) -> Cooling | None:
+    """The cooling set of a config's ``cooling`` (docs/model.md s. 9), or None; refused
+    beside a nylon set whose heat loss is fitted (a ``fit thermal`` file's value wins)."""
+    if cooling is None:
+        return None
+    try:
+        env = cooling_parameters(cooling)
+    except ValueError as err:
+        raise InputError(str(err)) from None
+    if "nylonflex fit" in str(nylon.sources.get("heat_loss_per_length", "")):
+        raise InputError("cooling: the nylon set's heat_loss_per_length is fitted (a fit "
+                         "thermal file); leave out cooling: or the fitted value")
+    return env
 
 
 def _models(model) -> tuple[str, ...]:

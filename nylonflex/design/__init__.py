@@ -88,8 +88,10 @@ class DesignResult:
 def _materials(ds, spec):
     """The model with the materials (and supply) the cube was computed with, from its
     attributes; evaluations are remembered per cube config and model variant."""
-    silicone, nylon, base, supply, memo = _cube_materials(ds.attrs["config_yaml"], spec.model)
-    return Model(silicone, nylon, base, spec.model, memo, supply_voltage=supply)
+    silicone, nylon, base, supply, cooling, memo = _cube_materials(ds.attrs["config_yaml"],
+                                                                   spec.model)
+    return Model(silicone, nylon, base, spec.model, memo, supply_voltage=supply,
+                 cooling=cooling)
 
 
 @functools.lru_cache(maxsize=8)
@@ -97,7 +99,8 @@ def _cube_materials(config_yaml, model):
     from ..engine.provenance import evaluate_settings
 
     s = evaluate_settings({"config_yaml": config_yaml})
-    return s["silicone"], s["nylon"], s["base_thickness"], s.get("supply_voltage"), {}
+    return (s["silicone"], s["nylon"], s["base_thickness"], s.get("supply_voltage"),
+            s.get("cooling"), {})
 
 
 def _open(spec, cube):

@@ -13,6 +13,7 @@ from ..config import ResolvedConfig
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke_max
+from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length
 from ..physics.wrap import muscle_width
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
 
@@ -102,8 +103,14 @@ def check_physics(cfg: ResolvedConfig):
                                   cfg.base_thickness))
     w_min = float(np.min(muscle_width(ax["coil_index"], ny)))
     l_max = ax["length"][-1] * min(1.0 / np.sin(ax["wrap_angle"][0]), p_max / w_min)
-    check_supply_rise(cfg.supply_voltage, l_max, ny.resistance_per_length,
-                      ny.heat_loss_per_length)
+    # r' and lambda' per coil index: the largest product gives the least rise (a bound)
+    c = ax["coil_index"]
+    product = np.atleast_1d(coil_resistance_per_length(c, ny)) * \
+        np.atleast_1d(coil_heat_loss_per_length(c, ny, cfg.cooling))
+    j = int(np.argmax(product))
+    check_supply_rise(cfg.supply_voltage, l_max,
+                      np.atleast_1d(coil_resistance_per_length(c, ny))[j],
+                      np.atleast_1d(coil_heat_loss_per_length(c, ny, cfg.cooling))[j])
 
 
 def _chunk_cap(per_radius: int) -> int:
@@ -139,7 +146,9 @@ def _coil_table(cfg: ResolvedConfig):
     c = cfg.axes["coil_index"]
     column = lambda x: np.ascontiguousarray(x, dtype=float).reshape(-1)  # noqa: E731
     return CoilTable(column(stroke_max(c, cfg.nylon)), column(nylon_force_limit(c, cfg.nylon)),
-                     column(muscle_width(c, cfg.nylon)))
+                     column(muscle_width(c, cfg.nylon)),
+                     column(coil_resistance_per_length(c, cfg.nylon)),
+                     column(coil_heat_loss_per_length(c, cfg.nylon, cfg.cooling)))
 
 
 class ArrayPool:

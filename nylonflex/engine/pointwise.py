@@ -25,7 +25,7 @@ from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
-from ..physics.thermal import check_supply_rise
+from ..physics.thermal import _coil_resistance, check_supply_rise
 from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
@@ -46,7 +46,8 @@ _NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_
 
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
-             silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None):
+             silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None,
+             cooling=None):
     """Every design variable of designs that broadcast together (compiled, parallel).
 
     Parameters
@@ -76,13 +77,19 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     supply_voltage : float, optional
         Steady supply voltage across the muscle [V], in (0, 1000]; None: no supply limit
         (docs/model.md s. 15).
+    cooling : str, dict or Cooling, optional
+        Cooling environment (``materials.COOLING_PARAMETERS``: ``still_air``,
+        ``forced_air``, ``still_water``); None: the nylon set's ``heat_loss_per_length``
+        (docs/model.md s. 9).
 
     Returns
     -------
     dict of str to ndarray
         The design variables of :data:`nylonflex.variables.DESIGN` (the same names, units
         and values as :func:`nylonflex.design_limits`), each of the broadcast shape;
-        ``limit`` and ``validity`` are int8; ``heating_time`` is NaN without a supply.
+        ``limit`` and ``validity`` are int8; ``heating_time`` and the dynamics
+        (``cycle_time``, ``cycle_rate``, ``heating_energy``, ``mechanical_work``,
+        ``efficiency``; docs/model.md s. 20) are NaN without a supply.
 
     Raises
     ------
@@ -128,12 +135,32 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     force_limit = strength * (np.pi * d_f**2 / 4.0)
     width = d_f * (c_flat + 1.0)
     muscle = [flat(ny[k]) for k in _MUSCLE_FIELDS]
+    r_per_len = np.vectorize(_coil_resistance, otypes=[float])(
+        flat(ny["resistance_per_length"]), flat(ny["resistance_coil_index"]), c_flat)
+    loss_per_len = _heat_loss(cooling, d_f, flat(ny["t_max"]), flat(ny["t_amb"]), c_flat,
+                              flat(ny["heat_loss_per_length"]))
     options = (MODELS.index(model), voltage, stretch_max)
     out = _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
-               (s_max, force_limit, width), ogden, muscle, options)
-    check_supply_rise(voltage, out["muscle_length"], ny["resistance_per_length"],
-                      ny["heat_loss_per_length"], "supply_voltage")
+               (s_max, force_limit, width, r_per_len, loss_per_len), ogden, muscle, options)
+    check_supply_rise(voltage, out["muscle_length"], r_per_len.reshape(shape),
+                      loss_per_len.reshape(shape), "supply_voltage")
     return out
+
+
+def _heat_loss(cooling, d_f, t_max, t_amb, c, own):
+    """lambda' [W/(K m)] of each design: the set's own without ``cooling``, else the
+    cooling set's correlation at d_f (C + 1) and T_s = t_max, once per distinct design
+    (docs/model.md s. 9)."""
+    if cooling is None:
+        return own
+    from ..materials import cooling_parameters
+    from ..physics.thermal import convection_loss_per_length
+
+    env = cooling_parameters(cooling)
+    keys, inverse = np.unique(np.stack([d_f, t_max, t_amb, c]), axis=1, return_inverse=True)
+    values = np.array([convection_loss_per_length(k[0] * (k[3] + 1.0), k[1], k[2], env.fluid,
+                                                  env.speed) for k in keys.T])
+    return np.ascontiguousarray(values[inverse.reshape(-1)])
 
 
 def _stretch_max(silicone) -> float:
@@ -177,7 +204,7 @@ def serial():
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
                   silicone="tc5005", nylon="silver_nylon66", model="paper",
-                  supply_voltage=None):
+                  supply_voltage=None, cooling=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
     The compiled :func:`evaluate` with docs/interface.md's positional signature: floats (and an
@@ -186,7 +213,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     """
     out = evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
                    base_thickness=base_thickness, silicone=silicone, nylon=nylon, model=model,
-                   supply_voltage=supply_voltage)
+                   supply_voltage=supply_voltage, cooling=cooling)
     if out["limit"].ndim:
         return out
     return {name: int(v) if name in ("limit", "validity") else float(v)

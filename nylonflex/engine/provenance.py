@@ -191,6 +191,12 @@ def evaluate_settings(attrs) -> dict:
         out["supply_voltage"] = float(supply["voltage"])
     elif isinstance(supply, (int, float)) and not isinstance(supply, bool):
         out["supply_voltage"] = float(supply)
+    cooling = doc.get("cooling")  # only in cubes swept with a cooling set (docs/model.md s. 9)
+    if isinstance(cooling, dict) and cooling.get("fluid") is not None:
+        from ..materials import Cooling
+
+        out["cooling"] = Cooling(str(cooling["fluid"]), float(cooling.get("speed", 0.0)),
+                                 name=str(cooling.get("name", "custom")))
     return out
 
 

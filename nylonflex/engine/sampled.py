@@ -157,6 +157,7 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
     out["base_thickness"] = cfg.base_thickness
     out["model"] = cfg.models[0]  # a sampled sweep has one model (nylonflex.config refuses more)
     out["supply_voltage"] = cfg.supply_voltage
+    out["cooling"] = cfg.cooling
     return out
 
 

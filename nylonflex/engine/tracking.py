@@ -19,7 +19,7 @@ from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import _stroke_scale, stroke
-from ..physics.thermal import steady_temperature
+from ..physics.thermal import coil_resistance_per_length, steady_temperature
 from ..physics.wrap import muscle_length
 from ..variables import TRACKING
 
@@ -67,9 +67,9 @@ def top_pressure(cfg: ResolvedConfig, lm, coil_index) -> np.ndarray:
     least 0.5 (simulate refuses those). ``lm`` [m] and ``coil_index`` broadcast."""
     ny, spec = cfg.nylon, cfg.tracking
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
-    r = ny.resistance_per_length * lm
+    r = coil_resistance_per_length(coil_index, ny) * lm
     v = cfg.supply_voltage * r / (r + 0.0)  # simulate's terminal voltage, no source resistance
-    top = np.maximum(t0, steady_temperature(v, lm, ny))
+    top = np.maximum(t0, steady_temperature(v, lm, ny, coil_index=coil_index))
     s_top = np.asarray(stroke(top, coil_index, ny), float)
     p = np.asarray(chamber_pressure(np.minimum(s_top, _STROKE_CAP)), float) * (1.0 + 1e-9)
     return np.where(s_top < _STROKE_CAP, np.maximum(p, 1.0), np.nan)
@@ -114,7 +114,8 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
         p_group, a, t, -1.0 if base is None else base, mu, alpha, *nodes, NEWTON_RTOL,
         kappa, slope)
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
-    muscle = (ny.resistance_per_length, ny.heat_capacity_per_length,
+    muscle = (np.ascontiguousarray(np.atleast_1d(coil_resistance_per_length(C, ny)), float),
+              ny.heat_capacity_per_length,
               ny.heat_loss_per_length, ny.t_amb, t0, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
     keep = math.exp(-spec.step / spec.filter_time_constant) \
         if spec.filter_time_constant > 0 else 0.0

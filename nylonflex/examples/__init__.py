@@ -19,6 +19,7 @@ EXAMPLES = {
     "fig12": "sweep: the design space of the paper's figure 12 (nylonflex sweep configs/fig12.yaml)",
     "fig12_uncertain": "sweep with uncertainty and requirements: quantiles and feasibility",
     "fig12_fitted": "sweep with a fitted silicone (configs/fits/ecoflex_0050_ogden2.yaml)",
+    "fig12_dynamics": "sweep at the paper's 12 V: cycle rate, energy, work and efficiency",
     "big20m": "sweep: 20 million designs, for clusters and memory checks",
     "fig12_tracking": "sweep with tracking: the closed loop of figure 9 for every design",
     "design_force": "design: the largest tip force with a full range (needs sweeps/fig12)",

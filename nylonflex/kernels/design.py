@@ -32,7 +32,7 @@ from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _node_count, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _design_state, _design_values, _model_moment,
+                              _design_state, _design_values, _dynamic_values, _model_moment,
                               _model_state_nodes,
                               _nylon_force_model, _reach,
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
@@ -45,7 +45,7 @@ from ._compile import jit_kernel
 
 #: Number of float design variables in ``out.design``: the registry's float design
 #: variables (all but ``limit`` and ``validity``), in its order.
-N_FLOAT_DESIGN = 14
+N_FLOAT_DESIGN = 19
 
 
 def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
@@ -70,7 +70,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     x_base, w_base, phi_trig, w_phi = nodes.x_base, nodes.w_base, nodes.phi_trig, nodes.w_phi
     # unpacked before the loop: a record's fields written inside prange are lost (Numba)
     out_design, out_flags, out_force, out_angle, out_tip = out
-    coil_s_max, coil_force_limit, coil_width = coil
+    coil_s_max, coil_force_limit, coil_width, coil_r, coil_loss = coil
     model, voltage, stretch_max = options
     t_amb = muscle.t_amb[0]
     t_max = muscle.t_max[0]
@@ -78,11 +78,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     beta = muscle.beta[0]
     t_g = muscle.t_g[0]
     sigma_g = muscle.sigma_g[0]
-    r_per_len = muscle.r_per_len[0]
     c_per_len = muscle.c_per_len[0]
-    loss_per_len = muscle.loss_per_len[0]
     force_coeff = muscle.force_coeff[0]
-    tau = c_per_len / loss_per_len
     default = model == PAPER and voltage <= 0.0
     cauchy = model == CAUCHY_MOMENT
     top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
@@ -139,6 +136,10 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         for ic in range(nc):
             s_max = coil_s_max[ic]
             f_lim = coil_force_limit[ic]
+            # r' and lambda' depend on the coil index (docs/model.md s. 9)
+            r_per_len = coil_r[ic]
+            loss_per_len = coil_loss[ic]
+            tau = c_per_len / loss_per_len
             scale = s_max / top
             kappa_full = 0.0
             if default:
@@ -210,9 +211,18 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[11, ia, it, il, ic, ip] = th[3]
                     out_design[12, ia, it, il, ic, ip] = th[4]
                     out_design[13, ia, it, il, ic, ip] = th[5]
+                    dyn = _dynamic_values(model, v[0], a, t, lever, solid, mu, alpha, p_atm,
+                                          th[0], th[1], voltage, th[5], temps[2], temps[1],
+                                          t_amb, tau)
+                    out_design[14, ia, it, il, ic, ip] = dyn[0]
+                    out_design[15, ia, it, il, ic, ip] = dyn[1]
+                    out_design[16, ia, it, il, ic, ip] = dyn[2]
+                    out_design[17, ia, it, il, ic, ip] = dyn[3]
+                    out_design[18, ia, it, il, ic, ip] = dyn[4]
                     out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4], a, t, b,
                                                               stretch_max,
-                                                              length[il] / pitch, closes)
+                                                              length[il] / pitch, closes,
+                                                              dyn[4])
                 for js in range(ns):
                     if model == INCOMPRESSIBLE_WALL:
                         f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
@@ -233,15 +243,14 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     both give the same numbers.
     """
     radius, wall, base, length, wrap = designs
-    s_max_all, f_lim_all, width_all = coil
+    s_max_all, f_lim_all, width_all, r_all, loss_all = coil
     mu_all, alpha_all = silicone
     x_base, w_base, phi_trig, w_phi = nodes
     out_design, out_flags = out
     model, voltage, stretch_max = options
     t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
         muscle.t_amb, muscle.t_max, muscle.gamma, muscle.beta, muscle.t_g, muscle.sigma_g
-    r_all, c_all, loss_all, coeff_all = \
-        muscle.r_per_len, muscle.c_per_len, muscle.loss_per_len, muscle.force_coeff
+    c_all, coeff_all = muscle.c_per_len, muscle.force_coeff
     n = radius.shape[0]
     step = 0 if mu_all.shape[0] == 1 else 1  # one row for all, or one a design
     for i in prange(n):
@@ -285,7 +294,17 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         out_design[11, i] = th[3]
         out_design[12, i] = th[4]
         out_design[13, i] = th[5]
-        out_flags[1, i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, st[7])
+        solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
+        dyn = _dynamic_values(model, v[0], a, t, lever, solid, mu, alpha, p_atm, th[0], th[1],
+                              voltage, th[5], temps[2], temps[1], t_amb,
+                              c_all[i] / loss_all[i])
+        out_design[14, i] = dyn[0]
+        out_design[15, i] = dyn[1]
+        out_design[16, i] = dyn[2]
+        out_design[17, i] = dyn[3]
+        out_design[18, i] = dyn[4]
+        out_flags[1, i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, st[7],
+                                    dyn[4])
 
 
 #: Threaded (Numba prange) and serial compilations of the same loops. The serial ones are

@@ -26,9 +26,10 @@ Nodes = namedtuple("Nodes", "x_base w_base phi_trig w_phi")
 GridAxes = namedtuple("GridAxes", "radius wall length wrap base_thickness stroke pressure p_atm")
 
 #: Per coil index: ``s_max`` [-], ``force_limit`` F_lim [N], ``width`` of the coiled muscle
-#: [m]. The grid kernel takes one entry a coil index of the axis, the pointwise kernel one
+#: [m], ``r_per_len`` r'(C) [ohm/m] and ``loss_per_len`` lambda'(C) [W/(K m)] (docs/model.md
+#: s. 9). The grid kernel takes one entry a coil index of the axis, the pointwise kernel one
 #: a design.
-CoilTable = namedtuple("CoilTable", "s_max force_limit width")
+CoilTable = namedtuple("CoilTable", "s_max force_limit width r_per_len loss_per_len")
 
 #: Output arrays of the grid kernel: ``design`` (float design variables, the registry's
 #: order less ``limit``, then the slab's design shape), ``flags`` (int8, rows ``limit`` and
@@ -41,6 +42,7 @@ GridOut = namedtuple("GridOut", "design flags nylon_force bend_angle tip_force")
 #: kernel) or one a design (the pointwise kernel): ``t_amb``, ``t_max``, ``t_g`` [K],
 #: ``gamma`` [1/K], ``beta`` [-], ``sigma_g`` [K], ``r_per_len`` r' [ohm/m], ``c_per_len``
 #: c' [J/(K m)], ``loss_per_len`` lambda' [W/(K m)], ``force_coeff`` c of eq. (1) [N/K].
+#: The design kernels read r' and lambda' per coil index from :data:`CoilTable` instead.
 Muscle = namedtuple("Muscle", "t_amb t_max gamma beta t_g sigma_g r_per_len c_per_len "
                               "loss_per_len force_coeff")
 
@@ -52,7 +54,7 @@ Options = namedtuple("Options", "model voltage stretch_max")
 #: ``wrap`` [rad].
 PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
 
-#: Output of the pointwise kernel: ``design`` (float variables, shape (14, n)) and ``flags``
+#: Output of the pointwise kernel: ``design`` (float variables, shape (19, n)) and ``flags``
 #: (int8, shape (2, n): ``limit`` and ``validity``).
 PointOut = namedtuple("PointOut", "design flags")
 

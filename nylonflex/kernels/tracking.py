@@ -198,8 +198,8 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
     kappa, kappa_slope : ndarray (na, nt, points)
         :func:`kappa_tables` on the spacing p_group / (points - 1).
     muscle : tuple
-        r' [ohm/m], c' [J/(K m)], lambda' [W/(K m)], T_amb, T(0) [K], gamma [1/K], beta
-        [-], T_g, sigma_g [K].
+        r'(C) [ohm/m] (an array over the coil indices, docs/model.md s. 9), c' [J/(K m)],
+        lambda' [W/(K m)], T_amb, T(0) [K], gamma [1/K], beta [-], T_g, sigma_g [K].
     silicone, nodes : tuple
         Ogden (mu [Pa], alpha [-]); the quadrature nodes and weights.
     rtol : float
@@ -237,7 +237,7 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         b = wall[j] if base <= 0.0 else base
         g = ref_scale[i, j, li, ci, wi]
         # one call, no branch in the prange body (writes after a branch were lost)
-        res = _one_design(dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len, c_per_len,
+        res = _one_design(dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len[ci], c_per_len,
                           loss_per_len, t_amb, t_start, scale[ci], gamma, beta, t_g, sigma_g,
                           radius[i], wall[j], b, length[li], p_top[i, j, li, ci, wi], points,
                           mu, alpha, x_base, w_base, phi_trig, w_phi, rtol,

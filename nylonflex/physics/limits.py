@@ -22,13 +22,13 @@ from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pres
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
-from .thermal import _cooling_time, _heating_power, _heating_time, _steady_temperature, \
-    check_supply_rise
+from .thermal import _coil_resistance, _cooling_time, _heating_power, _heating_time, \
+    _steady_temperature, check_supply_rise, coil_heat_loss_per_length
 from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
     _outer_perimeter, _pitch, _wrap_force
 
-__all__ = ["DESIGN_VARIABLES", "MODELS", "VALIDITY_FLAGS", "design_limits", "model_bend_angle",
-           "stroke_limit"]
+__all__ = ["DESIGN_VARIABLES", "EFFICIENCY_BOUND", "MODELS", "VALIDITY_FLAGS", "design_limits",
+           "model_bend_angle", "stroke_limit"]
 
 from ..variables import MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE = \
@@ -36,7 +36,21 @@ PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_P
 
 #: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
-                  "chamber_closes": 8}
+                  "chamber_closes": 8, "efficiency_beyond_bound": 16}
+
+#: The highest efficiency measured for coiled polymer muscles, mechanical work over the
+#: energy put in: 1.32 % (polyethylene; 1.08 % for nylon 6,6), Haines et al., Science
+#: 343:868, 2014. ``efficiency`` above it sets the ``efficiency_beyond_bound`` bit
+#: (docs/model.md s. 20).
+EFFICIENCY_BOUND = 0.0132
+
+#: 8-point Gauss-Legendre nodes and weights on [-1, 1] (Abramowitz & Stegun, Table 25.4):
+#: the work integral of the nylon force over the stroke (docs/model.md s. 20).
+_WORK_X = (-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+           -0.1834346424956498, 0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+           0.9602898564975363)
+_WORK_W = (0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+           0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763)
 
 #: Fraction of the free stroke that counts as reached (heating) or let go (cooling) [-].
 HEATED_FRACTION = 0.95
@@ -62,6 +76,11 @@ DESIGN_VARIABLES = (
     "heating_voltage",
     "cooling_time",
     "heating_time",
+    "cycle_time",
+    "cycle_rate",
+    "heating_energy",
+    "mechanical_work",
+    "efficiency",
     "validity",
 )
 
@@ -371,12 +390,51 @@ def _thermal_values_at(length, pitch, perimeter, cos_wrap, voltage, t_work, t_ho
 
 
 @formula
+def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
+    """Integral of the nylon force over the stroke, int_0^s F_n(s') ds' [N].
+
+    8-point Gauss-Legendre on [0, s] (F_n is smooth there: Boyle's pressure and the Ogden
+    hoop stress; docs/model.md s. 20); times the muscle length, the work [J].
+    """
+    half = 0.5 * stroke
+    total = 0.0
+    for j in range(8):
+        total += _WORK_W[j] * _nylon_force_model(model, half * (1.0 + _WORK_X[j]), radius,
+                                                 wall_thickness, lever, solid, mu, alpha,
+                                                 p_atm)[0]
+    return total * half
+
+
+@formula
+def _dynamic_values(model, s_star, radius, wall_thickness, lever, solid, mu, alpha, p_atm,
+                    muscle_length, resistance, voltage, heating, t_hot, t_cool, t_amb, tau):
+    """cycle_time [s], cycle_rate [Hz], heating_energy [J], mechanical_work [J], efficiency.
+
+    With a supply V (``voltage`` > 0; NaN without): the cycle heats at V from ambient to
+    95 % of the working stroke (``heating``, the heating time to T_95) and cools from there
+    to 5 % of it, tau ln((T_95 - T_amb)/(T_5 - T_amb)); the heating energy is V^2/R times
+    the heating time; the work l_m int_0^s* F_n ds; the efficiency their ratio
+    (docs/model.md s. 20).
+    """
+    if not voltage > 0.0:
+        return math.nan, math.nan, math.nan, math.nan, math.nan
+    cycle = heating + _cooling_time(t_hot, t_cool, t_amb, tau)
+    energy = voltage * voltage / resistance * heating
+    work = muscle_length * _stroke_work(model, s_star, radius, wall_thickness, lever, solid,
+                                        mu, alpha, p_atm)
+    return cycle, 1.0 / cycle, energy, work, work / energy
+
+
+@formula
 def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch_max,
-              turns, closes):
+              turns, closes, efficiency):
     """The ``validity`` bits (docs/model.md s. 17): 1 self contact (theta* > 2 pi), 2 the
     largest axial stretch 1 + kappa* (b + a + t) beyond the silicone's fitted range, 4 fewer
-    than one turn of wrap, 8 the chamber closes (``incompressible_wall``)."""
+    than one turn of wrap, 8 the chamber closes (``incompressible_wall``), 16 the efficiency
+    above :data:`EFFICIENCY_BOUND` (NaN without a supply: never set)."""
     flags = 0
+    if efficiency > EFFICIENCY_BOUND:
+        flags += 16
     if bend_angle > 2.0 * math.pi:
         flags += 1
     if 1.0 + kappa * (base_thickness + radius + wall_thickness) > stretch_max:
@@ -487,7 +545,8 @@ def stroke_limit(radius, wall_thickness, coil_index, wrap_angle, base_thickness=
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
-                  silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None):
+                  silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None,
+                  cooling=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
     The slow, obviously-right pure-Python loop the compiled engine is tested against.
@@ -514,6 +573,9 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         Model variant, one of :data:`MODELS` (docs/model.md s. 16).
     supply_voltage : float, optional
         Steady supply voltage V [V], > 0; None: no supply limit (docs/model.md s. 15).
+    cooling : str, dict or Cooling, optional
+        Cooling environment (``materials.COOLING_PARAMETERS``); None: the muscle set's
+        ``heat_loss_per_length`` (docs/model.md s. 9).
 
     Returns
     -------
@@ -523,8 +585,9 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         ``bend_angle_max`` theta* [rad], ``range_fraction`` theta*/theta(s_max) [-],
         ``nylon_force_max`` F_n(s*) [N], ``nylon_use`` F_n(s*)/F_lim [-],
         ``muscle_length`` [m], ``resistance`` [ohm], ``heating_power`` [W],
-        ``heating_voltage`` [V], ``cooling_time`` [s], ``heating_time`` [s] (NaN without a
-        supply) and ``validity`` (bits of :data:`VALIDITY_FLAGS`). Floats (ints for the
+        ``heating_voltage`` [V], ``cooling_time`` [s], ``heating_time`` [s], ``cycle_time``
+        [s], ``cycle_rate`` [Hz], ``heating_energy`` [J], ``mechanical_work`` [J],
+        ``efficiency`` [-] (the last six NaN without a supply) and ``validity`` (bits of :data:`VALIDITY_FLAGS`). Floats (ints for the
         flags) for scalar input, arrays of the broadcast shape otherwise.
 
     Raises
@@ -555,28 +618,37 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     top = _stroke_shape(ny.t_max, *shape_args)
     out = {name: np.empty(a.shape, dtype=np.int8 if name in ("limit", "validity") else float)
            for name in DESIGN_VARIABLES}
+    r_all, loss_all = np.empty(a.shape), np.empty(a.shape)
     for idx in np.ndindex(a.shape):
         ai, ti, bi, Li, ci, pi = (float(x[idx]) for x in (a, t, b, L, c, psi))
         force_limit = float(np.interp(ci, c_tab, ny.tensile_strength_table)) * ny.fibre_area
+        r_per_len = _coil_resistance(ny.resistance_per_length, ny.resistance_coil_index, ci)
+        loss_per_len = ny.heat_loss_per_length if cooling is None else \
+            coil_heat_loss_per_length(ci, ny, cooling)
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))
         pitch = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0))
         lever = pitch / math.cos(pi)
         *state, closes, t_reach = _design_state(
             code, voltage, ai, ti, bi, Li, pi, pitch, lever, force_limit, s_max, s_max / top,
             ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g,
-            ny.resistance_per_length, ny.heat_loss_per_length, ny.thermal_force_coefficient,
+            r_per_len, loss_per_len, ny.thermal_force_coefficient,
             mu, alpha, *nodes, P_ATM)
         values = _design_values(*state, force_limit, Li)
         temps = _working_temperatures(code, values[0], t_reach, s_max / top, *shape_args[:1],
                                       ny.t_max, *shape_args[1:])
         thermal = _thermal_values(Li, pitch, ai, ti, bi, pi, voltage, *temps, ny.t_amb,
-                                  ny.resistance_per_length, ny.heat_capacity_per_length,
-                                  ny.heat_loss_per_length)
-        flags = _validity(values[5], state[4], ai, ti, bi, stretch_max, Li / pitch, closes)
-        for name, v in zip(DESIGN_VARIABLES, (*values, *thermal, flags)):
+                                  r_per_len, ny.heat_capacity_per_length, loss_per_len)
+        solid = _solid_fraction(ai, ti, bi) if code == INCOMPRESSIBLE_WALL else 0.0
+        dynamic = _dynamic_values(code, values[0], ai, ti, lever, solid, mu, alpha, P_ATM,
+                                  thermal[0], thermal[1], voltage, thermal[5], temps[2],
+                                  temps[1], ny.t_amb,
+                                  ny.heat_capacity_per_length / loss_per_len)
+        flags = _validity(values[5], state[4], ai, ti, bi, stretch_max, Li / pitch, closes,
+                          dynamic[4])
+        r_all[idx], loss_all[idx] = r_per_len, loss_per_len
+        for name, v in zip(DESIGN_VARIABLES, (*values, *thermal, *dynamic, flags)):
             out[name][idx] = v
-    check_supply_rise(voltage, out["muscle_length"], ny.resistance_per_length,
-                      ny.heat_loss_per_length, "supply_voltage")
+    check_supply_rise(voltage, out["muscle_length"], r_all, loss_all, "supply_voltage")
     return {name: (int(v) if name in ("limit", "validity") and v.ndim == 0
                    else scalar_or_array(v)) for name, v in out.items()}
 

@@ -10,11 +10,15 @@ import math
 
 import numpy as np
 
-from ..materials import nylon_parameters
+from ..materials import cooling_parameters, nylon_parameters
 from ._formula import check, formula, scalar_or_array
 
 __all__ = [
     "AIR_PROPERTIES",
+    "WATER_PROPERTIES",
+    "coil_heat_loss_per_length",
+    "coil_resistance_per_length",
+    "convection_loss_per_length",
     "MIN_SUPPLY_RISE",
     "check_supply_rise",
     "coiled_resistance_per_length",
@@ -37,6 +41,19 @@ AIR_PROPERTIES = {
     "a": (22.5e-6, 29.9e-6, 38.3e-6, 47.2e-6),
     "pr": (0.707, 0.700, 0.690, 0.686),
 }
+#: Saturated liquid water: temperature [K], k [W/(m K)], nu = mu/rho [m^2/s], a = nu/Pr
+#: [m^2/s], Pr [-], volumetric expansion beta [1/K]. Incropera et al., 6th ed., Table A.6
+#: (300, 325, 350 K and the boiling point at 1 atm); linear in between.
+WATER_PROPERTIES = {
+    "t": (300.0, 325.0, 350.0, 373.15),
+    "k": (0.613, 0.645, 0.668, 0.680),
+    "nu": (855e-6 * 1.003e-3, 528e-6 * 1.013e-3, 365e-6 * 1.027e-3, 279e-6 * 1.044e-3),
+    "a": (855e-6 * 1.003e-3 / 5.83, 528e-6 * 1.013e-3 / 3.42, 365e-6 * 1.027e-3 / 2.29,
+          279e-6 * 1.044e-3 / 1.76),
+    "pr": (5.83, 3.42, 2.29, 1.76),
+    "beta": (276.1e-6, 436.7e-6, 624.2e-6, 750.1e-6),
+}
+_FLUIDS = {"air": AIR_PROPERTIES, "water": WATER_PROPERTIES}
 _G = 9.80665  # [m/s^2]
 _SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m^2 K^4)]
 
@@ -89,14 +106,137 @@ def free_convection_loss_per_length(diameter, t_surface, t_amb, emissivity=0.0):
     return float(np.pi * k * nu_d + radiation)
 
 
+def convection_loss_per_length(diameter, t_surface, t_amb, fluid="air", speed=0.0):
+    """Heat loss per length of a horizontal cylinder in a fluid, lambda' [W/(K m)].
+
+    ``speed`` 0: free convection, Churchill and Chu (Int. J. Heat Mass Transfer
+    18:1049-1053, 1975), as :func:`free_convection_loss_per_length`, with the fluid's
+    expansion coefficient (1/T_f for air, Table A.6 for water). ``speed`` > 0: cross flow,
+    Churchill and Bernstein (J. Heat Transfer 99:300-306, 1977; Re_D Pr >= 0.2)::
+
+        Nu_D = 0.3 + 0.62 Re^(1/2) Pr^(1/3) / [1 + (0.4/Pr)^(2/3)]^(1/4)
+                   [1 + (Re/282000)^(5/8)]^(4/5),   Re = U D / nu
+
+    free convection left out (Gr/Re^2 is about 1e-3 for the muscle at 2 m/s). Properties at
+    the film temperature (T_s + T_amb)/2; lambda' = pi k Nu_D.
+
+    Parameters
+    ----------
+    diameter : float
+        Outer diameter D [m], > 0.
+    t_surface, t_amb : float
+        Surface and ambient temperature [K], T_s > T_amb; the film temperature inside the
+        fluid's table (air 300-450 K, water 300-373.15 K).
+    fluid : str
+        ``"air"`` or ``"water"``.
+    speed : float
+        Speed of the fluid across the cylinder [m/s], >= 0.
+
+    Returns
+    -------
+    float
+        lambda' [W/(K m)].
+    """
+    if fluid not in _FLUIDS:
+        raise ValueError(f"fluid: must be one of {', '.join(_FLUIDS)}, got {fluid!r}")
+    d, ts, ta, u = float(diameter), float(t_surface), float(t_amb), float(speed)
+    if not d > 0:
+        raise ValueError(f"diameter: must be > 0 m, got {d:g}")
+    if not ts > ta > 0:
+        raise ValueError(f"t_surface: must be above t_amb > 0 K, got {ts:g} and {ta:g}")
+    if not u >= 0:
+        raise ValueError(f"speed: must be >= 0 m/s, got {u:g}")
+    table = _FLUIDS[fluid]
+    tf = 0.5 * (ts + ta)
+    t = table["t"]
+    if not t[0] <= tf <= t[-1]:
+        raise ValueError(f"film temperature (t_surface + t_amb)/2: must be in [{t[0]:g}, "
+                         f"{t[-1]:g}] K (the {fluid} table), got {tf:g}")
+    k, nu, a, pr = (float(np.interp(tf, t, table[q])) for q in ("k", "nu", "a", "pr"))
+    if u > 0.0:
+        re = u * d / nu
+        nu_d = 0.3 + (0.62 * re**0.5 * pr ** (1 / 3) / (1 + (0.4 / pr) ** (2 / 3)) ** 0.25
+                      * (1 + (re / 282000.0) ** (5 / 8)) ** 0.8)
+    else:
+        beta = 1.0 / tf if "beta" not in table else float(np.interp(tf, t, table["beta"]))
+        ra = _G * beta * (ts - ta) * d**3 / (nu * a)
+        nu_d = (0.60 + 0.387 * ra ** (1 / 6) / (1 + (0.559 / pr) ** (9 / 16)) ** (8 / 27)) ** 2
+    return float(np.pi * k * nu_d)
+
+
+def coil_heat_loss_per_length(coil_index, nylon="silver_nylon66", cooling=None):
+    """Heat loss per muscle length lambda'(C) [W/(K m)] at each coil index.
+
+    ``cooling`` None: the nylon set's own ``heat_loss_per_length`` at every C (the
+    default set's is back-calculated from the paper's operating point, docs/model.md s. 9).
+    A cooling set (name, mapping or :class:`~nylonflex.materials.Cooling`):
+    :func:`convection_loss_per_length` for the muscle's outer diameter d_f (C + 1),
+    linearised at the operating point T_s = t_max.
+
+    Parameters
+    ----------
+    coil_index : float or array
+        C [-], > 0.
+    nylon : str, dict or Nylon
+        Muscle set (``fibre_diameter``, ``t_max``, ``t_amb``, ``heat_loss_per_length``).
+    cooling : str, dict, Cooling or None
+        Cooling environment (``materials.COOLING_PARAMETERS``).
+    """
+    ny = nylon_parameters(nylon)
+    c = check("coil_index", coil_index, 0.0, lo_open=True)
+    if cooling is None:
+        return scalar_or_array(np.full(c.shape, ny.heat_loss_per_length))
+    env = cooling_parameters(cooling)
+    out = np.vectorize(lambda ci: convection_loss_per_length(
+        ny.fibre_diameter * (ci + 1.0), ny.t_max, ny.t_amb, env.fluid, env.speed),
+        otypes=[float])(c)
+    return scalar_or_array(out)
+
+
+@formula
+def _coil_resistance(r_ref, c_ref, coil_index):
+    """r'(C) = r'_ref sqrt((pi C)^2 + 1) / sqrt((pi C_r)^2 + 1) [ohm/m]; r'_ref if C_r <= 0.
+
+    Exactly r'_ref at C = C_r (x / x is 1 in floating point).
+    """
+    if c_ref <= 0.0:
+        return r_ref
+    return r_ref * (math.sqrt((math.pi * coil_index) ** 2 + 1.0)
+                    / math.sqrt((math.pi * c_ref) ** 2 + 1.0))
+
+
+def coil_resistance_per_length(coil_index, nylon="silver_nylon66"):
+    """Resistance per muscle length r'(C) of the set at each coil index [ohm/m].
+
+    The set's ``resistance_per_length`` holds at its ``resistance_coil_index`` C_r (the
+    paper's 0.15 ohm/mm at its driven actuator's C = 1.7 for the default set); at another C
+    the coil holds sqrt((pi C)^2 + 1) of thread per length (:func:`coiled_resistance_per_length`),
+    so r' scales by that ratio: 0.663 of it at C = 1.1 (99.4 ohm/m), 0.774 at 1.3, 0.887 at
+    1.5 (docs/model.md s. 9). C_r = 0: the same r' at every C.
+
+    Parameters
+    ----------
+    coil_index : float or array
+        C [-], > 0.
+    nylon : str, dict or Nylon
+        Muscle set.
+    """
+    ny = nylon_parameters(nylon)
+    c = check("coil_index", coil_index, 0.0, lo_open=True)
+    out = np.vectorize(lambda ci: _coil_resistance(ny.resistance_per_length,
+                                                   ny.resistance_coil_index, ci),
+                       otypes=[float])(c)
+    return scalar_or_array(out)
+
+
 def coiled_resistance_per_length(thread_resistance_per_length, coil_index):
     """Resistance per muscle length of a close-wound coil of a thread, r' [ohm/m].
 
     A coil of touching turns (pitch = d_f) of mean diameter C d_f holds
     sqrt((pi C)^2 + 1) of thread per length of muscle (the helix's length per turn over its
     pitch), so r' = r'_thread sqrt((pi C)^2 + 1): 3.6 times the thread's at C = 1.1, 5.4 at
-    1.7. Not used by the named sets (docs/model.md s. 9: the paper's r' is measured on its
-    muscle, the thread's is not given).
+    1.7. The named sets scale their measured r' by its ratio between coil indices
+    (:func:`coil_resistance_per_length`; docs/model.md s. 9).
 
     Parameters
     ----------
@@ -197,7 +337,15 @@ def _lengths(muscle_length):
     return check("muscle_length", muscle_length, 0.0, lo_open=True, unit="m")
 
 
-def muscle_resistance(muscle_length, nylon="silver_nylon66"):
+def _r_per_len(ny, coil_index):
+    """r' [ohm/m] of a set: at ``coil_index`` (:func:`coil_resistance_per_length`), or the
+    set's own (at its ``resistance_coil_index``) when None."""
+    if coil_index is None:
+        return ny.resistance_per_length
+    return np.asarray(coil_resistance_per_length(coil_index, ny), float)
+
+
+def muscle_resistance(muscle_length, nylon="silver_nylon66", coil_index=None):
     """Electrical resistance R = r' l_m of the muscle [ohm].
 
     Parameters
@@ -206,9 +354,11 @@ def muscle_resistance(muscle_length, nylon="silver_nylon66"):
         Length of muscle in the wrap l_m [m], > 0.
     nylon : str, dict or Nylon
         Muscle set (``resistance_per_length`` r' [ohm/m]; the paper measured 0.15 ohm/mm).
+    coil_index : float or array, optional
+        C [-]: r'(C) (:func:`coil_resistance_per_length`); None: the set's own r'.
     """
     ny = nylon_parameters(nylon)
-    return scalar_or_array(ny.resistance_per_length * _lengths(muscle_length))
+    return scalar_or_array(_r_per_len(ny, coil_index) * _lengths(muscle_length))
 
 
 def thermal_time_constant(nylon="silver_nylon66"):
@@ -217,7 +367,8 @@ def thermal_time_constant(nylon="silver_nylon66"):
     return ny.heat_capacity_per_length / ny.heat_loss_per_length
 
 
-def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66"):
+def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66",
+                     coil_index=None):
     """Right-hand side of eq. (3): dT/dt = (V^2/R - Lambda (T - T_amb)) / C [K/s].
 
     Parameters
@@ -230,6 +381,8 @@ def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66"
         Muscle length l_m [m], > 0.
     nylon : str, dict or Nylon
         Muscle set.
+    coil_index : float or array, optional
+        C [-] for r'(C); None: the set's own r'.
 
     References
     ----------
@@ -239,12 +392,12 @@ def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66"
     t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
     v = check("voltage", voltage, unit="V")
     lm = _lengths(muscle_length)
-    heat = v * v / (ny.resistance_per_length * lm)
+    heat = v * v / (_r_per_len(ny, coil_index) * lm)
     loss = ny.heat_loss_per_length * lm * (t - ny.t_amb)
     return scalar_or_array((heat - loss) / (ny.heat_capacity_per_length * lm))
 
 
-def steady_temperature(voltage, muscle_length, nylon="silver_nylon66"):
+def steady_temperature(voltage, muscle_length, nylon="silver_nylon66", coil_index=None):
     """Steady state of eq. (3), T_ss = T_amb + V^2 / (R Lambda) [K].
 
     Parameters
@@ -255,15 +408,18 @@ def steady_temperature(voltage, muscle_length, nylon="silver_nylon66"):
         Muscle length l_m [m], > 0.
     nylon : str, dict or Nylon
         Muscle set.
+    coil_index : float or array, optional
+        C [-] for r'(C); None: the set's own r'.
     """
     ny = nylon_parameters(nylon)
     v = check("voltage", voltage, unit="V")
     lm = _lengths(muscle_length)
-    return scalar_or_array(ny.t_amb + v * v / (ny.resistance_per_length * ny.heat_loss_per_length
-                                               * lm * lm))
+    return scalar_or_array(ny.t_amb + v * v / (_r_per_len(ny, coil_index)
+                                               * ny.heat_loss_per_length * lm * lm))
 
 
-def temperature_step(temperature, voltage, dt, muscle_length, nylon="silver_nylon66"):
+def temperature_step(temperature, voltage, dt, muscle_length, nylon="silver_nylon66",
+                     coil_index=None):
     """Temperature after a step dt at constant voltage, exact solution of eq. (3) [K].
 
     Parameters
@@ -278,12 +434,14 @@ def temperature_step(temperature, voltage, dt, muscle_length, nylon="silver_nylo
         Muscle length l_m [m], > 0.
     nylon : str, dict or Nylon
         Muscle set.
+    coil_index : float, optional
+        C [-] for r'(C); None: the set's own r'.
     """
     ny = nylon_parameters(nylon)
     t = check("temperature", temperature, 0.0, lo_open=True, unit="K")
     v = check("voltage", voltage, unit="V")
     h = check("dt", dt, 0.0, unit="s")
     lm = _lengths(muscle_length)
-    return scalar_or_array(_temperature_step(t, v, h, lm, ny.t_amb, ny.resistance_per_length,
+    return scalar_or_array(_temperature_step(t, v, h, lm, ny.t_amb, _r_per_len(ny, coil_index),
                                              ny.heat_capacity_per_length,
                                              ny.heat_loss_per_length))

@@ -1,0 +1,213 @@
+"""How fast a design moves (issue 29; docs/model.md s. 20): a cycle-rate map over two axes,
+cycle rate against radius per coil index (figure-12 style), and the trade-off of tip force
+against cycle rate.
+
+Each chart is ``f(ds, *, ax=None, **slice) -> matplotlib.figure.Figure``: drawn into ``ax``
+when given (its figure is returned), else into a new :class:`matplotlib.figure.Figure`
+(no pyplot state). The cube must have a supply (``cycle_rate`` is stored only then).
+Axis labels come from the registry, in display units.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import InputError
+from ..variables import AXES, to_display
+from ._common import (_COLOURS, _LENGTH_DEFAULT, _RC, _WRAP_DEFAULT, _coils, _eq, _footer,
+                      _label, _nearest)
+
+__all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate"]
+
+
+def _need_rate(ds):
+    if "cycle_rate" not in ds:
+        raise InputError("cycle_rate: the cube has none (it needs a supply: add "
+                         "'supply: {voltage: 12, units: V}' to the sweep config)")
+
+
+def _axes(ax, size):
+    """``(fig, ax)``: the given axes and their figure, or a new figure (no pyplot)."""
+    if ax is not None:
+        return ax.figure, ax
+    from matplotlib.figure import Figure
+
+    import matplotlib
+
+    with matplotlib.rc_context(_RC):
+        fig = Figure(figsize=size, layout="constrained")
+        return fig, fig.add_subplot()
+
+
+def _fixed(ds, free, **given):
+    """The grid values of every axis but ``free``: ``given`` [SI] or the defaults (length
+    nearest 90 mm, wrap angle nearest 8 deg, coil index nearest 1.7, radius 15 mm, wall
+    2 mm)."""
+    default = {"radius": 15e-3, "wall_thickness": 2e-3, "length": _LENGTH_DEFAULT,
+               "coil_index": 1.7, "wrap_angle": _WRAP_DEFAULT}
+    out = {}
+    for name in AXES:
+        if name in free:
+            continue
+        value = given.get(name)
+        if isinstance(value, (list, tuple, np.ndarray)):
+            value = value[0]
+        out[name] = _nearest(ds, name, default[name] if value is None else value)
+    return out
+
+
+def _title(ax, title, fixed):
+    ax.set_title(f"{title}\n" + ", ".join(_eq(k, v) for k, v in fixed.items()), fontsize=9)
+
+
+def cycle_rate_map(ds, *, ax=None, x="radius", y="wrap_angle", radius=None,
+                   wall_thickness=None, length=None, coil_index=None, wrap_angle=None):
+    """Cycle rate over two design axes, the others fixed.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube with a supply.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new figure.
+    x, y : str
+        The two axes of the map (names of :data:`nylonflex.variables.AXES`); default
+        radius and wrap angle (the wrap angle sets the muscle length, which sets the rate).
+    radius, wall_thickness, length, coil_index, wrap_angle : float, optional
+        The fixed axes [SI]; default nearest 15 mm, 2 mm, 90 mm, 1.7 and 8 deg.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    _need_rate(ds)
+    for name in (x, y):
+        if name not in AXES or x == y:
+            raise InputError(f"cycle_rate_map: x and y must be two of {', '.join(AXES)}, "
+                             f"got {x!r} and {y!r}")
+    fixed = _fixed(ds, (x, y), radius=radius, wall_thickness=wall_thickness, length=length,
+                   coil_index=coil_index, wrap_angle=wrap_angle)
+    cut = ds["cycle_rate"].sel(**fixed).transpose(y, x).load()
+    fig, ax = _axes(ax, (6.4, 4.6))
+    xs, ys = to_display(x, ds[x].values), to_display(y, ds[y].values)
+    rate = to_display("cycle_rate", cut.values)
+    if len(xs) > 1 and len(ys) > 1:
+        filled = ax.contourf(xs, ys, rate, levels=12, cmap="magma")
+        lines = ax.contour(xs, ys, rate, levels=filled.levels[2::3], colors="white",
+                           linewidths=0.6)
+        ax.clabel(lines, fmt="%.3g", fontsize=7.5)
+    else:
+        filled = ax.pcolormesh(xs, ys, rate, cmap="magma", shading="nearest")
+    fig.colorbar(filled, ax=ax, label=_label("cycle_rate"))
+    ax.set_xlabel(_label(x))
+    ax.set_ylabel(_label(y))
+    _title(ax, "Cycle rate: heat to 95 % of the stroke at the supply, cool to 5 %", fixed)
+    _footer(fig, ds)
+    return fig
+
+
+def cycle_rate_lines(ds, *, ax=None, wall_thickness=None, length=None, wrap_angle=None,
+                     coil_index=None):
+    """Cycle rate against radius, one line per coil index (figure-12 style).
+
+    Strength-limited designs are marked with an open circle, supply-limited ones with a
+    cross (the ``limit`` flag).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube with a supply.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new figure.
+    wall_thickness, length, wrap_angle : float, optional
+        The fixed axes [SI]; default nearest 2 mm, 90 mm and 8 deg.
+    coil_index : float or sequence of float, optional
+        Coil indices drawn [-]; default every one of the cube.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    _need_rate(ds)
+    fixed = _fixed(ds, ("radius", "coil_index"), wall_thickness=wall_thickness,
+                   length=length, wrap_angle=wrap_angle)
+    coils = _coils(ds, coil_index)
+    cut = ds[["cycle_rate", "limit"]].sel(**fixed).load()
+    fig, ax = _axes(ax, (6.4, 4.4))
+    x = to_display("radius", ds["radius"].values)
+    for i, c in enumerate(coils):
+        one = cut.sel(coil_index=c)
+        rate = to_display("cycle_rate", one["cycle_rate"].values)
+        lim = one["limit"].values
+        colour = _COLOURS[i % len(_COLOURS)]
+        ax.plot(x, rate, color=colour, label=_eq("coil_index", c))
+        for code, marker in ((1, "o"), (2, "x")):
+            hit = lim == code
+            if hit.any():
+                ax.plot(x[hit], rate[hit], ls="", marker=marker, ms=4, mfc="none",
+                        color=colour)
+    from matplotlib.lines import Line2D
+
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Line2D([], [], ls="", marker="o", mfc="none", color="0.3",
+                       label="strength-limited"),
+                Line2D([], [], ls="", marker="x", color="0.3", label="supply-limited")]
+    ax.legend(handles=handles, fontsize=8)
+    ax.set_xlabel(_label("radius"))
+    ax.set_ylabel(_label("cycle_rate"))
+    ax.set_ylim(bottom=0)
+    _title(ax, "Cycle rate against radius per coil index", fixed)
+    _footer(fig, ds)
+    return fig
+
+
+def force_rate(ds, *, ax=None, coil_index=None, length=None, wrap_angle=None):
+    """Tip force against cycle rate of every design, with the front of the largest force.
+
+    The front is the largest force among the designs at each rate or faster; ``length``
+    and ``wrap_angle`` may fix a slice.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube with a supply.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new figure.
+    coil_index : float or sequence of float, optional
+        Coil indices drawn [-], one colour each; default every one of the cube.
+    length, wrap_angle : float, optional
+        Fix these axes [SI]; default every value of the cube.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    _need_rate(ds)
+    coils = _coils(ds, coil_index)
+    sel = {k: _nearest(ds, k, v) for k, v in (("length", length), ("wrap_angle", wrap_angle))
+           if v is not None}
+    cut = ds[["cycle_rate", "tip_force_max"]].sel(coil_index=coils, **sel).load()
+    fig, ax = _axes(ax, (6.4, 4.6))
+    all_rate, all_force = [], []
+    for i, c in enumerate(coils):
+        one = cut.sel(coil_index=c)
+        rate = to_display("cycle_rate", one["cycle_rate"].values.ravel())
+        force = to_display("tip_force_max", one["tip_force_max"].values.ravel())
+        ok = np.isfinite(rate) & np.isfinite(force)
+        ax.scatter(rate[ok], force[ok], s=4, alpha=0.35, color=_COLOURS[i % len(_COLOURS)],
+                   label=_eq("coil_index", c), rasterized=True, linewidths=0)
+        all_rate.append(rate[ok])
+        all_force.append(force[ok])
+    rate, force = np.concatenate(all_rate), np.concatenate(all_force)
+    if rate.size:  # the front: the largest force among designs at least this fast
+        order = np.argsort(-rate)
+        front = np.maximum.accumulate(force[order])
+        ax.step(rate[order], front, where="post", color="k", lw=1.2,
+                label="largest force at this rate or faster")
+    ax.set_xlabel(_label("cycle_rate"))
+    ax.set_ylabel(_label("tip_force_max"))
+    ax.legend(fontsize=8, markerscale=3)
+    where = ", ".join(_eq(k, v) for k, v in sel.items()) or "every design of the cube"
+    ax.set_title(f"Tip force against cycle rate\n{where}", fontsize=9)
+    _footer(fig, ds)
+    return fig
