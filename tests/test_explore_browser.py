@@ -29,7 +29,7 @@ if not os.path.exists(CHROMIUM):
 pytestmark = pytest.mark.slow
 
 sync_api = pytest.importorskip("playwright.sync_api")
-pytest.importorskip("panel")
+pytest.importorskip("bokeh")
 
 # The page's default design: radius 15 mm, wall 2 mm, length 90 mm, C 1.7, psi 8 deg; the
 # tests move the length slider one grid step down (90 -> 70 mm) and pick bend_angle_max.
@@ -315,3 +315,30 @@ def test_offline_file_every_view_shows_one_design(cube, browser, tmp_path):
     page.goto(out.as_uri())
     _rapid(page, cube)
     context.close()
+
+
+def test_where_table_sorts_and_picks_a_design(cube, browser, tmp_path):
+    # explore --where: the matching designs in a table; a column's title sorts it, a row
+    # picks its design for every view
+    out = tmp_path / "where.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out), "--where", "tip_force_max >= 0.5 N", "--where",
+                    "wall_thickness >= 4 mm"], env=env, check=True, capture_output=True)
+    page = browser.new_page(viewport={"width": 1300, "height": 1000})
+    page.goto(out.as_uri())
+    page.wait_for_selector("#nf-readout")
+    rows = page.evaluate("() => Bokeh.documents[0].get_model_by_name('nf-where-rows')"
+                         ".data.tip_force_max")
+    assert min(rows) >= 0.5
+    page.locator(".slick-header-column", has_text="maximum tip force").click()
+    page.locator(".slick-row").first.click()
+    from nylonflex.storage import open_cube
+
+    with open_cube(cube) as ds:
+        snap = _snapshot(page)
+        ix = _check_one_design(ds, snap)
+        assert float(ds["wall_thickness"].isel(wall_thickness=ix["wall_thickness"])) >= 4e-3
+    value = float(page.locator("#nf-readout").get_attribute("data-value"))
+    assert value == pytest.approx(min(rows), rel=1e-6)  # the smallest, first once sorted

@@ -93,10 +93,13 @@ def run(args) -> int:
         return 0
 
     url = f"http://127.0.0.1:{args.port}/"
-    print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
+
+    def ready():
+        print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
+
     try:
         serve(ds, port=args.port, source=str(args.cube), where=where,
-              show=not args.no_browser)
+              show=not args.no_browser, ready=ready)
     except KeyboardInterrupt:
         pass
     return 0

@@ -328,8 +328,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         map_fig.scatter("x", "y", source=match_src, marker="circle", size=6,
                         fill_color="white", line_color="black",
                         legend_label="meets --where: " + "; ".join(p["where"]))
-        map_fig.legend.location = "bottom_right"
-        map_fig.legend.background_fill_alpha = 0.6
+        map_fig.add_layout(map_fig.legend[0], "below")  # not over the cells
     star = ColumnDataSource({"x": [], "y": [], "design": []}, name="nf-star")
     map_fig.scatter("x", "y", source=star, marker="star", size=20, fill_color="gold",
                     line_color="black")
@@ -420,7 +419,8 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         where_box = [Div(width=1250, name="nf-where-note", text=(
             f"<b>{rows['matching']:,} designs of this page meet --where "
             f"{html.escape(' and '.join(p['where']))}</b>"
-            + (f" (the first {listed:,} listed)" if listed < rows["matching"] else "")
+            + (f" (the first {listed:,} in grid order listed; sorting sorts those)"
+               if listed < rows["matching"] else "")
             + ": click a column's title to sort, a row to pick that design; the map marks "
             "the matching designs of its slice with a white dot.")), where_table]
 
@@ -464,10 +464,11 @@ def build_html(ds, *, source: str = "", where=()) -> str:
     return re.sub(r'<script[^>]*\bsrc="[^"]*"[^>]*>\s*</script>\s*', "", text)
 
 
-def serve(ds, *, port: int, source: str = "", where=(), show: bool = True):
+def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready=None):
     """Serve the page of :func:`build_document` on ``127.0.0.1:port`` until interrupted.
 
     The numbers are read from the cube once; each browser session gets its own document.
+    ``ready`` (no arguments) is called once the server listens.
     """
     from bokeh.application import Application
     from bokeh.application.handlers.function import FunctionHandler
@@ -484,6 +485,8 @@ def serve(ds, *, port: int, source: str = "", where=(), show: bool = True):
                     address="127.0.0.1",
                     allow_websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"])
     server.start()
+    if ready is not None:
+        ready()
     if show:
         server.io_loop.add_callback(server.show, "/")
     server.io_loop.start()
