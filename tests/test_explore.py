@@ -161,8 +161,8 @@ def test_one_document_for_the_served_page_and_the_file(ds):
 
     served = file_html(build_document(synthetic(ds), served=True), "inline")
     saved = build_html(synthetic(ds))
-    for text in (served, saved):
-        assert "model variant" in text and "update.js" in text  # one script draws both
+    for text in (served, saved):  # one script, update.js, draws both from one state
+        assert "model variant" in text and "const st = {v: Number(variable.value)" in text
     assert "Served page" in served and "Exported page" in saved
 
 
