@@ -78,73 +78,97 @@ def test_snap_names_the_grid_point_and_says_when_between(ds):
         explore.snap(ds, "colour", 1.0)
 
 
-def test_map_slice_is_the_cube_in_display_units(ds):
-    m = explore.map_slice(ds, "tip_force_max", "radius", "wall_thickness", AT)
-    want = ds["tip_force_max"].sel(length=AT["length"], coil_index=AT["coil_index"],
-                                   wrap_angle=AT["wrap_angle"], method="nearest")
-    np.testing.assert_allclose(m["z"], want.transpose("wall_thickness", "radius").values)
-    np.testing.assert_allclose(m["x"], ds["radius"].values * 1e3)  # mm
-    assert m["limit"].shape == m["z"].shape == m["validity"].shape  # cubes carry validity
-    b = explore.map_slice(ds, "bend_angle_max", "coil_index", "wrap_angle", AT)
-    assert b["z"].shape == (3, 2)
-    np.testing.assert_allclose(b["y"], [5, 8, 20])  # deg
-    with pytest.raises(InputError, match="two different"):
-        explore.map_slice(ds, "tip_force_max", "radius", "radius", AT)
+def _grid(p, name):
+    """A payload's array of ``name`` as the cube's grid (model first where there is one)."""
+    shape = ([len(p["models"])] if p["models"] else []) + p["sizes"]
+    return np.asarray(p["data"][p["variables"].index(name)]).reshape(shape)
 
 
-def test_design_table_and_curves_of_one_grid_design(ds):
-    rows = {r["name"]: r for r in explore.design_table(ds, AT)}
-    point = ds.sel(AT, method="nearest")
-    assert rows["tip_force_max"]["value"] == pytest.approx(float(point["tip_force_max"]))
-    assert rows["pressure_max"]["value"] == pytest.approx(float(point["pressure_max"]) / 1e3)
-    assert rows["pressure_max"]["unit"] == "kPa"
-    assert rows["bend_angle_max"]["value"] == pytest.approx(
-        math.degrees(float(point["bend_angle_max"])))
-    curves = explore.design_curves(ds, AT)
-    np.testing.assert_allclose(curves["tip_force"][1], point["tip_force"].values)
-    np.testing.assert_allclose(curves["bend_angle"][0], ds["pressure"].values / 1e3)
-    assert curves["nylon_force_limit"] == pytest.approx(float(point["nylon_force_limit"]))
+def test_the_page_carries_the_cube_in_display_units(ds):
+    from nylonflex.explore.page import build_payload
+
+    p = build_payload(ds)  # the numbers update.js draws every view from
+    assert p["sizes"] == [ds.sizes[a] for a in AXES]  # a small cube: every design
+    cube = ds.transpose(*AXES, ...)
+    np.testing.assert_allclose(_grid(p, "tip_force_max"), cube["tip_force_max"].values,
+                               rtol=1e-6)  # float32 on the page
+    np.testing.assert_allclose(_grid(p, "pressure_max"), cube["pressure_max"].values / 1e3,
+                               rtol=1e-6)  # kPa
+    np.testing.assert_allclose(_grid(p, "bend_angle_max"),
+                               np.degrees(cube["bend_angle_max"].values), rtol=1e-6)
+    bend = p["curves"]["bend_angle"]
+    assert bend["dims"] == ["radius", "wall_thickness", "length"]
+    np.testing.assert_allclose(np.asarray(bend["values"]).reshape(9, 3, 2, 9),
+                               np.degrees(ds["bend_angle"].transpose(
+                                   "radius", "wall_thickness", "length", "pressure").values),
+                               rtol=1e-6)
+    np.testing.assert_allclose(bend["x"], ds["pressure"].values / 1e3)  # kPa
+    np.testing.assert_array_equal(np.asarray(p["limit"]).reshape(p["sizes"]),
+                                  cube["limit"].values)
+    assert p["labels"]["wrap_angle"] == ["5 deg", "8 deg", "20 deg"]
 
 
-def test_fig12_lines_mark_strength_limited_designs(ds):
-    lines = explore.fig12_lines(ds, "torque_max", AT)
-    assert set(lines["lines"]) == {1.1, 1.7}
-    values, strong = lines["lines"][1.7]
-    cut = ds[["torque_max", "limit"]].sel(wall_thickness=AT["wall_thickness"],
-                                          length=AT["length"], coil_index=1.7,
-                                          wrap_angle=AT["wrap_angle"], method="nearest")
-    np.testing.assert_allclose(values, cut["torque_max"].values * 1e3)  # N mm
-    np.testing.assert_array_equal(strong, cut["limit"].values == 1)
+def test_where_marks_the_designs_the_query_finds(ds):
+    from nylonflex.explore.page import build_payload
+    from nylonflex.query import parse_where, query_cube
+
+    text = ["tip_force_max >= 0.5 N", "wall_thickness <= 4 mm"]
+    p = build_payload(ds, parse_where(text))
+    res = query_cube(ds, where=text, limit=1)
+    assert p["rows"]["matching"] == int(p["match"].sum()) == res.matched > 0
+    rows = p["rows"]["data"]
+    assert min(rows["tip_force_max"]) >= 0.5 and max(rows["wall_thickness"]) <= 4
+    assert p["rows"]["columns"][:5] == list(AXES) and "validity" in p["rows"]["columns"]
+    # each row's grid indices (what a click on the row picks) name its own design
+    i = {a: rows[f"i_{a}"][0] for a in AXES}
+    assert rows["tip_force_max"][0] == pytest.approx(
+        float(ds["tip_force_max"].isel(i)), rel=1e-6)
+    with pytest.raises(InputError, match="unknown name 'colour'"):
+        build_payload(ds, parse_where(["colour > 1"]))
+
+
+def test_cli_where_is_parsed_by_the_query_parser(cube, tmp_path, capsys):
+    out = tmp_path / "page.html"
+    assert main(["explore", str(cube), "--html", str(out), "--where", "tip_force_max >= x"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--where" in err and not out.exists()
+    assert main(["explore", str(cube), "--html", str(out), "--where",
+                 "tip_force_max >= 0.5 N"]) == 0
+    assert "designs of this page meet --where tip_force_max" in out.read_text()
 
 
 def test_model_dimension_and_validity_flags_are_handled(ds):
+    from nylonflex.explore.page import build_payload
+
     syn = synthetic(ds)
     assert explore.flag_meanings(syn)[0] == (1, "self_contact")
-    at = {**AT, "model": "coupled_muscle"}
-    m = explore.map_slice(syn, "tip_force_max", "radius", "wall_thickness", at)
-    base = explore.map_slice(ds, "tip_force_max", "radius", "wall_thickness", AT)
-    np.testing.assert_allclose(m["z"], 2 * base["z"])
-    assert m["validity"][0].tolist() == [4] * 7 + [5] * 2  # wall 2 mm; radius > 20 mm
-    rows = {r["name"]: r["value"] for r in explore.design_table(syn, at)}
-    assert rows["tip_force_max"] == pytest.approx(
-        2 * float(ds["tip_force_max"].sel(AT, method="nearest")))
-    with pytest.raises(InputError, match="model: 'nope'"):
-        explore.design_table(syn, {**AT, "model": "nope"})
+    p, base = build_payload(syn), build_payload(ds)
+    assert p["models"] == ["paper", "coupled_muscle"]
+    np.testing.assert_allclose(_grid(p, "tip_force_max")[1], 2 * _grid(base, "tip_force_max"))
+    v = np.asarray(p["validity"]).reshape(2, *p["sizes"])
+    assert v[0, :, 0, 0, 0, 0].tolist() == [4] * 7 + [5] * 2  # wall 2 mm; radius > 20 mm
+    assert np.asarray(p["curves"]["tip_force"]["values"]).size == 2 * base["curves"][
+        "tip_force"]["values"].size  # curves without a model dimension repeat per model
+    with pytest.raises(InputError, match="model == nope"):
+        build_payload(syn, ["model == nope"])
 
 
-def test_served_page_builds_with_model_and_flags(ds):
-    pytest.importorskip("panel")
-    from nylonflex.explore_page import build_page
+def test_one_document_for_the_served_page_and_the_file(ds):
+    pytest.importorskip("bokeh")
+    from bokeh.embed import file_html
 
-    page, states = build_page(synthetic(ds))
-    assert states == {}
-    text = str(page)
-    assert "model variant" in text
+    from nylonflex.explore.page import build_document, build_html
+
+    served = file_html(build_document(synthetic(ds), served=True), "inline")
+    saved = build_html(synthetic(ds))
+    for text in (served, saved):  # one script, update.js, draws both from one state
+        assert "model variant" in text and "const st = {v: Number(variable.value)" in text
+    assert "Served page" in served and "Exported page" in saved
 
 
 def test_html_is_offline_and_holds_the_cube(ds, tmp_path):
     pytest.importorskip("bokeh")
-    from nylonflex.explore_html import build_html
+    from nylonflex.explore.page import build_html
 
     text = build_html(synthetic(ds), source="cube.h5")
     assert not re.search(r"<script[^>]+src=|<link[^>]+href=\"?https?:", text)
@@ -152,10 +176,10 @@ def test_html_is_offline_and_holds_the_cube(ds, tmp_path):
 
 
 def test_html_subset_is_bounded(ds, monkeypatch):
-    from nylonflex import explore_html
+    from nylonflex.explore import page
 
-    monkeypatch.setattr(explore_html, "MAX_DESIGNS", 100)
-    keep = explore_html._subset(ds)
+    monkeypatch.setattr(page, "MAX_DESIGNS", 100)
+    keep = page._subset(ds)
     assert math.prod(len(v) for v in keep.values()) <= 100
     assert all(len(keep[a]) >= 1 for a in AXES) and len(keep["radius"]) >= 3
 
@@ -194,32 +218,17 @@ def test_cli_refuses_a_port_in_use(cube, capsys):
 
 
 # ---------------------------------------------------------------------------- issue 25
-def test_validity_by_flag_name_in_the_served_readout(ds):
-    pytest.importorskip("panel")
-    from nylonflex.explore_page import _readout_html
-
+def test_validity_by_flag_name(ds):
+    # the page names the flags the same way (update.js's flagtext; the browser test)
     syn = synthetic(ds)  # bits: 1 where radius > 20 mm, 4 where wall < 3 mm
     assert explore.validity_names(syn, 5) == "self contact, under one turn"
     assert explore.validity_names(syn, 0) == "valid"
     assert explore.validity_names(syn, float("nan")) == "unknown"
-    text = _readout_html(syn, "tip_force_max", {**AT, "model": "paper"}, [])
-    assert 'id="nf-validity" data-value="4"' in text and "under one turn" in text
-    clean = _readout_html(syn, "tip_force_max", {**AT, "wall_thickness": 4e-3,
-                                                 "model": "paper"}, [])
-    assert "validity: <b>valid</b>" in clean
-
-
-def test_colour_scale_is_set_by_the_clean_designs():
-    z = np.array([[1.0, 2.0, 50.0], [3.0, np.nan, 4.0]])
-    bits = np.array([[0, 0, 1], [0, 0, 0]])
-    assert explore.colour_range(z, bits) == (1.0, 4.0)  # the flagged 50 does not set it
-    assert explore.colour_range(z) == (1.0, 50.0)
-    assert explore.colour_range(z, np.ones_like(bits)) == (1.0, 50.0)  # none clean: all
 
 
 def test_offline_file_names_its_hover_colour_bar_and_validity(ds):
     pytest.importorskip("bokeh")
-    from nylonflex.explore_html import build_html
+    from nylonflex.explore.page import build_html
 
     text = build_html(synthetic(ds), source="cube.h5")
     # the hover names the variable (it said "value", and "???" over the star marker)
@@ -254,12 +263,9 @@ def test_copy_as_config_sweeps_to_the_selected_designs_values(ds):
     assert "values: ['@radius@']" in explore.design_config(ds, at, placeholders=True)
 
 
-def test_both_pages_offer_the_config(ds):
+def test_the_page_offers_the_config(ds):
     pytest.importorskip("bokeh")
-    pytest.importorskip("panel")
-    from nylonflex.explore_html import build_html
-    from nylonflex.explore_page import _readout_html
+    from nylonflex.explore.page import build_html
 
-    assert 'id="nf-config"' in _readout_html(ds, "tip_force_max", AT, [])
     text = build_html(ds, source="cube.h5")
     assert "copy as config" in text and "@radius@" in text

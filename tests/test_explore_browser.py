@@ -29,7 +29,7 @@ if not os.path.exists(CHROMIUM):
 pytestmark = pytest.mark.slow
 
 sync_api = pytest.importorskip("playwright.sync_api")
-pytest.importorskip("panel")
+pytest.importorskip("bokeh")
 
 # The page's default design: radius 15 mm, wall 2 mm, length 90 mm, C 1.7, psi 8 deg; the
 # tests move the length slider one grid step down (90 -> 70 mm) and pick bend_angle_max.
@@ -197,3 +197,148 @@ def test_exported_map_click_picks_the_nearest_grid_point(cube, browser, tmp_path
     page.goto(out.as_uri())
     page.wait_for_selector("#nf-readout")
     _click_map_and_check(page, cube)
+
+
+# ---------------------------------------------------------------------------- issue 25
+# Every view of the selected design is drawn from one state: after each of 20 rapid map
+# clicks, slider drags and bursts of key presses, the read-out, the map's marker and every
+# curve show the same design, and each shows the cube's own numbers for it (ds.isel, read
+# here, not by the page). A key press is never lost: a burst of k presses moves a slider k
+# grid steps (up to its end).
+_SNAPSHOT = """() => {
+  const doc = Bokeh.documents[0], get = (n) => doc.get_model_by_name(n);
+  const out = {readout: get("nf-readout").text, star: get("nf-star").data, curves: {},
+               sliders: {}};
+  for (const n of ["nylon_force", "bend_angle", "tip_force"]) {
+    const m = get("nf-curve-" + n);
+    if (m) out.curves[n] = {y: Array.from(m.data.y), design: Array.from(m.data.design)};
+  }
+  for (const a of AXES) out.sliders[a] = get("nf-slider-" + a).value;
+  out.star = {x: Array.from(out.star.x), y: Array.from(out.star.y),
+              design: Array.from(out.star.design)};
+  return out;
+}"""
+AXES_JS = "const AXES = ['radius', 'wall_thickness', 'length', 'coil_index', 'wrap_angle'];"
+
+
+def _snapshot(page):
+    return page.evaluate("() => { " + AXES_JS + " return (" + _SNAPSHOT + ")(); }")
+
+
+def _check_one_design(ds, snap, variable="tip_force_max"):
+    """The views of one snapshot agree with each other and with the cube."""
+    import re
+
+    import numpy as np
+
+    from nylonflex.explore import validity_names
+    from nylonflex.variables import AXES, to_display
+
+    design = re.search(r'data-design="([\d,]+)"', snap["readout"])[1]
+    ix = dict(zip(AXES, map(int, design.split(","))))
+    assert ix == {a: round(v) for a, v in snap["sliders"].items()}, (ix, snap["sliders"])
+    assert snap["star"]["design"] == [design], (design, snap["star"])
+    point = ds.isel(ix)
+    assert snap["star"]["x"][0] == pytest.approx(float(point["radius"]) * 1e3, rel=1e-6)
+    assert snap["star"]["y"][0] == pytest.approx(float(point["wall_thickness"]) * 1e3,
+                                                 rel=1e-6)
+    for name, curve in snap["curves"].items():
+        assert set(curve["design"]) == {design}, name
+        want = to_display(name, point[name].values.astype(float))
+        np.testing.assert_allclose(curve["y"], want, rtol=1e-6, err_msg=name)
+    value = float(re.search(r'data-value="([^"]+)"', snap["readout"])[1])
+    assert value == pytest.approx(float(to_display(variable, float(point[variable]))),
+                                  rel=1e-6)
+    bits = float(point["validity"])
+    assert f'id="nf-validity" data-value="{bits:g}"' in snap["readout"]
+    assert f"validity: <b>{validity_names(ds, bits)}</b>" in snap["readout"]
+    return ix
+
+
+def _rapid(page, cube):
+    """20 actions as fast as the browser takes them, each checked at once."""
+    import random
+
+    from nylonflex.storage import open_cube
+
+    page.wait_for_selector("#nf-readout", timeout=60_000)
+    rng = random.Random(25)
+    handles = page.locator(".noUi-handle")
+    box = page.locator("canvas").first.bounding_box()
+    with open_cube(cube) as ds:
+        ix = _check_one_design(ds, _snapshot(page))
+        for k in range(20):
+            kind = k % 3
+            if kind == 0:  # a click somewhere on the map
+                page.mouse.click(box["x"] + rng.uniform(0.1, 0.8) * box["width"],
+                                 box["y"] + rng.uniform(0.1, 0.85) * box["height"])
+                ix = _check_one_design(ds, _snapshot(page))
+            elif kind == 1:  # a burst of key presses on one slider, none lost
+                j = rng.randrange(5)
+                axis = list(ix)[j]
+                key, step = rng.choice((("ArrowRight", 1), ("ArrowLeft", -1)))
+                presses = rng.randint(2, 4)
+                handles.nth(j).focus()
+                for _ in range(presses):
+                    page.keyboard.press(key)
+                new = _check_one_design(ds, _snapshot(page))
+                end = ds.sizes[axis] - 1
+                assert new[axis] == min(end, max(0, ix[axis] + step * presses)), \
+                    (axis, key, presses, ix[axis], new[axis])
+                ix = new
+            else:  # a drag of a slider's handle to somewhere along its track
+                j = rng.randrange(5)
+                h = handles.nth(j).bounding_box()
+                track = page.locator(".noUi-target").nth(j).bounding_box()
+                page.mouse.move(h["x"] + h["width"] / 2, h["y"] + h["height"] / 2)
+                page.mouse.down()
+                page.mouse.move(track["x"] + rng.uniform(0, 1) * track["width"],
+                                h["y"] + h["height"] / 2, steps=4)
+                page.mouse.up()
+                ix = _check_one_design(ds, _snapshot(page))
+
+
+def test_served_page_every_view_shows_one_design(cube, browser, tmp_path):
+    with _serve_page(cube, browser) as page:
+        _rapid(page, cube)
+        page.screenshot(path=str(tmp_path / "served_rapid.png"), full_page=True)
+
+
+def test_offline_file_every_view_shows_one_design(cube, browser, tmp_path):
+    out = tmp_path / "fig12.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out)], env=env, check=True, capture_output=True)
+    context = browser.new_context(offline=True, viewport={"width": 1300, "height": 1000})
+    page = context.new_page()
+    page.goto(out.as_uri())
+    _rapid(page, cube)
+    context.close()
+
+
+def test_where_table_sorts_and_picks_a_design(cube, browser, tmp_path):
+    # explore --where: the matching designs in a table; a column's title sorts it, a row
+    # picks its design for every view
+    out = tmp_path / "where.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out), "--where", "tip_force_max >= 0.5 N", "--where",
+                    "wall_thickness >= 4 mm"], env=env, check=True, capture_output=True)
+    page = browser.new_page(viewport={"width": 1300, "height": 1000})
+    page.goto(out.as_uri())
+    page.wait_for_selector("#nf-readout")
+    rows = page.evaluate("() => Bokeh.documents[0].get_model_by_name('nf-where-rows')"
+                         ".data.tip_force_max")
+    assert min(rows) >= 0.5
+    page.locator(".slick-header-column", has_text="maximum tip force").click()
+    page.locator(".slick-row").first.click()
+    from nylonflex.storage import open_cube
+
+    with open_cube(cube) as ds:
+        snap = _snapshot(page)
+        ix = _check_one_design(ds, snap)
+        assert float(ds["wall_thickness"].isel(wall_thickness=ix["wall_thickness"])) >= 4e-3
+    value = float(page.locator("#nf-readout").get_attribute("data-value"))
+    assert value == pytest.approx(min(rows), rel=1e-6)  # the smallest, first once sorted

@@ -425,14 +425,77 @@ def test_default_table_shows_axes_asked_and_headline_in_120_columns(cube, capsys
     assert out.splitlines()[0].split()[5:7] == ["tip_force_max", "nylon_use"]
 
 
+def _header_names(out, n):
+    """The column names of a table of ``n`` rows, its header lines joined again (names
+    broken after an underscore over lines; blocks of columns, each with a '#' line)."""
+    lines = [x for x in out.splitlines() if "designs shown" not in x and
+             not x.startswith("at ")]
+    heads = []
+    if any(x.split()[:1] == ["#"] for x in lines):
+        start = 0
+        while start < len(lines):
+            i = next(k for k in range(start, len(lines)) if lines[k].split()[:1] == ["#"])
+            heads.append(lines[start:i + 1])
+            start = i + 2 + n + 1  # the unit line, the rows, a blank line
+    else:
+        heads.append(lines[:len(lines) - n - 1])
+    names = []
+    for head in heads:
+        width = max(map(len, head))
+        used = [any(len(h) > k and h[k] != " " for h in head) for k in range(width)]
+        k = 0
+        while k < width:
+            e = k
+            while e < width and used[e]:
+                e += 1
+            if e > k:
+                names.append("".join(h[k:e].strip() for h in head))
+            k = e + 1
+    return [x for x in names if x != "#"]
+
+
+TWO_FLAGS = {  # a 1 mm wall, 120 mm long: self contact and stretch beyond the fit (fig12)
+    "name": "two_flags",
+    "grid": {"radius": {"values": [15.5, 16], "units": "mm"},
+             "wall_thickness": {"values": [1], "units": "mm"},
+             "length": {"values": [120], "units": "mm"},
+             "coil_index": {"values": [1.7]},
+             "wrap_angle": {"values": [5, 8], "units": "deg"}},
+    "curves": SMALL["curves"],
+}
+
+
+def test_every_table_fits_in_120_columns(tmp_path, capsys):
+    # issue 25: --where ... --sort on the fig12 cube's designs with two validity flags
+    # printed 126 columns; now long names break after an underscore, and a table that is
+    # still too wide goes in blocks of columns, each led by the row number
+    two = write_cube(tmp_path, TWO_FLAGS)
+    for extra in ([], ["--sort=-bend_angle_max"], ["--columns", "all"]):
+        rc, out, _ = run(capsys, two, "--where", SLIM, "--limit", "5", *extra)
+        assert rc == 0 and "self_contact+stretch_beyond_fit" in out
+        assert max(map(len, out.splitlines())) <= 120, out
+    assert _header_names(out, 4) == list(query.shown_columns(
+        query.query_cube(open_cube(two), where=[SLIM], columns="all"), "table"))
+    # every flag set and every column: blocks, each line within 120 columns
+    from nylonflex.query.format import _columns_text
+
+    heads = [*query.COLUMNS]
+    cells = [[query.flag_names(15) if h == "validity" else "123.456" for h in heads]] * 3
+    lines = _columns_text(heads, cells)
+    assert max(map(len, lines)) <= 120 and sum(line.lstrip().startswith("#")
+                                               for line in lines) >= 2
+    assert _header_names("\n".join(lines), 3) == heads
+
+
 def test_columns_option_picks_and_refuses(cube, capsys):
     rc, out, _ = run(capsys, cube, "--where", SLIM, "--limit", "2",
                      "--columns", "radius,validity,heating_time")
     assert rc == 0 and out.splitlines()[0].split() == ["radius", "validity", "heating_time"]
     assert out.splitlines()[2].split()[2] == "nan"  # named: kept although all NaN
     rc, out, _ = run(capsys, cube, "--limit", "1", "--columns", "all")
-    assert "heating_time" not in out.splitlines()[0]  # no supply: no value in any row
-    assert "usable_stroke" in out.splitlines()[0]
+    names = _header_names(out, 1)  # 17 columns: wrapped to fit in 120 columns
+    assert "heating_time" not in names  # no supply: no value in any row
+    assert "usable_stroke" in names and max(map(len, out.splitlines())) <= 120
     rc, out, _ = run(capsys, cube, "--limit", "2", "--format", "csv", "--columns",
                      "radius,limit")
     assert rc == 0 and out.splitlines()[0] == "radius [m],limit [1]"

@@ -9,10 +9,13 @@ DESCRIPTION = """\
 Serve a page on http://127.0.0.1:PORT with a variable selector, a slider per axis, a design
 map (strength-limited and flagged designs marked), figure 12 style lines and, for the picked
 design, every design variable and its curves. Sliders snap to grid values; nothing is
-interpolated. With --html, write one self-contained file that works offline instead.
+interpolated. With --html, write one self-contained file that works offline instead: the
+same page, drawn by the same code. --where marks the matching designs on the map and lists
+them in a table (sort by a column's title, pick a design by its row).
 
   nylonflex explore sweeps/fig12/cube.h5
   nylonflex explore sweeps/fig12/cube.h5 --html fig12.html
+  nylonflex explore sweeps/fig12/cube.h5 --where "tip_force_max >= 0.5 N"
 """
 
 
@@ -22,6 +25,10 @@ def add_arguments(p):
     p.add_argument("--html", metavar="OUT.html", help="write one offline HTML file and exit")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --html file")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.add_argument("--where", action="append", default=[], metavar="EXPR",
+                   help="mark the designs that meet EXPR (as query --where, e.g. "
+                        "\"tip_force_max >= 0.5 N\"; repeat to AND) and list them in a "
+                        "sortable table")
 
 
 _NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explore]'"
@@ -68,35 +75,31 @@ def run(args) -> int:
         raise InputError(f"--port {args.port}: already in use on 127.0.0.1; choose another "
                          "with --port N")
 
-    ds = open_cube_for("explore", args.cube)
-    if args.html:
-        if not _has("bokeh"):
-            print(_NEEDS_EXTRA.format(what="the offline file needs Bokeh"), file=sys.stderr)
-            return 1
-        from ..explore_html import build_html
+    from ..query import parse_where
 
+    where = parse_where(args.where)  # the query's own parser: bad input before any work
+    ds = open_cube_for("explore", args.cube)
+    if not _has("bokeh"):
+        print(_NEEDS_EXTRA.format(what="the explorer needs Bokeh"), file=sys.stderr)
+        return 1
+    from ..explore.page import build_html, serve
+
+    if args.html:
         from ..files import write_atomic
 
-        text = build_html(ds, source=str(args.cube))
+        text = build_html(ds, source=str(args.cube), where=where)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
 
-    if not (_has("panel") and _has("holoviews")):
-        print(_NEEDS_EXTRA.format(what="the explorer needs Panel and HoloViews"),
-              file=sys.stderr)
-        return 1
-    import panel as pn
-
-    from ..explore_page import build_page
-
-    def page():
-        return build_page(ds, source=str(args.cube))[0]
-
     url = f"http://127.0.0.1:{args.port}/"
-    print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
-    pn.serve({"/": page}, port=args.port, address="127.0.0.1", show=not args.no_browser,
-             websocket_origin=[f"127.0.0.1:{args.port}", f"localhost:{args.port}"],
-             title=f"nylonflex explorer: {ds.attrs.get('name', '')}", print_url=False)
-    return 0
 
+    def ready():
+        print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
+
+    try:
+        serve(ds, port=args.port, source=str(args.cube), where=where,
+              show=not args.no_browser, ready=ready)
+    except KeyboardInterrupt:
+        pass
+    return 0

@@ -147,19 +147,80 @@ def format_table(res) -> str:
     if res.at:
         print(f"at {_describe_at(res)}", file=out)
     heads = list(shown_columns(res, "table"))
-    units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
     cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
-    widths = [max(len(h), len(u), *(len(r[j]) for r in cells)) for j, (h, u) in
-              enumerate(zip(heads, units))] if cells else [max(len(h), len(u)) for h, u in
-                                                          zip(heads, units)]
-    # names to the left (the model column), numbers to the right
-    just = [str.ljust if h == "model" else str.rjust for h in heads]
-    print("  ".join(j(h, w) for h, w, j in zip(heads, widths, just)), file=out)
-    print("  ".join(j(u, w) for u, w, j in zip(units, widths, just)), file=out)
-    for r in cells:
-        print("  ".join(j(c, w) for c, w, j in zip(r, widths, just)), file=out)
+    for line in _columns_text(heads, cells):
+        print(line, file=out)
     print(rows_note(res), file=out)
     return out.getvalue()
+
+
+#: The widest line a query table prints [characters].
+WIDTH = 120
+
+
+def _name_lines(name, width) -> list[str]:
+    """``name`` over as few lines as fit in ``width``, broken after its underscores
+    (``"wall_"``, ``"thickness"``); a word longer than ``width`` keeps its line."""
+    pieces = [w + "_" for w in name.split("_")[:-1]] + [name.split("_")[-1]]
+    lines = [pieces[0]]
+    for piece in pieces[1:]:
+        if len(lines[-1]) + len(piece) <= width:
+            lines[-1] += piece
+        else:
+            lines.append(piece)
+    return lines
+
+
+def _columns_text(heads, cells, width=WIDTH) -> list[str]:
+    """The lines of a table of ``cells`` under ``heads`` (a unit line below the names), at
+    most ``width`` wide where it can be: first in one line per name; else with long names
+    broken after their underscores over a few header lines; else in blocks of columns, each
+    led by a row number ``#``."""
+    units = [("[" + _unit(h) + "]") if _unit(h) != "1" else "" for h in heads]
+    body = [max([len(u), *(len(r[j]) for r in cells)]) for j, u in enumerate(units)]
+
+    def render(cols, names):
+        widths = [max(body[j], *(len(x) for x in names[j])) for j in cols]
+        # names to the left (the model column), numbers to the right
+        just = [str.ljust if heads[j] == "model" else str.rjust for j in cols]
+        depth = max(len(names[j]) for j in cols)
+        head = [[""] * (depth - len(names[j])) + names[j] for j in cols]
+        lines = ["  ".join(jf(h[k], w) for h, w, jf in zip(head, widths, just)).rstrip()
+                 for k in range(depth)]
+        lines.append("  ".join(jf(units[j], w) for j, w, jf in zip(cols, widths, just)))
+        lines += ["  ".join(jf(r[j], w) for j, w, jf in zip(cols, widths, just))
+                  for r in cells]
+        return lines
+
+    every = list(range(len(heads)))
+    lines = render(every, [[h] for h in heads])
+    if max(map(len, lines)) <= width:
+        return lines
+    names = [_name_lines(h, max(body[j], 1)) for j, h in enumerate(heads)]
+    lines = render(every, names)
+    if max(map(len, lines)) <= width:
+        return lines
+    # blocks of columns: each starts with the row number, then as many columns as fit
+    number = [str(i + 1) for i in range(len(cells))]
+    lead = max([1, *map(len, number)])
+    blocks, current, used = [], [], lead
+    for j in every:
+        w = max(body[j], *(len(x) for x in names[j]))
+        if current and used + 2 + w > width:
+            blocks.append(current)
+            current, used = [], lead
+        current.append(j)
+        used += 2 + w
+    blocks.append(current)
+    out = []
+    for b, cols in enumerate(blocks):
+        part = render(cols, names)
+        depth = len(part) - len(cells)
+        tags = [""] * (depth - 2) + ["#", ""] + number
+        if b:
+            out.append("")
+        out += [(t.rjust(lead) + "  " + line).rstrip() for t, line in zip(tags, part)]
+    return out
 
 
 def held_back(res) -> int:

@@ -1,34 +1,26 @@
-"""The explorer's data: the slices of a cube each view of ``nylonflex explore`` shows.
+"""The explorer's data: what ``nylonflex explore`` says about a cube besides its numbers.
 
-Every function reads only the slice it needs from a lazily opened cube
-(``ds[name].isel(...).values``), so a cube of tens of millions of designs opens in seconds
-and memory stays bounded by the views, not by the cube. Values are never interpolated: a
-design is always a grid point of the cube (:func:`snap` says which and whether a requested
-value fell between grid points). Numbers come back in display units (mm, deg, kPa, N) with
-their labels from the variable registry; a variable the registry does not know keeps the
-units the cube gives it.
+Labels and display units (from the variable registry; a variable the registry does not know
+keeps the units the cube gives it), the design variables, ``validity`` by flag name, the
+note on stand-in materials, the grid point nearest a value (:func:`snap`; the explorer never
+interpolates) and "copy as config". The views themselves are drawn in the browser by
+``update.js`` from the numbers :func:`nylonflex.explore.page.build_payload` puts in a page.
 
-The page itself (Panel, HoloViews) is built by :func:`nylonflex.explore_page.build_page`.
+The page itself is built by :func:`nylonflex.explore.page.build_document`.
 """
 
 from __future__ import annotations
 
-import weakref
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
-from .units import InputError
-from .variables import AXES, VARIABLES, to_display
+from ..units import InputError
+from ..variables import AXES, VARIABLES, to_display
 
-__all__ = ["Snapped", "axis_text", "design_curves", "design_table", "design_variables",
-           "colour_range", "design_config", "display_unit", "fig12_lines", "flag_meanings", "label",
-           "map_slice", "snap", "stand_in_note", "validity_names",
-           "to_display_any"]
-
-#: Curves of a design and the coordinate each is drawn against.
-CURVE_AXES = {"nylon_force": "stroke", "bend_angle": "pressure", "tip_force": "pressure"}
+__all__ = ["Snapped", "axis_text", "design_config", "design_variables", "display_unit",
+           "flag_meanings", "label", "snap", "stand_in_note", "to_display_any",
+           "validity_names"]
 
 
 # ---------------------------------------------------------------------------- units, labels
@@ -125,21 +117,6 @@ def stand_in_note(ds) -> str:
             "measurements.")
 
 
-def colour_range(z, validity=None) -> tuple[float, float]:
-    """``(lo, hi)`` of a map's colour scale: the finite values of the clean designs
-    (``validity`` 0), so that flagged ones (a 1 mm wall bending 1,300 deg) do not set it;
-    every finite value where no design is clean."""
-    z = np.asarray(z, float)
-    ok = np.isfinite(z)
-    if validity is not None:
-        clean = ok & (np.nan_to_num(np.asarray(validity, float), nan=1.0) == 0)
-        ok = clean if clean.any() else ok
-    if not ok.any():
-        return 0.0, 1.0
-    lo, hi = float(z[ok].min()), float(z[ok].max())
-    return (lo, hi) if hi > lo else (lo, lo + 1.0)
-
-
 def _curve_axis(name, si) -> dict:
     """A curve axis of a config in display units: start/stop/num when evenly spaced."""
     v = np.asarray(to_display(name, np.asarray(si, float)), float)
@@ -160,7 +137,7 @@ def design_config(ds, at: dict, placeholders: bool = False) -> str:
     value is ``'@AXIS@'``, for a page to fill in."""
     import yaml
 
-    from .materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
+    from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
 
     cfg = yaml.safe_load(str(ds.attrs.get("config_yaml", ""))) or {}
     out = {"name": f"{cfg.get('name', 'design')}_design"}
@@ -230,152 +207,3 @@ def snap(ds, axis: str, value: float) -> Snapped:
     span = float(np.ptp(grid)) or 1.0
     return Snapped(axis, i, float(grid[i]), float(value),
                    bool(abs(grid[i] - value) <= 1e-9 * span))
-
-
-def _index(ds, at: dict) -> dict:
-    """Positional indexers of ``at`` (axis -> SI value or, for ``model``, a name)."""
-    out = {}
-    for name, value in at.items():
-        if name not in ds.dims:
-            continue
-        if ds[name].dtype.kind in "OUS":
-            names = [str(v) for v in ds[name].values]
-            if str(value) not in names:
-                raise InputError(f"{name}: {value!r} is not in this cube; accepted: "
-                                 f"{', '.join(names)}")
-            out[name] = names.index(str(value))
-        else:
-            out[name] = snap(ds, name, float(value)).index
-    return out
-
-
-def _read(ds, name: str, at: dict):
-    """``ds[name]`` at the grid point(s) of ``at`` (its dims only), read from disk."""
-    da = ds[name]
-    return da.isel({k: v for k, v in _index(ds, at).items() if k in da.dims})
-
-
-# A radius-chunked cube decompresses every chunk of a variable for a slice across radii
-# (0.5 s for 20 million designs), so the map and the figure 12 lines share one block per
-# variable read at the held length and wrap angle: moving the radius, wall or coil index
-# sliders then reads nothing. Bounded: a few blocks, each at most _BLOCK_BYTES.
-_FREE = ("radius", "wall_thickness", "coil_index")
-_BLOCK_BYTES = 32 * 2**20
-_BLOCKS: OrderedDict = OrderedDict()
-
-
-def _block(ds, name: str, at: dict, free: tuple):
-    """``ds[name]`` with every dim outside ``free`` held at ``at``, as a DataArray in
-    memory (cached, least recently used first out)."""
-    da = ds[name]
-    held = {k: v for k, v in _index(ds, at).items() if k in da.dims and k not in free}
-    key = (id(ds), name, tuple(sorted(held.items())), free)
-    hit = _BLOCKS.get(key)
-    if hit is not None and hit[0]() is ds:  # the same Dataset, not one reusing its id
-        _BLOCKS.move_to_end(key)
-        return hit[1]
-    block = da.isel(held)
-    if block.size * block.dtype.itemsize > _BLOCK_BYTES:
-        return block
-    block = block.load()
-    _BLOCKS[key] = (weakref.ref(ds), block)
-    while len(_BLOCKS) > 8:
-        _BLOCKS.popitem(last=False)
-    return block
-
-
-# ---------------------------------------------------------------------------- views
-def map_slice(ds, var: str, x: str, y: str, at: dict) -> dict:
-    """``var`` over axes ``x`` and ``y`` with every other axis held at ``at``.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A nylonflex cube.
-    var : str
-        A design variable.
-    x, y : str
-        Two different design axes.
-    at : dict
-        The other axes' values [SI] (snapped to the grid), and ``model`` where the cube has
-        that dimension.
-
-    Returns
-    -------
-    dict
-        ``x``, ``y`` (grid values in display units), ``z`` (shape (ny, nx), display units),
-        ``limit`` (1 where strength-limited, shape (ny, nx), or None) and ``validity``
-        (flag bits, or None).
-    """
-    if x == y or x not in AXES or y not in AXES:
-        raise InputError(f"map axes: two different names of {', '.join(AXES)}; "
-                         f"got {x!r} and {y!r}")
-    rest = {k: v for k, v in at.items() if k not in (x, y)}
-
-    free = tuple(dict.fromkeys((*_FREE, x, y)))
-
-    def plane(name):
-        block = _block(ds, name, rest, free)
-        return block.isel({k: v for k, v in _index(ds, rest).items()
-                           if k in block.dims}).transpose(y, x).values
-
-    out = {"x": to_display_any(ds, x, ds[x].values), "y": to_display_any(ds, y, ds[y].values),
-           "z": to_display_any(ds, var, plane(var).astype(float)),
-           "limit": plane("limit") if "limit" in ds else None,
-           "validity": plane("validity") if "validity" in ds else None}
-    return out
-
-
-def design_table(ds, at: dict) -> list[dict]:
-    """Every design variable of one design: name, label, value (display units), unit, SI."""
-    rows = []
-    point = ds[design_variables(ds)].isel(_index(ds, at)).load()
-    for name in design_variables(ds):
-        si = float(point[name].values)
-        rows.append({"name": name, "label": label(ds, name),
-                     "value": float(to_display_any(ds, name, si)),
-                     "unit": display_unit(ds, name), "si": si})
-    return rows
-
-
-def design_curves(ds, at: dict) -> dict:
-    """The curves of one design: ``{name: (x display, y display)}``, plus the nylon limit.
-
-    ``nylon_force_limit`` comes back as a float [N] (the design's coil index) where the cube
-    has it.
-    """
-    out = {}
-    for name, axis in CURVE_AXES.items():
-        if name in ds:
-            y = _read(ds, name, at).values.astype(float)
-            out[name] = (to_display_any(ds, axis, ds[axis].values),
-                         to_display_any(ds, name, y))
-    if "nylon_force_limit" in ds:
-        out["nylon_force_limit"] = float(to_display_any(
-            ds, "nylon_force_limit", _read(ds, "nylon_force_limit", at).values))
-    return out
-
-
-def fig12_lines(ds, var: str, at: dict) -> dict:
-    """Figure 12 style: ``var`` against radius, one line per coil index.
-
-    Every other axis is held at ``at``. Returns ``{"radius": x, "lines": {coil_index:
-    (values, strength_limited)}}`` in display units; ``strength_limited`` is a bool array
-    (the paper draws a design solid while it is stroke-limited).
-    """
-    rest = {k: v for k, v in at.items() if k not in ("radius", "coil_index")}
-    idx = _index(ds, rest)
-
-    def cut(name):
-        block = _block(ds, name, rest, _FREE)
-        return block.isel({k: v for k, v in idx.items() if k in block.dims})
-
-    value_cut = cut(var)
-    limit_cut = cut("limit") if "limit" in ds else None
-    lines = {}
-    for k, c in enumerate(ds["coil_index"].values):
-        values = value_cut.isel(coil_index=k).transpose("radius").values.astype(float)
-        lim = limit_cut.isel(coil_index=k).transpose("radius").values == 1 \
-            if limit_cut is not None else np.zeros(values.shape, bool)
-        lines[float(c)] = (to_display_any(ds, var, values), lim)
-    return {"radius": to_display_any(ds, "radius", ds["radius"].values), "lines": lines}

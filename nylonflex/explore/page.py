@@ -1,0 +1,492 @@
+"""The explorer page: one Bokeh document, served by ``nylonflex explore`` or saved offline.
+
+One code path builds both forms (issue 28): :func:`build_document` makes the document, with
+the cube's numbers inside (at most :data:`MAX_DESIGNS` designs, chosen axis by axis; all of
+a small cube) as typed arrays, and every view is redrawn in the browser by one script,
+``update.js``, from one state (the variable, the model, the map's axes and a grid index per
+axis). :func:`build_html` writes that document as one self-contained file (bokeh's
+JavaScript inlined, no CDN, no server); :func:`serve` serves the same document from a local
+Bokeh server. Nothing is computed on the server after the page is built, so no view can
+show another design than the read-out and no key press waits on Python.
+
+Why not Panel's embedding (``panel.io.save(embed=True)``)? It records the page once per
+combination of widget states, rendering each in Python: on the fig12 cube the 14 states of
+the variable selector alone took 96 s (6.9 s a state on a busy machine, 1.1 MB), the page's
+sliders and selectors span 14 x 41 x 4 x 3 x 4 x 6 = 330,624 states, and a click on the map
+is no widget state at all (the README's section on the explorer).
+
+Hooks for tests and scripts: ``#nf-readout`` carries ``data-variable``, ``data-value``
+(display units), ``data-unit`` and ``data-design`` (the grid index of each axis, comma
+separated, then the model's index where the cube has several); the map's marker (the
+bokeh model named ``nf-star``) and each curve's source (``nf-curve-NAME``) carry the same
+``design`` in their data; ``#nf-validity`` carries the flag bits.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import re
+from importlib.resources import files
+
+import numpy as np
+
+from ..units import InputError
+from ..variables import AXES, VARIABLES
+from .data import (design_config, design_variables, display_unit, flag_meanings, label,
+                   snap, stand_in_note, to_display_any, validity_names)
+
+#: The most designs a page carries (the rest of a larger cube is left out, and it says so).
+MAX_DESIGNS = 120_000
+#: The most rows the table of designs matching ``--where`` lists.
+MAX_ROWS = 2000
+#: The default design: the paper's second worked example, at the nearest grid point [SI].
+DEFAULT_DESIGN = {"radius": 15e-3, "wall_thickness": 2e-3, "length": 90e-3,
+                  "coil_index": 1.7, "wrap_angle": math.radians(8.0)}
+_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
+            "#000000")
+_SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
+           "wrap_angle": "\u03c8"}
+_CURVES = {"nylon_force": ("stroke", ("radius", "wall_thickness", "coil_index", "wrap_angle")),
+           "bend_angle": ("pressure", ("radius", "wall_thickness", "length")),
+           "tip_force": ("pressure", ("radius", "wall_thickness", "length"))}
+
+
+def _conditions(where):
+    """``--where`` texts parsed by the query's parser (Condition objects pass through)."""
+    from ..query import parse_where
+
+    return [c for w in (where or ()) for c in (parse_where([w]) if isinstance(w, str)
+                                               else [w])]
+
+
+def _script(name: str) -> str:
+    return files(__package__).joinpath(name).read_text(encoding="utf-8")
+
+
+def _subset(ds) -> dict:
+    """Indices kept per axis so that the product stays within :data:`MAX_DESIGNS`.
+
+    The axes the map draws by default (radius, then wall thickness) keep the most values;
+    each axis keeps its ends and the default design's value.
+    """
+    sizes = {a: ds.sizes[a] for a in AXES}
+    keep = dict(sizes)
+    order = ["wrap_angle", "length", "coil_index", "wall_thickness", "radius"]
+    while math.prod(keep.values()) > MAX_DESIGNS:
+        a = max(order, key=lambda a: keep[a] / (4 if a == "radius" else
+                                                 2 if a == "wall_thickness" else 1))
+        keep[a] = max(2, keep[a] // 2) if keep[a] > 2 else 1
+    out = {}
+    for a in AXES:
+        idx = sorted(set(np.round(np.linspace(0, sizes[a] - 1, keep[a])).astype(int)
+                         .tolist()))
+        d = snap(ds, a, DEFAULT_DESIGN[a]).index
+        if len(idx) >= 3 and d not in idx:  # swap the nearest inner value for the default
+            j = 1 + int(np.argmin([abs(i - d) for i in idx[1:-1]]))
+            idx = sorted(idx[:j] + idx[j + 1:] + [d])
+        out[a] = idx
+    return out
+
+
+def _edges(x):
+    x = np.asarray(x, float)
+    if x.size == 1:
+        return np.array([x[0] - 0.5, x[0] + 0.5])
+    mid = (x[1:] + x[:-1]) / 2
+    return np.concatenate([[x[0] - (mid[0] - x[0])], mid, [x[-1] + (x[-1] - mid[-1])]])
+
+
+def _f32(a):
+    return np.ascontiguousarray(np.asarray(a, dtype=np.float32)).ravel()
+
+
+def _full(da, order, models):
+    """``da`` over ``order`` (the model first where the cube has several), C order."""
+    if models and "model" not in da.dims:
+        da = da.expand_dims(model=len(models))
+    return da.transpose(*[d for d in order if d in da.dims])
+
+
+def _where_mask(part, conditions, order, models):
+    """Which designs of ``part`` meet every condition (:func:`nylonflex.query.parse_where`),
+    as a bool array over ``order``; None without conditions."""
+    if not conditions:
+        return None
+    shape = tuple(len(models) if d == "model" else part.sizes[d] for d in order)
+    mask = np.ones(shape, bool)
+    for c in conditions:
+        if isinstance(c, str):  # "model == NAME": parse_where keeps it as its text
+            name = c.split("=")[-1].strip()
+            if not models or name not in models:
+                raise InputError(f"--where {c}: accepted models: "
+                                 f"{', '.join(models or ['(this cube has one model)'])}")
+            keep = np.zeros(shape, bool)
+            keep[models.index(name)] = True
+            mask &= keep
+            continue
+        if c.name not in part.variables:
+            raise InputError(f"--where {c.name}: not in this cube; accepted: "
+                             f"{', '.join([*AXES, *design_variables(part), 'validity'])}")
+        da = part[c.name]
+        if c.name in AXES:
+            da = da.broadcast_like(part["limit"] if "limit" in part else part[AXES[0]])
+        values = _full(da, order, models).values.astype(float)
+        mask &= np.broadcast_to(c.mask(values), shape)
+    return mask
+
+
+def build_payload(ds, where=()):
+    """The numbers a page carries, computed once per cube (every session of a served page
+    shares them): typed arrays in display units, the labels and, for parsed ``where``
+    conditions, the matching designs."""
+    keep = _subset(ds)
+    part = ds.isel(keep)
+    variables = design_variables(ds)
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else None
+    order = (("model",) if models else ()) + AXES
+    p = {"keep": keep, "variables": variables, "models": models,
+         "sizes": [len(keep[a]) for a in AXES]}
+    p["data"] = [_f32(to_display_any(ds, n, _full(part[n], order, models).values.astype(float)))
+                 for n in variables]
+    p["limit"] = _f32(_full(part["limit"], order, models).values) if "limit" in ds else None
+    p["validity"] = (_f32(np.nan_to_num(_full(part["validity"], order, models).values
+                                        .astype(float), nan=np.nan))
+                     if "validity" in ds else None)
+    grid = {a: part[a].values.astype(float) for a in AXES}
+    p["grid"] = grid
+    p["gx"] = {a: [float(v) for v in _f32(to_display_any(ds, a, grid[a]))] for a in AXES}
+    p["edges"] = {a: _edges(p["gx"][a]).tolist() for a in AXES}
+    p["labels"] = {a: [f"{float(to_display_any(ds, a, v)):.4g}"
+                       + ("" if display_unit(ds, a) == "1" else f" {display_unit(ds, a)}")
+                       for v in grid[a]] for a in AXES}
+    curves = {}
+    for name, (axis, dims) in _CURVES.items():
+        if name not in ds:
+            continue
+        da = part[name]
+        dims = (("model",) if models else ()) + dims + (axis,)
+        if models and "model" not in da.dims:
+            da = da.expand_dims(model=len(models))
+        curves[name] = {"dims": list(dims[:-1]), "n": int(ds.sizes[axis]),
+                        "x": [float(v) for v in to_display_any(ds, axis, ds[axis].values)],
+                        "values": _f32(to_display_any(ds, name, da.transpose(*dims).values
+                                                      .astype(float)))}
+    p["curves"] = curves
+    p["flim"] = ([float(v) for v in to_display_any(ds, "nylon_force_limit",
+                                                   part["nylon_force_limit"].values)]
+                 if "nylon_force_limit" in ds else None)
+    conditions = list(where or ())
+    p["where_conditions"] = conditions
+    mask = _where_mask(part, conditions, order, models)
+    p["where"] = [getattr(c, "text", str(c)) for c in conditions]
+    p["match"] = None if mask is None else mask.ravel().astype(np.uint8)
+    p["rows"] = _where_rows(ds, part, mask, order, models, p) if mask is not None else None
+    return p
+
+
+def _where_rows(ds, part, mask, order, models, p):
+    """The table of matching designs: index columns ``i_AXIS`` (for picking) and the
+    axes, the conditions' names and the headline variables in display units."""
+    hits = np.argwhere(mask)
+    rows = {"matching": int(len(hits))}
+    hits = hits[:MAX_ROWS]
+    cols = {}
+    for j, d in enumerate(order):
+        cols[f"i_{d}"] = hits[:, j].astype(int).tolist()
+    shown = [*AXES]
+    headline = ("tip_force_max", "bend_angle_max", "range_fraction", "limit")
+    for n in [*(getattr(c, "name", None) for c in p["where_conditions"]), *headline]:
+        if n and n not in shown and n in p["variables"]:
+            shown.append(n)
+    flat = np.ravel_multi_index(tuple(hits.T), mask.shape) if len(hits) else \
+        np.zeros(0, int)
+    for n in shown:
+        if n in AXES:
+            cols[n] = [float(f"{p['gx'][n][i]:.6g}") for i in cols[f"i_{n}"]]
+        else:
+            cols[n] = [float(v) for v in p["data"][p["variables"].index(n)][flat]]
+    if models:
+        cols["model"] = [models[i] for i in cols["i_model"]]
+        shown.insert(0, "model")
+    if p["validity"] is not None:
+        cols["validity"] = [validity_names(ds, v) for v in p["validity"][flat]]
+        shown.append("validity")
+    rows["columns"] = shown
+    rows["data"] = cols
+    return rows
+
+
+def _header(ds, p, source, served):
+    n_all = math.prod(ds.sizes[a] for a in AXES)
+    n_kept = math.prod(p["sizes"])
+    held = ("every design of the cube" if n_kept == n_all else
+            f"{n_kept:,} of the cube's {n_all:,} designs (" + ", ".join(
+                f"{a}: {s} of {ds.sizes[a]} values" for a, s in zip(AXES, p["sizes"])
+                if s < ds.sizes[a]) + ")")
+    flags = flag_meanings(ds)
+    flag_text = (" Cells outlined in orange are flagged: " + ", ".join(
+        m.replace("_", " ") for _, m in flags) + "." if flags else "")
+    form = ("Served page (127.0.0.1; everything is drawn in the browser)" if served else
+            "Exported page: it works offline")
+    text = (f"<h2 style='margin:0'>nylonflex explorer: cube "
+            f"'{html.escape(str(ds.attrs.get('name', '?')))}'</h2><p>{form} and holds {held}"
+            + (f", from <code>{html.escape(source)}</code>" if source else "") +
+            f", materials {html.escape(str(ds.attrs.get('silicone', '?')))} / "
+            f"{html.escape(str(ds.attrs.get('nylon', '?')))}. Sliders snap to grid values and "
+            "nothing is interpolated; click the map to pick a design (the nearest grid point)."
+            " <b>Hatched (x) cells are strength-limited</b>: the nylon breaks before the "
+            f"muscle uses its full stroke, so the range of motion is cut short.{flag_text} "
+            "The colour scale is set by the unflagged designs; flagged ones are faded.</p>")
+    if stand_in_note(ds):
+        text += (f"<p id='nf-stand-in' style='color:#a0522d'>{html.escape(stand_in_note(ds))}"
+                 "</p>")
+    return text
+
+
+def build_document(ds, *, source: str = "", where=(), served: bool = False, payload=None,
+                   doc=None):
+    """The explorer page of a cube as a Bokeh document.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube (read lazily; only the kept part is loaded).
+    source : str
+        The cube's path, named on the page.
+    where : sequence of str or Condition
+        Conditions (``--where``, parsed by :func:`nylonflex.query.parse_where`): the page
+        marks the matching designs on the map and lists them in a sortable table.
+    served : bool
+        Say "served page" in the header instead of "exported page".
+    payload : dict, optional
+        The numbers from an earlier call for the same cube and ``where`` (a served page
+        builds one document per browser session).
+    doc : bokeh.document.Document, optional
+        The document to fill (a server session's); a new one by default.
+
+    Returns
+    -------
+    bokeh.document.Document
+    """
+    from bokeh.document import Document
+    from bokeh.layouts import column, row
+    from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter,
+                              DataTable, Div, HoverTool, LinearColorMapper, NumberFormatter,
+                              RadioButtonGroup, Select, Slider, Span, TableColumn, TapTool,
+                              Title)
+    from bokeh.plotting import figure
+
+    conditions = _conditions(where)
+    if payload is None:
+        payload = build_payload(ds, conditions)
+    p = payload
+    variables, models, sizes = p["variables"], p["models"], p["sizes"]
+
+    # ---- widgets: the page's whole state
+    default_var = variables.index("tip_force_max") if "tip_force_max" in variables else 0
+    variable = Select(title="variable (map, lines and read-out)", width=300,
+                      options=[(str(i), label(ds, n)) for i, n in enumerate(variables)],
+                      value=str(default_var), name="nf-variable")
+    model = RadioButtonGroup(labels=models, active=0, name="nf-model") if models else None
+    axis_options = [(a, label(ds, a)) for a in AXES]
+    map_x = Select(title="map across", options=axis_options, value="radius", width=145,
+                   name="nf-map-x")
+    map_y = Select(title="map up", options=axis_options, value="wall_thickness", width=145,
+                   name="nf-map-y")
+    sliders = {}
+    for j, a in enumerate(AXES):
+        start = int(np.argmin(np.abs(p["grid"][a] - DEFAULT_DESIGN[a])))
+        fmt = CustomJSTickFormatter(args={"labels": p["labels"][a]},
+                                    code="return labels[Math.round(tick)] || '';")
+        sliders[a] = Slider(start=0, end=max(1, sizes[j] - 1), step=1, value=start,
+                            title=label(ds, a).split(" [")[0], format=fmt, width=300,
+                            disabled=sizes[j] < 2, name=f"nf-slider-{a}",
+                            css_classes=[f"nf-slider-{a}"])
+    # ---- the map (its cells are laid out by update.js for the chosen axes)
+    map_src = ColumnDataSource({k: [] for k in ("left", "right", "bottom", "top", "z", "h",
+                                                "lc", "fa", "vf", "xv", "yv")},
+                               name="nf-map")
+    mapper = LinearColorMapper(palette="Viridis256", low=0, high=1)
+    map_fig = figure(width=540, height=400, tools="tap,reset,save", name="nf-map-figure",
+                     x_axis_label=label(ds, "radius"), y_axis_label=label(ds, "wall_thickness"),
+                     x_range=(p["edges"]["radius"][0], p["edges"]["radius"][-1]),
+                     y_range=(p["edges"]["wall_thickness"][0],
+                              p["edges"]["wall_thickness"][-1]))
+    cells = map_fig.quad(source=map_src, left="left", right="right", bottom="bottom",
+                         top="top", fill_color={"field": "z", "transform": mapper},
+                         fill_alpha="fa", line_color="lc", line_width=2, hatch_pattern="h",
+                         hatch_color="white", hatch_alpha=0.8, hatch_scale=8,
+                         nonselection_fill_alpha="fa", selection_fill_alpha="fa")
+    hover = HoverTool(renderers=[cells], tooltips=[(label(ds, variables[default_var]),
+                                                    "@z{0.000}")])
+    map_fig.add_tools(hover)
+    colorbar = ColorBar(color_mapper=mapper, width=12, title=label(ds, variables[default_var]))
+    map_fig.add_layout(colorbar, "right")
+    match_src = ColumnDataSource({"x": [], "y": []}, name="nf-match")
+    if p["match"] is not None:
+        map_fig.scatter("x", "y", source=match_src, marker="circle", size=6,
+                        fill_color="white", line_color="black",
+                        legend_label="meets --where: " + "; ".join(p["where"]))
+        map_fig.add_layout(map_fig.legend[0], "below")  # not over the cells
+    star = ColumnDataSource({"x": [], "y": [], "design": []}, name="nf-star")
+    map_fig.scatter("x", "y", source=star, marker="star", size=20, fill_color="gold",
+                    line_color="black")
+    map_fig.select_one(TapTool).mode = "replace"
+    # ---- figure 12 style lines
+    lines_fig = figure(width=520, height=400, x_axis_label=label(ds, "radius"),
+                       tools="pan,box_zoom,reset,save")
+    line_srcs, solid_srcs = [], []
+    for k, c in enumerate(p["gx"]["coil_index"]):
+        colour = _COLOURS[k % len(_COLOURS)]
+        line_srcs.append(ColumnDataSource({"x": [], "y": []}))
+        solid_srcs.append(ColumnDataSource({"x": [], "y": []}))
+        lines_fig.line("x", "y", source=line_srcs[-1], color=colour, line_dash="dashed",
+                       legend_label=f"C = {c:.3g}")
+        lines_fig.line("x", "y", source=solid_srcs[-1], color=colour, line_width=3)
+    lines_fig.legend.location = "top_left"
+    lines_fig.add_layout(Title(text="solid: full range of motion; dashed: strength-limited",
+                               text_font_style="italic", text_font_size="11px"), "above")
+    # ---- the curves of the selected design
+    titles = {"nylon_force": "nylon force vs stroke (dashed: its limit)",
+              "bend_angle": "bend angle against chamber pressure",
+              "tip_force": "tip force against chamber pressure"}
+    curve_figs, curve_srcs = [], {}
+    for k, (name, (axis, _)) in enumerate(_CURVES.items()):
+        if name not in p["curves"]:
+            continue
+        f = figure(width=400, height=280, title=titles[name], x_axis_label=label(ds, axis),
+                   y_axis_label=label(ds, name), tools="pan,box_zoom,reset,save")
+        src = ColumnDataSource({"x": [], "y": [], "design": []}, name=f"nf-curve-{name}")
+        f.line("x", "y", source=src, color=_COLOURS[k], line_width=2)
+        curve_figs.append(f)
+        curve_srcs[name] = src
+    flim_span = None
+    if p["flim"] is not None and "nylon_force" in curve_srcs:
+        flim_span = Span(location=0, dimension="width", line_dash="dashed", line_color="black")
+        curve_figs[0].add_layout(flim_span)
+    readout = Div(width=640, name="nf-readout")
+    table = Div(width=420)
+    note = Div(text="", visible=False)
+    hold = Div(text="", visible=False)
+
+    args = dict(variable=variable, model=model, sliders=sliders, map_x=map_x, map_y=map_y,
+                data=p["data"], limit=p["limit"], validity=p["validity"], match=p["match"],
+                flags=[[m, n.replace("_", " ")] for m, n in flag_meanings(ds)],
+                config=(html.escape(design_config(ds, DEFAULT_DESIGN, placeholders=True),
+                                    quote=False) if "config_yaml" in ds.attrs else ""),
+                cfgvals={a: [f"{float(to_display_any(ds, a, v)):.12g}" for v in p["grid"][a]]
+                         for a in AXES},
+                colorbar=colorbar, hover=hover, sizes=sizes, AXES=list(AXES),
+                map_src=map_src, match_src=match_src, mapper=mapper, star=star, gx=p["gx"],
+                edges=p["edges"], names=_SYMBOL, labels=p["labels"],
+                alabels={a: label(ds, a) for a in AXES}, map_fig=map_fig,
+                map_xaxis=map_fig.xaxis[0], map_yaxis=map_fig.yaxis[0], lines_fig=lines_fig,
+                lines_yaxis=lines_fig.yaxis[0], line_srcs=line_srcs, solid_srcs=solid_srcs,
+                curves=p["curves"], curve_srcs=curve_srcs, flim=p["flim"],
+                flim_span=flim_span, readout=readout, table=table, note=note, hold=hold,
+                vnames=variables, vlabels=[label(ds, n) for n in variables],
+                vshort=[label(ds, n).split(" [")[0] for n in variables],
+                vunits=[display_unit(ds, n) for n in variables])
+    update = CustomJS(args=args, code=_script("update.js"))
+    for w in (variable, map_x, map_y):
+        w.js_on_change("value", update)
+    if model is not None:
+        model.js_on_change("active", update)
+    for s in sliders.values():
+        s.js_on_change("value", update)
+    pick_args = dict(sizes=sizes, AXES=list(AXES), sliders=sliders, model=model,
+                     map_x=map_x, map_y=map_y, labels=p["labels"], note=note, hold=hold,
+                     update=update)
+    map_src.selected.js_on_change("indices", CustomJS(args={**pick_args, "rows": None},
+                                                      code=_script("pick.js")))
+
+    where_box = []
+    if p["rows"] is not None:
+        rows = p["rows"]
+        rows_src = ColumnDataSource(rows["data"], name="nf-where-rows")
+        columns = []
+        for n in rows["columns"]:
+            title = label(ds, n) if n in VARIABLES or n in ds.variables else n
+            fmt = {} if n in ("model", "validity") else \
+                {"formatter": NumberFormatter(format="0.[000]")}
+            columns.append(TableColumn(field=n, title=title, **fmt))
+        where_table = DataTable(source=rows_src, columns=columns, width=1250, height=260,
+                                sortable=True, index_position=None, name="nf-where-table")
+        rows_src.selected.js_on_change("indices", CustomJS(args={**pick_args, "rows": rows_src},
+                                                           code=_script("pick.js")))
+        listed = min(rows["matching"], MAX_ROWS)
+        where_box = [Div(width=1250, name="nf-where-note", text=(
+            f"<b>{rows['matching']:,} designs of this page meet --where "
+            f"{html.escape(' and '.join(p['where']))}</b>"
+            + (f" (the first {listed:,} in grid order listed; sorting sorts those)"
+               if listed < rows["matching"] else "")
+            + ": click a column's title to sort, a row to pick that design; the map marks "
+            "the matching designs of its slice with a white dot.")), where_table]
+
+    controls = [variable] + ([Div(text="model variant"), model] if model else []) + \
+        [row(map_x, map_y)] + list(sliders.values())
+    layout = column(Div(width=1250, text=_header(ds, p, source, served)),
+                    row(column(*controls, width=320),
+                        column(readout, row(map_fig, lines_fig))),
+                    *where_box,
+                    row(table, *curve_figs), note, hold)
+    doc = Document() if doc is None else doc
+    doc.add_root(layout)
+    doc.title = f"nylonflex explorer: {ds.attrs.get('name', '')}"
+    doc.js_on_event("document_ready", update)
+    return doc
+
+
+def build_html(ds, *, source: str = "", where=()) -> str:
+    """The self-contained explorer page of a cube, as HTML text (bokeh's JS inlined).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube.
+    source : str
+        The cube's path, named on the page.
+    where : sequence of str or Condition
+        ``--where`` conditions (see :func:`build_document`).
+
+    Returns
+    -------
+    str
+    """
+    from bokeh.embed import file_html
+    from bokeh.resources import Resources
+
+    doc = build_document(ds, source=source, where=where)
+    text = file_html(doc, Resources(mode="inline"), title=doc.title)
+    # Where Panel is imported in the same process, bokeh bundles its extensions' script
+    # tags (relative URLs this page never uses and that could not load offline): drop them.
+    return re.sub(r'<script[^>]*\bsrc="[^"]*"[^>]*>\s*</script>\s*', "", text)
+
+
+def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready=None):
+    """Serve the page of :func:`build_document` on ``127.0.0.1:port`` until interrupted.
+
+    The numbers are read from the cube once; each browser session gets its own document.
+    ``ready`` (no arguments) is called once the server listens.
+    """
+    from bokeh.application import Application
+    from bokeh.application.handlers.function import FunctionHandler
+    from bokeh.server.server import Server
+
+    conditions = _conditions(where)
+    payload = build_payload(ds, conditions)
+
+    def session(doc):
+        build_document(ds, source=source, where=conditions, served=True, payload=payload,
+                       doc=doc)
+
+    server = Server({"/": Application(FunctionHandler(session))}, port=port,
+                    address="127.0.0.1",
+                    allow_websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"])
+    server.start()
+    if ready is not None:
+        ready()
+    if show:
+        server.io_loop.add_callback(server.show, "/")
+    server.io_loop.start()
