@@ -28,6 +28,7 @@ COMMANDS = {
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",
+    "warmup": "warmup",
     "fit": "fit",
     "validate": "validate",
     "init": "init",
