@@ -196,7 +196,7 @@ def test_the_light_commands_import_no_numba_nor_dask(command, small_cube, tmp_pa
             "query": ["query", str(small_cube), "--where", "tip_force_max > 0", "--limit", "3"],
             "chart": ["chart", "--help"],
             "list": ["list", "materials"],
-            "init": ["init", str(tmp_path / "new.yaml")]}[command]
+            "init": ["init", str(tmp_path / "examples")]}[command]
     assert command in LIGHT_COMMANDS
     assert _loaded(argv, list(_HEAVY[command]), tmp_path) == []
 
