@@ -71,13 +71,17 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     return _timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
 
 
-def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
+def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0) -> float:
     """Compile (or load from cache) the pointwise kernels of :func:`nylonflex.evaluate`.
 
     Parameters
     ----------
     settings : dict, optional
         Keyword arguments of :func:`~nylonflex.engine.pointwise.evaluate` (materials).
+    sizes : iterable of int, optional
+        How many designs the caller's evaluations will hold: only the loops those use are
+        compiled (the serial one below 64 designs, the threaded one from 64; each is a
+        compile of its own, half the cold cost of a one-design ``query --at``). None: both.
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
@@ -94,9 +98,11 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     from .pointwise import _PARALLEL_FROM, evaluate
 
     kw = dict(settings or {})
+    loops = sorted({1 if n < _PARALLEL_FROM else _PARALLEL_FROM
+                    for n in ((1, _PARALLEL_FROM) if sizes is None else sizes)})
 
     def call():
-        for n in (1, _PARALLEL_FROM):  # the serial and the threaded loop
+        for n in loops:  # the serial and/or the threaded loop
             evaluate(np.full(n, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
 
     return _timed(call, notice, after)
