@@ -6,7 +6,8 @@
 #   BASE=/work/main benchmarks/issue27.sh # ... and the same figures of another checkout
 #                                         # (its .venv/bin/nylonflex) beside them
 #   RUNS=5 COLD_RUNS=3 BIG=/tmp/big.h5 benchmarks/issue27.sh
-#   SKIP_BENCH=1 ...                      # leave out section 6 (the full nylonflex bench)
+#   SKIP_BENCH=1 SKIP_SAMPLED=1 ...       # leave out section 6 (the full nylonflex bench)
+#                                         # or 5 (three 3 M-evaluation sampled sweeps each)
 #
 # Cold runs point NUMBA_CACHE_DIR at a new empty folder each time (every kernel compiles).
 # BIG is the 20 M-design cube (made with 'nylonflex sweep configs/big20m.yaml' if missing,
@@ -95,13 +96,15 @@ PY
 done | sort -n | awk '{r[NR]=$0} END {split(r[int((NR+1)/2)], x, " ");
     printf "single %s us, batch %s us a design (CPU): single/batch %s (target <= 20)\n", x[2], x[3], x[1]}'
 
-echo "== 5. the sampled path: fig12 x 256 samples (CPU s per million evaluations)"
+if [ -z "${SKIP_SAMPLED:-}" ]; then
+echo "== 5. the sampled path: fig12 x 256 samples (CPU-us per evaluation)"
 EVALS=$((41 * 6 * 3 * 4 * 4 * 256))
 read -r cpu _ < <(median "$RUNS" "$NF" sweep configs/fig12_uncertain.yaml --out "$WORK/unc/cube.h5" --no-charts --quiet)
 echo "sampled (this)  $cpu s for $EVALS evaluations: $(awk -v c="$cpu" -v n="$EVALS" 'BEGIN {printf "%.2f", c / n * 1e6}') CPU-us each"
 if [ -n "${BASE:-}" ]; then
     read -r bcpu _ < <(median "$RUNS" "$BASE/.venv/bin/nylonflex" sweep configs/fig12_uncertain.yaml --out "$WORK/unc_base/cube.h5" --no-charts --quiet)
     echo "sampled (base)  $bcpu s: this/base $(ratio "$cpu" "$bcpu") (target <= 0.5)"
+fi
 fi
 
 if [ -z "${SKIP_BENCH:-}" ]; then

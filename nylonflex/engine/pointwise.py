@@ -118,7 +118,14 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
                          f"materials {batch})") from None
     n = math.prod(shape)
     flat = lambda x: _flat(x, shape, n)  # noqa: E731
-    c_flat = flat(c)
+    if shape == ():  # one design: its six inputs as the rows of one read-only block
+        block = np.array([a, t, b, L, psi, c], dtype=float).reshape(6, 1)
+        block.flags.writeable = False
+        designs = tuple(block[:5])
+        c_flat = block[5]
+    else:
+        designs = (flat(a), flat(t), flat(b), flat(L), flat(psi))
+        c_flat = flat(c)
     s_max = _interp(c_flat, _rows(table, shape), _rows(ny["stroke_max_table"], shape))
     strength = _interp(c_flat, _rows(table, shape), _rows(ny["tensile_strength_table"], shape))
     d_f = flat(ny["fibre_diameter"])
@@ -127,8 +134,7 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     muscle = _single_muscle(nylon) if n == 1 and isinstance(nylon, str) else \
         [flat(ny[k]) for k in _MUSCLE_FIELDS]
     options = (MODELS.index(model), voltage, stretch_max)
-    out = _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
-               (s_max, force_limit, width), ogden, muscle, options)
+    out = _run(shape, n, designs, (s_max, force_limit, width), ogden, muscle, options)
     check_supply_rise(voltage, out["muscle_length"], ny["resistance_per_length"],
                       ny["heat_loss_per_length"], "supply_voltage")
     return out
