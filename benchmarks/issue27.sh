@@ -52,7 +52,7 @@ AT="radius=7.3mm,wall_thickness=2.2mm,length=80mm,coil_index=1.37,wrap_angle=9de
 read -r warm _ < <(median "$RUNS" "$NF" query "$WORK/fig12/cube.h5" --at "$AT")
 read -r coldc _ < <(median "$COLD_RUNS" "$COLD" "$NF" query "$WORK/fig12/cube.h5" --at "$AT")
 echo "query --at (off the grid)  warm $warm  cold $coldc  cold/warm $(ratio "$coldc" "$warm") (target <= 3)"
-echo "cold compile per kernel (s, one empty cache, nylonflex warmup):"
+echo "cold compile per kernel (wall s and CPU-s, one empty cache, nylonflex warmup):"
 "$COLD" "$NF" warmup 2>/dev/null | sed 's/^/  /'
 
 echo "== 2. info on the 20 M cube (CPU s, peak MB)"
