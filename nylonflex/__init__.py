@@ -44,5 +44,7 @@ def __getattr__(name):
     if name in _LAZY:
         import importlib
 
-        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value  # later look-ups are plain (20 us a call of nf.evaluate)
+        return value
     raise AttributeError(f"module 'nylonflex' has no attribute {name!r}")

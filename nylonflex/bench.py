@@ -129,6 +129,37 @@ def _pointwise_seconds(n: int) -> tuple[float, float, int]:
     return t_point, (time.perf_counter() - t0) / m, n
 
 
+def _single_vs_batch_cpu(n: int = 20_000, calls: int = 2000) -> tuple[float, float]:
+    """CPU seconds [s] of ``nf.evaluate`` for one design, and per design of an ``n``-design
+    batch, measured back to back in this process (issue 27: at most 20x)."""
+    from .engine import evaluate
+
+    d = random_designs(n, seed=27)
+    one = {k: float(v[0]) for k, v in d.items()}
+    evaluate(**d), evaluate(**one)  # compile or load the cache: both loops
+    t0 = time.process_time()
+    for _ in range(3):
+        evaluate(**d)
+    batch = (time.process_time() - t0) / 3 / n
+    t0 = time.process_time()
+    for _ in range(calls):
+        evaluate(**one)
+    return (time.process_time() - t0) / calls, batch
+
+
+def _matmul_gflops(n: int = 1024) -> float:
+    """The machine's practical floating-point peak [GFlop/s]: NumPy's matmul of two
+    n x n float64 matrices (2 n^3 flops), best of 3, on the BLAS threads it has."""
+    a = np.random.default_rng(0).random((n, n))
+    a @ a
+    best = math.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        a @ a
+        best = min(best, time.perf_counter() - t0)
+    return 2.0 * n**3 / best / 1e9
+
+
 def _closed_loop_seconds(duration: float) -> tuple[float, float]:
     """Loop time [s] of the figure-9 closed loop over ``duration`` [s] at 10 ms, and the
     whole run's (tables and output included), once compiled."""
@@ -218,6 +249,9 @@ def run_bench(quick: bool = False, log=None) -> dict:
         _reference_design(cfg, *d)
     t_ref = (time.perf_counter() - t0) / n_ref
     t_point, t_loop_py, n_point = _pointwise_seconds(sizes["pointwise_designs"])
+    cpu_single, cpu_batch = _single_vs_batch_cpu(2000 if quick else 20_000,
+                                                 200 if quick else 2000)
+    gflops = _matmul_gflops(256 if quick else 1024)
 
     sim_duration = 60.0 if quick else 3600.0
     t_loop, t_sim = _closed_loop_seconds(sim_duration)
@@ -248,6 +282,10 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "kernel_vs_numpy": t_numpy / t_kernel_whole,
         "peak_rss_mb": peak_mb,
         "cube_mb": size_mb,
+        "single_design_cpu_s": cpu_single,
+        "batch_design_cpu_s": cpu_batch,
+        "single_vs_batch": cpu_single / cpu_batch,
+        "matmul_gflops": gflops,
         "sampled_s": t_sampled,
         "sampled_evaluations": n_sampled,
         "sampled_evaluations_per_s": n_sampled / t_sampled,
@@ -269,6 +307,12 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f"(physics.design_limits, the same formulas uncompiled)")
     say(f"  evaluate speed-up          {result['pointwise_vs_reference']:>12,.0f} x the scipy "
         f"reference, {result['pointwise_vs_python_loop']:,.0f} x the python loop (same run)")
+    say(f"  nf.evaluate, one design    {cpu_single * 1e6:8.1f} us CPU, "
+        f"{result['single_vs_batch']:.1f} x a design of a batch ({cpu_batch * 1e6:.2f} us CPU"
+        f" each, same run)")
+    say(f"  NumPy matmul (peak)        {gflops:8.1f} GFlop/s (float64, the BLAS threads of "
+        "this process: one under the nylonflex command; the kernel's fraction of peak is "
+        "its flops a design over this)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  sampled sweep (uncertainty) {t_sampled:7.2f} s  "

@@ -82,3 +82,26 @@ def test_each_kernel_family_is_known():
     assert compiling.family(control.closed_loop) == "control"
     assert compiling.family(codec._shuffle_bytes_jit) == "codec"
     assert set(compiling.MEASURED) == set(compiling.FAMILIES)
+
+
+def test_warm_up_kernels_runs_each_kernel_once_and_reports_progress():
+    # every engine kernel of warmup.KERNELS, in order, progress after each; a cached one
+    # reports 0.0 s (the suite's cache is warm by now: the grid and pointwise tests ran)
+    from nylonflex.engine.warmup import KERNELS, warm_up_kernels
+
+    seen = []
+    out = warm_up_kernels(["pointwise", "codec"], notice=lambda line: None,
+                          progress=lambda done, total, name: seen.append((done, total, name)))
+    assert seen == [(1, 2, "pointwise"), (2, 2, "codec")]
+    assert set(out) == {"pointwise", "codec"} and all(v >= 0.0 for v in out.values())
+    assert [k[0] for k in KERNELS] == ["grid", "grid-serial", "pointwise", "codec"]
+
+
+def test_the_warmup_command_names_every_kernel(capsys):
+    from nylonflex.cli import main
+
+    assert main(["warmup"]) == 0
+    out = capsys.readouterr().out
+    for name in ("grid", "grid-serial", "pointwise", "codec", "control"):
+        assert f" {name} " in out
+    assert out.splitlines()[-1].startswith("warm: every kernel")

@@ -81,6 +81,37 @@ def test_design_limits_is_the_scalar_face_of_evaluate():
     assert out["limit"] == 0
 
 
+def test_one_design_is_its_row_of_a_batch_bit_for_bit_through_one_compiled_body():
+    # issue 27's single-design path (scalars filled directly, named materials prepared
+    # once) gives the bits the broadcast path gives the same design inside a batch, and
+    # both run the one compiled signature of each pointwise loop (no second compile)
+    from nylonflex.kernels import design as kernels
+
+    d = random_designs(80, seed=27)
+    batch = nf.evaluate(**d)
+    nf.evaluate(**{k: v[:3] for k, v in d.items()})  # a small batch: the serial loop
+    compiled = list(kernels.design_points_serial.signatures)
+    for i in (0, 17, 79):
+        one = nf.evaluate(*(float(v[i]) for v in d.values()))
+        for name in DESIGN:
+            np.testing.assert_array_equal(one[name], batch[name][i], err_msg=name)
+    again = nf.evaluate(**{k: float(v[3]) for k, v in d.items()}, silicone="tc5005",
+                        nylon={"set": "silver_nylon66"})  # a mapping: the general path
+    for name in DESIGN:
+        np.testing.assert_array_equal(again[name], batch[name][3], err_msg=name)
+    assert kernels.design_points_serial.signatures == compiled
+
+
+def test_a_single_out_of_range_design_says_what_the_array_check_says():
+    # the scalar fast check of check_input must refuse what the array check refuses
+    for bad in (0.0, -1e-3, float("nan"), float("inf"), 0.5):
+        with pytest.raises(ValueError, match="radius: must be") as one:
+            nf.evaluate(bad, 2e-3, 70e-3, 1.7, 0.1396)
+        with pytest.raises(ValueError, match="radius: must be") as arr:
+            nf.evaluate(np.array([bad]), 2e-3, 70e-3, 1.7, 0.1396)
+        assert str(one.value) == str(arr.value)
+
+
 @pytest.mark.parametrize("kwargs,match", [
     (dict(radius=7.5), r"radius: .*7.5 looks like mm"),
     (dict(coil_index=2.5), r"coil_index: must be in \[1.1, 1.7\]"),

@@ -138,3 +138,72 @@ def test_the_contract_fails_when_an_arrow_runs_back(tmp_path, monkeypatch):
             test_imports_point_down()
     finally:
         bad.unlink()
+
+
+# ------------------------------------------------------------- the commands that stay light
+#: What each light command may not import, run as a user runs it (its own process, the
+#: console script): no Numba anywhere; no dask; ``info`` no xarray either (it reads the
+#: cube through h5py), ``chart --help`` nothing that draws or reads.
+_HEAVY = {
+    "info": ("numba", "dask", "xarray", "pandas", "nylonflex.engine"),
+    "query": ("numba", "dask", "nylonflex.kernels"),
+    "chart": ("numba", "dask", "xarray", "matplotlib", "h5py"),
+    "list": ("numba", "dask", "xarray", "h5py"),
+    "init": ("numba", "dask", "xarray", "h5py"),
+}
+
+_PROBE = """
+import atexit, json, sys
+heavy = json.loads(sys.argv[1])
+atexit.register(lambda: print("LOADED", json.dumps(
+    [m for m in heavy if sys.modules.get(m) is not None])))  # None: blocked, not loaded
+sys.argv = ["nylonflex", *sys.argv[2:]]
+from nylonflex.cli import run
+run()
+"""
+
+
+def _loaded(argv, heavy, tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(heavy), *argv],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert done.returncode == 0, done.stderr
+    line = next(x for x in done.stdout.splitlines() if x.startswith("LOADED "))
+    return json.loads(line[len("LOADED "):])
+
+
+@pytest.fixture(scope="module")
+def small_cube(tmp_path_factory):
+    import yaml
+
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+
+    raw = yaml.safe_load((Path(__file__).parent / "data" / "reference_cube.yaml").read_text())
+    path = tmp_path_factory.mktemp("light") / "cube.h5"
+    nf.run_sweep(parse_config(raw), path).close()
+    return path
+
+
+@pytest.mark.parametrize("command", sorted(_HEAVY))
+def test_the_light_commands_import_no_numba_nor_dask(command, small_cube, tmp_path):
+    from nylonflex.cli import LIGHT_COMMANDS
+
+    argv = {"info": ["info", str(small_cube)],
+            "query": ["query", str(small_cube), "--where", "tip_force_max > 0", "--limit", "3"],
+            "chart": ["chart", "--help"],
+            "list": ["list", "materials"],
+            "init": ["init", str(tmp_path / "examples")]}[command]
+    assert command in LIGHT_COMMANDS
+    assert _loaded(argv, list(_HEAVY[command]), tmp_path) == []
+
+
+def test_the_light_command_probe_sees_what_a_command_imports(small_cube, tmp_path):
+    # the same probe sees info's reader (h5py) and query's xarray: a module imported while
+    # the command runs is reported, so an empty list above means not imported
+    assert _loaded(["info", str(small_cube)], ["h5py", "numba"], tmp_path) == ["h5py"]
+    assert _loaded(["query", str(small_cube), "--limit", "1"], ["xarray"], tmp_path) \
+        == ["xarray"]

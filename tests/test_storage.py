@@ -256,3 +256,68 @@ def test_an_opened_cube_of_every_codec_saves_again_with_either_engine(tmp_path, 
                 xr.testing.assert_identical(back.load(), part.load())
             with h5py.File(out, "r") as f:  # what was written needs no plugin either
                 assert f["tip_force_max"].compression in ("gzip", None), engine
+
+
+# ------------------------------------------------------------------ info's flag counts
+@pytest.mark.parametrize("dtype", [np.int8, np.uint8])
+@pytest.mark.parametrize("piece", [1, 7, 1 << 18])
+def test_the_flag_histogram_counts_each_byte_as_a_loop_does(dtype, piece):
+    from nylonflex.storage.reader import flag_histogram
+
+    rng = np.random.default_rng(27)
+    flags = rng.integers(0, 256, size=(13, 17, 5)).astype(np.uint8).view(dtype)
+    slow = np.zeros(256, dtype=np.int64)
+    for value in flags.reshape(-1):  # the obviously right reference
+        slow[int(np.uint8(value.view(np.uint8)))] += 1
+    np.testing.assert_array_equal(flag_histogram(flags, piece=piece), slow)
+    with pytest.raises(ValueError, match="one-byte"):
+        flag_histogram(flags.astype(np.int16))
+
+
+def _flag_counts_through_xarray(path):
+    """The flagged line's numbers as ``info`` counted them before issue 27: the whole
+    validity variable through open_cube (masked radii read as NaN), as int64."""
+    import warnings
+
+    from nylonflex.storage import open_cube
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = open_cube(path)
+    v = ds["validity"].values
+    v = v[~np.isnan(v)].astype(np.int64) if v.dtype.kind == "f" else v.astype(np.int64)
+    bits = [int(x) for x in np.atleast_1d(ds["validity"].attrs["flag_masks"])]
+    counts = [int(np.sum((v & bit) > 0)) for bit in bits]
+    ds.close()
+    return int(np.sum(v > 0)), v.size, counts
+
+
+@pytest.mark.parametrize("incomplete", [False, True])
+def test_info_counts_the_flags_xarray_counts(tmp_path, incomplete):
+    from pathlib import Path
+
+    import yaml
+
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+    from nylonflex.storage import cube_summary
+
+    raw = yaml.safe_load((Path(__file__).parent / "data" / "reference_cube.yaml").read_text())
+    path = tmp_path / "cube.h5"
+    nf.run_sweep(parse_config(raw), path).close()
+    with h5py.File(path, "r+") as f:
+        # flags of every kind, negative bytes too, so that each bit has designs to count
+        v = f["validity"]
+        rng = np.random.default_rng(5)
+        v[...] = rng.integers(-128, 128, size=v.shape).astype(np.int8)
+        if incomplete:  # a stopped sweep: the second radius not done
+            done = f["slab_done"][...]
+            done[1] = 0
+            f["slab_done"][...] = done
+            f.attrs["complete"] = np.int8(0)
+    flagged, total, counts = _flag_counts_through_xarray(path)
+    line = next(x for x in cube_summary(path) if x.startswith("flagged"))
+    names = str(h5py.File(path, "r")["validity"].attrs["flag_meanings"]).split()
+    assert line.startswith(f"flagged   {flagged:,} of {total:,} design values")
+    assert line.endswith(", ".join(f"{n} {c:,}" for n, c in zip(names, counts)))
+    assert ("INCOMPLETE" in "\n".join(cube_summary(path))) == incomplete

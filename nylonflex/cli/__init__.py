@@ -28,6 +28,7 @@ COMMANDS = {
     "info": "info",
     "simulate": "simulate",
     "bench": "bench",
+    "warmup": "warmup",
     "fit": "fit",
     "validate": "validate",
     "init": "init",
@@ -101,6 +102,7 @@ def run():
     import os
     import threading
 
+    _block_unused_dask(_command(sys.argv[1:]))
     code = main()
     try:
         sys.stdout.flush()
@@ -118,6 +120,26 @@ def run():
         sys.stderr.flush()
     finally:
         os._exit(0 if code is None else int(code))
+
+
+#: Commands that read cubes and configs and never compute on Dask: they import no Numba
+#: (their modules import none) and no dask (:func:`_block_unused_dask`); tests/test_layers.py
+#: runs each and checks. ``query --at`` off the grid evaluates (Numba, never dask).
+LIGHT_COMMANDS = ("info", "query", "chart", "list", "init")
+
+
+def _block_unused_dask(command):
+    """Keep dask out of a light command's own process (the console script only).
+
+    xarray imports ``dask.base`` and ``dask.array`` (0.3-0.5 CPU-s) the first time it
+    checks whether an array is a dask one, whenever dask is installed. A ``None`` in
+    ``sys.modules`` is Python's documented way to make a module unimportable, and
+    ``importlib.util.find_spec`` (xarray's check) then reports it absent: xarray works on
+    NumPy arrays only, which is all these commands give it. Not done by :func:`main`, so
+    that a process running several commands (the tests) keeps dask for the others.
+    """
+    if command in LIGHT_COMMANDS and "dask" not in sys.modules:
+        sys.modules["dask"] = None
 
 
 def main(argv=None) -> int:

@@ -11,9 +11,11 @@ runs in parallel over the designs; its body is the one the pure-Python reference
 
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Mapping
 from contextlib import contextmanager
+from functools import lru_cache
 
 import numpy as np
 
@@ -103,45 +105,48 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     a, t, b = check_section(radius, wall_thickness, base_thickness)
     L = check_input("length", length)
     psi = check_wrap_angle(wrap_angle)
-    ogden = _silicone_arrays(silicone)
-    stretch_max = _stretch_max(silicone)
-    ny = _nylon_arrays(nylon)
-    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
-                                          "sigma_g")))
+    ogden, stretch_max, ny = _materials(silicone, nylon)
     c = check_input("coil_index", coil_index, -np.inf, np.inf)
     table = ny["coil_index_table"]
     bad = ~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])
-    if np.any(bad):
+    if bad.any():
         lo, hi = np.broadcast_arrays(table[..., 0], table[..., -1], c)[:2]
         j = np.flatnonzero(np.broadcast_to(bad, np.broadcast(lo, c).shape))[0]
         raise ValueError(f"coil_index: must be in [{lo.flat[j]:g}, {hi.flat[j]:g}] (the "
                          f"nylon set's table), got {np.broadcast_to(c, lo.shape).flat[j]:g}")
-    batch = [ogden[0].shape[:-1], ogden[1].shape[:-1], table.shape[:-1],
-             ny["stroke_max_table"].shape[:-1], ny["tensile_strength_table"].shape[:-1],
-             *(np.shape(v) for k, v in ny.items() if k not in _NYLON_TABLES)]
+    batch = _named_batch(silicone, nylon) if isinstance(silicone, str) and \
+        isinstance(nylon, str) else _batch_shapes(ogden, ny)
+    shapes = (a.shape, t.shape, b.shape, L.shape, c.shape, psi.shape, *batch)
     try:
-        shape = np.broadcast_shapes(a.shape, t.shape, b.shape, L.shape, c.shape, psi.shape,
-                                    *batch)
+        shape = np.broadcast_shapes(*shapes) if any(shapes) else ()
     except ValueError:
         raise ValueError("evaluate: the designs and material arrays do not broadcast "
                          f"together (shapes {[x.shape for x in (a, t, L, c, psi)]}, "
                          f"materials {batch})") from None
-    flat = lambda x: np.ascontiguousarray(np.broadcast_to(x, shape), float).reshape(-1)  # noqa: E731
-    n = int(np.prod(shape))
-    c_flat = flat(c)
+    n = math.prod(shape)
+    flat = lambda x: _flat(x, shape, n)  # noqa: E731
+    if shape == ():  # one design: its six inputs as the rows of one read-only block
+        block = np.array([a, t, b, L, psi, c], dtype=float).reshape(6, 1)
+        block.flags.writeable = False
+        designs = tuple(block[:5])
+        c_flat = block[5]
+    else:
+        designs = (flat(a), flat(t), flat(b), flat(L), flat(psi))
+        c_flat = flat(c)
     s_max = _interp(c_flat, _rows(table, shape), _rows(ny["stroke_max_table"], shape))
     strength = _interp(c_flat, _rows(table, shape), _rows(ny["tensile_strength_table"], shape))
     d_f = flat(ny["fibre_diameter"])
     force_limit = strength * (np.pi * d_f**2 / 4.0)
     width = d_f * (c_flat + 1.0)
-    muscle = [flat(ny[k]) for k in _MUSCLE_FIELDS]
+    muscle = _single_muscle(nylon) if n == 1 and isinstance(nylon, str) else \
+        [flat(ny[k]) for k in _MUSCLE_FIELDS]
     r_per_len = np.vectorize(_coil_resistance, otypes=[float])(
         flat(ny["resistance_per_length"]), flat(ny["resistance_coil_index"]), c_flat)
     loss_per_len = _heat_loss(cooling, d_f, flat(ny["t_max"]), flat(ny["t_amb"]), c_flat,
                               flat(ny["heat_loss_per_length"]))
     options = (MODELS.index(model), voltage, stretch_max)
-    out = _run(shape, n, (flat(a), flat(t), flat(b), flat(L), flat(psi)),
-               (s_max, force_limit, width, r_per_len, loss_per_len), ogden, muscle, options)
+    out = _run(shape, n, designs, (s_max, force_limit, width, r_per_len, loss_per_len), ogden,
+               muscle, options)
     check_supply_rise(voltage, out["muscle_length"], r_per_len.reshape(shape),
                       loss_per_len.reshape(shape), "supply_voltage")
     return out
@@ -163,6 +168,74 @@ def _heat_loss(cooling, d_f, t_max, t_amb, c, own):
     return np.ascontiguousarray(values[inverse.reshape(-1)])
 
 
+def _flat(x, shape, n):
+    """``x`` broadcast to ``shape``, as a read-only contiguous 1-D float array of ``n``.
+
+    A scalar (the common single-design case) is filled directly, 2 us instead of the
+    broadcast's 10; either way the same values and the same array type (read-only, C), so
+    the kernel is the one compiled body.
+    """
+    if isinstance(x, float) or (isinstance(x, np.ndarray) and x.ndim == 0):
+        out = np.full(n, x, dtype=float)
+        out.flags.writeable = False
+        return out
+    return np.ascontiguousarray(np.broadcast_to(x, shape), float).reshape(-1)
+
+
+def _materials(silicone, nylon):
+    """``(ogden, stretch_max, nylon arrays)`` of the material arguments, checked.
+
+    Named sets (strings, the usual case) are prepared once a process
+    (:func:`_named_materials`): a single design spent 0.6 ms here on every call. The
+    cached nylon arrays are read-only; the Ogden arrays are copied (the kernel's record
+    takes them writable, one compiled type).
+    """
+    if isinstance(silicone, str) and isinstance(nylon, str):
+        (mu, alpha), stretch_max, ny = _named_materials(silicone, nylon)
+        return (mu.copy(), alpha.copy()), stretch_max, dict(ny)
+    ogden = _silicone_arrays(silicone)
+    stretch_max = _stretch_max(silicone)
+    ny = _nylon_arrays(nylon)
+    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
+                                          "sigma_g")))
+    return ogden, stretch_max, ny
+
+
+@lru_cache(maxsize=64)
+def _named_materials(silicone: str, nylon: str):
+    """:func:`_materials` of two set names (the registry's sets do not change)."""
+    ogden = _silicone_arrays(silicone)
+    stretch_max = _stretch_max(silicone)
+    ny = _nylon_arrays(nylon)
+    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
+                                          "sigma_g")))
+    for value in ny.values():
+        value.flags.writeable = False
+    return ogden, stretch_max, ny
+
+
+def _batch_shapes(ogden, ny) -> list:
+    """The shapes the material arrays add to the designs' broadcast (tables: columns off)."""
+    return [ogden[0].shape[:-1], ogden[1].shape[:-1], ny["coil_index_table"].shape[:-1],
+            ny["stroke_max_table"].shape[:-1], ny["tensile_strength_table"].shape[:-1],
+            *(np.shape(v) for k, v in ny.items() if k not in _NYLON_TABLES)]
+
+
+@lru_cache(maxsize=64)
+def _named_batch(silicone: str, nylon: str) -> list:
+    """:func:`_batch_shapes` of two named sets (all scalars: every shape ``()``)."""
+    ogden, _, ny = _named_materials(silicone, nylon)
+    return _batch_shapes(ogden, ny)
+
+
+@lru_cache(maxsize=16)
+def _single_muscle(nylon: str) -> tuple:
+    """The muscle record's arrays of one design of a named nylon set (read-only, cached),
+    as ``_flat`` makes them."""
+    ny = _nylon_arrays(nylon)
+    return tuple(_flat(ny[k], (), 1) for k in _MUSCLE_FIELDS)
+
+
 def _stretch_max(silicone) -> float:
     """Top of the silicone set's fitted stretch range [-] (inf when it records none)."""
     base = silicone
@@ -173,9 +246,7 @@ def _stretch_max(silicone) -> float:
 
 
 def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
-    from ..kernels import design as kernels
-    from ..kernels.records import (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns,
-                                   PointOut)
+    kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut) = _kernels()
 
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
@@ -188,6 +259,16 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     result["limit"] = out.flags[0].reshape(shape)
     result["validity"] = out.flags[1].reshape(shape)
     return {name: result[name] for name in DESIGN}
+
+
+@lru_cache(maxsize=1)
+def _kernels():
+    """The pointwise kernels' module and records, imported on first use (Numba)."""
+    from ..kernels import design as kernels
+    from ..kernels.records import (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns,
+                                   PointOut)
+
+    return kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut)
 
 
 @contextmanager

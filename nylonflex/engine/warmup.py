@@ -18,7 +18,8 @@ from contextlib import nullcontext
 
 from ..config import ResolvedConfig
 
-__all__ = ["COMPILE_NOTICE", "warm_up_grid", "warm_up_points"]
+__all__ = ["COMPILE_NOTICE", "KERNELS", "warm_up_codec", "warm_up_grid", "warm_up_kernels",
+           "warm_up_points"]
 
 #: How every compile notice begins (the rest names the kernel and its estimate).
 COMPILE_NOTICE = "compiling "
@@ -70,13 +71,17 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     return _timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
 
 
-def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
+def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0) -> float:
     """Compile (or load from cache) the pointwise kernels of :func:`nylonflex.evaluate`.
 
     Parameters
     ----------
     settings : dict, optional
         Keyword arguments of :func:`~nylonflex.engine.pointwise.evaluate` (materials).
+    sizes : iterable of int, optional
+        How many designs the caller's evaluations will hold: only the loops those use are
+        compiled (the serial one below 64 designs, the threaded one from 64; each is a
+        compile of its own, half the cold cost of a one-design ``query --at``). None: both.
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
@@ -93,9 +98,88 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     from .pointwise import _PARALLEL_FROM, evaluate
 
     kw = dict(settings or {})
+    loops = sorted({1 if n < _PARALLEL_FROM else _PARALLEL_FROM
+                    for n in ((1, _PARALLEL_FROM) if sizes is None else sizes)})
 
     def call():
-        for n in (1, _PARALLEL_FROM):  # the serial and the threaded loop
+        for n in loops:  # the serial and/or the threaded loop
             evaluate(np.full(n, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
 
     return _timed(call, notice, after)
+
+
+def warm_up_codec(*, notice=None) -> float:
+    """Compile (or load from cache) the cube codec's byte shuffles (both loops), on a few
+    bytes. Returns the seconds [s] it took when a kernel compiled, else 0.0."""
+    import numpy as np
+
+    from ..kernels.bytes import shuffle_bytes
+
+    def call():
+        for size, n in ((8, 16), (3, 5)):  # the 8-byte word loop and the byte loop
+            src = np.zeros((n, size), dtype=np.uint8)
+            shuffle_bytes(src, np.empty((size, n), dtype=np.uint8))
+
+    return _timed(call, notice)
+
+
+def _tiny_config():
+    """A one-radius, one-design-a-axis sweep config (fig12's materials and model)."""
+    from ..config import parse_config
+
+    return parse_config({
+        "name": "warmup",
+        "grid": {"radius": {"values": [10], "units": "mm"},
+                 "wall_thickness": {"values": [2], "units": "mm"},
+                 "length": {"values": [90], "units": "mm"},
+                 "coil_index": {"values": [1.3]},
+                 "wrap_angle": {"values": [8], "units": "deg"}},
+        "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 2},
+                   "pressure": {"start": 0, "stop": 25, "num": 2, "units": "kPa"}},
+    })
+
+
+#: The kernels :func:`warm_up_kernels` compiles, in order: (name, what runs it, warm-up
+#: taking ``notice``). The closed-loop kernels (``simulate``) sit above the engine and are
+#: warmed by ``nylonflex warmup`` itself.
+KERNELS = (
+    ("grid", "sweeps (threaded)",
+     lambda notice: warm_up_grid(_tiny_config(), parallel=True, notice=notice)),
+    ("grid-serial", "Dask workers' slabs",
+     lambda notice: warm_up_grid(_tiny_config(), parallel=False, notice=notice)),
+    ("pointwise", "nylonflex.evaluate, design, query --at, sampled sweeps",
+     lambda notice: warm_up_points(notice=notice)),
+    ("codec", "the cube writer's byte shuffle", lambda notice: warm_up_codec(notice=notice)),
+)
+
+
+def warm_up_kernels(names=None, *, notice=None, progress=None) -> dict:
+    """Compile (or load from Numba's cache) every engine kernel once.
+
+    What a new install, a CI run or a Dask worker calls before the work, so that the
+    first sweep, ``query --at`` or sampled sweep does not compile (a Dask worker:
+    ``client.register_worker_callbacks(nylonflex.engine.warmup.warm_up_kernels)`` or
+    ``client.run(...)``; ``nylonflex warmup`` also warms the closed-loop kernels).
+
+    Parameters
+    ----------
+    names : iterable of str, optional
+        Names of :data:`KERNELS` to warm; None: all.
+    notice : callable, optional
+        Receives one line per kernel family that really compiles; None: a
+        :class:`~nylonflex.kernels.compiling.CompileWarning`.
+    progress : callable, optional
+        Called as ``progress(done, total, name)`` [kernels] after each kernel.
+
+    Returns
+    -------
+    dict of str to float
+        Seconds [s] each kernel's warm-up took when it compiled, else 0.0 (cached).
+    """
+    chosen = [k for k in KERNELS if names is None or k[0] in set(names)]
+    out = {}
+    for done, (name, _, warm) in enumerate(chosen, 1):
+        out[name] = warm(notice)
+        if progress is not None:
+            progress(done, len(chosen), name)
+    return out

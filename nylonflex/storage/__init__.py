@@ -5,13 +5,35 @@
 - :mod:`.journal`: the journal of finished slabs and the one-writer lock;
 - :mod:`.run`: a sweep into a file (the journaled sink of the engine's slab loop, resume);
 - :mod:`.reader`: :func:`open_cube` and friends.
+
+The names below are imported from their modules on first use (PEP 562), so that reading a
+cube (``nylonflex info``) does not import the engine that writes one, nor Numba.
 """
 
-from ..engine.provenance import CUBE_FORMAT, VOLATILE_ATTRS
-from .cube import CubeFile
-from .journal import Journal, exclusive
-from .reader import check_cube, cube_attrs, cube_summary, open_cube
-from .run import CubeSink, DiskFull, Interrupted, sweep_to_file
+from __future__ import annotations
 
-__all__ = ["CUBE_FORMAT", "VOLATILE_ATTRS", "CubeFile", "CubeSink", "DiskFull", "Interrupted", "Journal",
-           "check_cube", "cube_attrs", "cube_summary", "exclusive", "open_cube", "sweep_to_file"]
+import importlib
+
+#: Each public name -> the module of this package (or the engine's) that defines it.
+_WHERE = {
+    "CUBE_FORMAT": "..engine.provenance", "VOLATILE_ATTRS": "..engine.provenance",
+    "CubeFile": ".cube",
+    "Journal": ".journal", "exclusive": ".journal",
+    "check_cube": ".reader", "cube_attrs": ".reader", "cube_summary": ".reader",
+    "open_cube": ".reader",
+    "CubeSink": ".run", "DiskFull": ".run", "Interrupted": ".run", "sweep_to_file": ".run",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name):
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE))

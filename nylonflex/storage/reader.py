@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engine.provenance import is_complete
 from ..units import InputError
-from ..variables import AXES, CURVES, DESIGN, UNCERTAIN
+from ..variables import AXES, CURVES, DESIGN, UNCERTAIN, is_complete
 from .cube import require_filters
 from .journal import Journal
 
@@ -131,20 +130,67 @@ def portable_encoding(encoding: dict) -> dict:
     return out
 
 
-def _validity_lines(ds) -> list[str]:
-    """How many designs carry each validity bit (docs/model.md s. 17), per model."""
-    if "validity" not in ds:
+def _validity_lines(f, h5, done) -> list[str]:
+    """How many designs carry each validity bit (docs/model.md s. 17), per model.
+
+    ``f`` is the open cube (h5netcdf), ``h5`` the same file in h5py (its data reads
+    fast), ``done`` the radii computed (bool). Counted from a
+    histogram of the flag bytes, radius slab by radius slab (one chunk row at a time): no
+    copy of the flags wider than a byte, memory bounded by one slab.
+    """
+    if "validity" not in f.variables:
         return []
-    v = ds["validity"].values
-    v = v[~np.isnan(v)].astype(np.int64) if v.dtype.kind == "f" else v.astype(np.int64)
-    n = v.size or 1
-    meanings = str(ds["validity"].attrs.get("flag_meanings", "")).split()
-    bits = [int(x) for x in np.atleast_1d(ds["validity"].attrs.get("flag_masks", []))]
-    parts = [f"{name} {int(np.sum((v & bit) > 0)):,}" for bit, name in zip(bits, meanings)]
-    flagged = int(np.sum(v > 0))
-    per = " (counted over every model)" if "model" in ds.dims else ""
-    return [f"flagged   {flagged:,} of {v.size:,} design values ({100 * flagged / n:.1f} %)"
+    var = f.variables["validity"]
+    counts = _byte_histogram(h5["validity"], var.dimensions[:1] == ("radius",), done)
+    n_values = int(counts.sum())
+    n = n_values or 1
+    meanings = str(var.attrs.get("flag_meanings", "")).split()
+    bits = [int(x) for x in np.atleast_1d(var.attrs.get("flag_masks", []))]
+    values = np.arange(256, dtype=np.uint8)  # each byte's value as the variable stores it
+    values = (values.view(np.int8) if np.dtype(var.dtype).kind == "i" else values) \
+        .astype(np.int64)
+    parts = [f"{name} {int(counts[(values & bit) > 0].sum()):,}"
+             for bit, name in zip(bits, meanings)]
+    flagged = int(counts[values > 0].sum())
+    per = " (counted over every model)" if "model" in f.dimensions else ""
+    return [f"flagged   {flagged:,} of {n_values:,} design values ({100 * flagged / n:.1f} %)"
             f"{per}: " + ", ".join(parts)]
+
+
+def flag_histogram(flags, piece: int = 1 << 18) -> np.ndarray:
+    """How many of ``flags`` (an array of one-byte integers) hold each byte value [-].
+
+    Returns 256 counts, index ``b`` the unsigned byte ``b`` (an int8 -1 counts at 255):
+    ``np.bincount`` over a ``uint8`` view, a piece of ``piece`` bytes at a time (bincount
+    takes its input as intp: a piece's copy is 8 bytes a flag, never the whole array's).
+    """
+    flags = np.ascontiguousarray(flags)
+    if flags.dtype.itemsize != 1:
+        raise ValueError(f"flags: one-byte integers expected, not {flags.dtype}")
+    raw = flags.view(np.uint8).reshape(-1)
+    counts = np.zeros(256, dtype=np.int64)
+    for start in range(0, raw.size, piece):
+        counts += np.bincount(raw[start:start + piece], minlength=256)
+    return counts
+
+
+def _byte_histogram(dset, radial, done) -> np.ndarray:
+    """:func:`flag_histogram` of a one-byte h5py dataset, over the radii ``done`` when its
+    first axis is the radius (``radial``), read a few MB of whole chunk rows at a time."""
+    counts = np.zeros(256, dtype=np.int64)
+    if not dset.shape or not dset.size:
+        return counts
+    row = max(1, dset.size // dset.shape[0])
+    chunk = dset.chunks[0] if dset.chunks else 1
+    step = chunk * max(1, (4 << 20) // (row * chunk))
+    for start in range(0, dset.shape[0], step):
+        stop = min(start + step, dset.shape[0])
+        keep = done[start:stop] if radial else np.ones(stop - start, dtype=bool)
+        if not keep.any():
+            continue
+        block = dset[start:stop]
+        counts += flag_histogram(block if keep.all() else block[keep])
+    return counts
 
 
 def _masked(var, done):
@@ -261,52 +307,83 @@ def _check_dataset(path, name, dset, full):
 
 
 def cube_summary(path) -> list[str]:
-    """Lines that describe a cube: dims, ranges, variables, provenance, completeness."""
+    """Lines that describe a cube: dims, ranges, variables, provenance, completeness.
+
+    Read through h5netcdf (the netCDF-4 layout, no xarray, pandas or dask): the
+    coordinates, the attributes, ``slab_done`` and the flag bytes (:func:`_validity_lines`).
+    """
+    import h5netcdf
+    import h5py
+
     from ..variables import VARIABLES, to_display
 
     path = Path(path)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ds = open_cube(path, quiet=True)
-    a = ds.attrs
+    a = cube_attrs(path)
+    if a is None:
+        if not path.exists():
+            open_cube(path)  # the missing-cube message, with a journal's hint
+        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
+                         "written by 'nylonflex sweep')")
+    check_chunk_sizes(path)
+    require_filters(a.get("compression"))
     out = []
     complete = is_complete(a)
-    done = int(ds["slab_done"].sum())
-    out.append(f"cube      {path}")
-    # a spot check: the first chunk of each variable read ('info --check' reads all)
-    damaged = check_cube(path, full=False)
-    out.append(f"name      {str(a.get('name'))[:80]}   "
-               f"config sha256 {str(a.get('config_sha256', ''))[:16]}")
-    state = "DAMAGED" if damaged else "complete" if complete else "INCOMPLETE"
-    out.append(f"status    {state} ({done}/{ds.sizes['radius']} radii)")
-    out.extend(f"damaged   {line}" for line in damaged)
-    n = int(np.prod([ds.sizes[d] for d in AXES]))
-    out.append(f"designs   {n:,} = " + " x ".join(f"{ds.sizes[d]} {d}" for d in AXES))
-    if "model" in ds.dims:
-        out.append(f"models    {', '.join(str(m) for m in ds['model'].values)}")
-    if a.get("supply_voltage", "none") != "none":
-        out.append(f"supply    {a['supply_voltage']}")
-    try:
-        out.extend(_validity_lines(ds))
-    except (OSError, ValueError, RuntimeError):
-        out.append("flagged   (the validity flags cannot be read)")
-    out.append("axes")
-    for name in (*AXES, "stroke", "pressure"):
-        v = VARIABLES[name]
-        vals = to_display(name, ds[name].values)
-        unit = "" if v.display == "1" else f" {v.display}"
-        out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})")
-    out.append("variables")
-    for name in ds.data_vars:
-        if name == "slab_done":
-            continue
-        out.append(f"  {name:<18} ({', '.join(ds[name].dims)}) [{ds[name].attrs.get('units')}] "
-                   f"{ds[name].attrs.get('long_name')}")
+    with h5py.File(path, "r") as h5, h5netcdf.File(h5, "r") as f:
+        sizes = {name: int(size) for name, size in
+                 ((n, f.dimensions[n].size) for n in f.dimensions)}
+        done_flags = np.asarray(h5["slab_done"][...]).astype(bool)
+        done = int(np.sum(done_flags, dtype=np.int64))
+        out.append(f"cube      {path}")
+        # a spot check: the first chunk of each variable read ('info --check' reads all)
+        damaged = check_cube(path, full=False)
+        out.append(f"name      {str(a.get('name'))[:80]}   "
+                   f"config sha256 {str(a.get('config_sha256', ''))[:16]}")
+        state = "DAMAGED" if damaged else "complete" if complete else "INCOMPLETE"
+        out.append(f"status    {state} ({done}/{sizes['radius']} radii)")
+        out.extend(f"damaged   {line}" for line in damaged)
+        n = int(np.prod([sizes[d] for d in AXES]))
+        out.append(f"designs   {n:,} = " + " x ".join(f"{sizes[d]} {d}" for d in AXES))
+        if "model" in sizes:
+            out.append("models    " + ", ".join(
+                _text(m) for m in np.asarray(h5["model"][...]).reshape(-1)))
+        if a.get("supply_voltage", "none") != "none":
+            out.append(f"supply    {a['supply_voltage']}")
+        try:
+            out.extend(_validity_lines(f, h5, done_flags if not complete else
+                                       np.ones_like(done_flags)))
+        except (OSError, ValueError, RuntimeError):
+            out.append("flagged   (the validity flags cannot be read)")
+        out.append("axes")
+        for name in (*AXES, "stroke", "pressure"):
+            v = VARIABLES[name]
+            vals = to_display(name, np.asarray(h5[name][...]))
+            unit = "" if v.display == "1" else f" {v.display}"
+            out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})")
+        out.append("variables")
+        for name in _data_vars(f):
+            if name == "slab_done":
+                continue
+            var = f.variables[name]
+            out.append(f"  {name:<18} ({', '.join(var.dimensions)}) "
+                       f"[{_attr(var.attrs.get('units'))}] {_attr(var.attrs.get('long_name'))}")
     out.append("provenance")
     for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
                 "quadrature", "created", "run_seconds", "designs_per_second", "workers",
                 "scheduler"):
         if key in a:
             out.append(f"  {key:<18} {str(a[key])[:200]}")
-    ds.close()
     return out
+
+
+def _text(value) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _data_vars(f) -> list[str]:
+    """The data variables of an open netCDF-4 file, in file order, as xarray names them:
+    every variable that is neither a dimension's coordinate nor named in a variable's
+    ``coordinates`` attribute."""
+    named = set()
+    for var in f.variables.values():
+        named.update(str(_attr(var.attrs.get("coordinates", ""))).split())
+    return [n for n in f.variables if n not in f.dimensions and n not in named]
