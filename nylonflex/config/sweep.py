@@ -24,7 +24,7 @@ import yaml
 from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
 
 from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
-from ..requirements import parse_requirements
+from ..query.parse import parse_requirements
 from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import INPUTS, VARIABLES
