@@ -19,10 +19,10 @@ PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 LAYERS = {
     "_version": 0, "units": 0, "safe_yaml": 0.05, "files": 0.05, "examples": 0.05, "variables": 0.1,
     "material_files": 0.15, "materials": 0.2, "query.parse": 0.25, "config": 0.3,
-    "physics": 1, "reference": 1,
+    "physics": 1,
     "kernels": 2,
     "engine": 3, "simconfig": 3, "simulate": 3.1,
-    "storage": 4, "charts": 4, "charts_sim": 4, "charts_fit": 4, "query": 4,
+    "storage": 4, "charts": 4, "query": 4,
     "sweep": 4.5, "fe": 4.5, "charts_ahead": 4.5, "bench": 5, "bench_numpy": 4.9, "calibration": 5, "design": 5, "explore": 5, "explore_page": 5.1, "explore_html": 5.1,
     "uncertainty": 5, "schema": 5,
     "cli": 6,
@@ -130,7 +130,7 @@ def test_physics_imports_no_numba_xarray_matplotlib():
 
 def test_charts_compute_no_physics():
     for path, module, target in _edges():
-        if _unit(module) in ("charts", "charts_sim"):
+        if _unit(module) == "charts":
             assert _unit(target) not in ("physics", "kernels", "engine"), (module, target)
 
 
@@ -143,3 +143,19 @@ def test_the_contract_fails_when_an_arrow_runs_back(tmp_path, monkeypatch):
             test_imports_point_down()
     finally:
         bad.unlink()
+
+
+def test_no_pyplot_and_no_backend_switch_in_the_package():
+    # figures are matplotlib.figure.Figure objects: a notebook user's backend and pyplot
+    # state are left alone (no matplotlib.use, no pyplot import)
+    found = []
+    for path, module in _modules():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                names = [a.name for a in node.names] + [getattr(node, "module", None) or ""]
+                if any(n == "matplotlib.pyplot" or n == "pyplot" for n in names):
+                    found.append(f"{module} imports pyplot")
+            elif isinstance(node, ast.Attribute) and node.attr == "use" and \
+                    isinstance(node.value, ast.Name) and node.value.id == "matplotlib":
+                found.append(f"{module} calls matplotlib.use")
+    assert not found, "; ".join(found)

@@ -2,8 +2,9 @@
 
 Charts read the :class:`xarray.Dataset` only; they never compute physics. Every axis label
 comes from the variable registry (:mod:`nylonflex.variables`) in the unit a designer reads
-(mm, deg, kPa, N), and every title names the slice of the cube it shows. matplotlib is
-imported lazily with the headless Agg backend (after ``xarray/plot/utils.py``).
+(mm, deg, kPa, N), and every title names the slice of the cube it shows. Figures are
+:class:`matplotlib.figure.Figure` objects made without pyplot (:func:`new_figure`): drawing
+never switches the caller's backend nor leaves figures in pyplot's state.
 
 Each chart is a function ``f(ds, **slice) -> matplotlib.figure.Figure``; the keyword
 arguments choose the slice in SI (default: the grid values nearest the paper's choices), and
@@ -23,16 +24,15 @@ from ..config import CHARTS as _CHART_NAMES
 from ..files import save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
-# _figure, _plt and _RC are shared with the uncertainty and design charts
-from ._common import FORMATS, _RC, _figure, _grid_value, _plt  # noqa: F401
+from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
 from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
 from .fig12 import fig12a, fig12b, fig12c
 from .maps import design_map, feasibility_map
 
-__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "design_map",
+__all__ = ["CHARTS", "FORMATS", "RC", "SLICE_AXES", "chart_slice", "compare", "design_map",
            "draw_charts", "feasibility_map", "fig4", "fig6", "fig7", "fig12a", "fig12b",
-           "fig12c"]
+           "fig12c", "new_figure", "rc_context"]
 
 
 #: Chart name -> function, the names a config's ``charts`` list accepts.
@@ -279,16 +279,16 @@ def warm_up():
     (0.3-0.5 s) at a process's first indexing when dask is installed, which each
     drawing process would otherwise do again.
     """
+    import matplotlib.backends.backend_agg  # noqa: F401  (the PNG canvas)
+    import matplotlib.figure  # noqa: F401
     import xarray as xr
 
-    _plt()
     xr.DataArray(np.zeros(2), dims="x").isel(x=0)
 
 
 def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
     """Draw chart ``name`` (of ``model``'s slice of a cube of several) into ``path``."""
-    plt = _plt()
-    with plt.rc_context(_RC):
+    with rc_context():
         # a cube of several models: each figure once a model, its name in title and file
         one = ds if model is None else ds.sel(model=model, drop=True)
         fig = CHARTS[name](one, **kwargs)
@@ -304,5 +304,4 @@ def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
                 "svg": {"Date": None}}[fmt]
         extra = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
         save_figure(fig, path, format=fmt, metadata=meta, **extra)
-        plt.close(fig)
     return path
