@@ -23,7 +23,7 @@ LAYERS = {
     "kernels": 2,
     "engine": 3, "simconfig": 3, "simulate": 3.1,
     "storage": 4, "charts": 4, "query": 4,
-    "sweep": 4.5, "fe": 4.5, "charts_ahead": 4.5, "bench": 5, "bench_numpy": 4.9, "calibration": 5, "design": 5, "explore": 5, "explore_page": 5.1, "explore_html": 5.1,
+    "sweep": 4.5, "fe": 4.5, "bench": 5, "bench_numpy": 4.9, "calibration": 5, "design": 5, "explore": 5, "explore_page": 5.1, "explore_html": 5.1,
     "uncertainty": 5, "schema": 5,
     "cli": 6,
 }
