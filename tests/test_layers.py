@@ -13,18 +13,20 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 
 #: Layer of each top-level module or subpackage, lowest first. Same-layer imports are
-#: allowed only inside one subpackage. A module of a subpackage may sit lower than its
-#: package (``query.parse``, the condition grammar the config reads, needs only units and
-#: variables); its package may import it, it imports nothing of its package.
+#: allowed only inside one subpackage. A module of a subpackage may have a layer of its own:
+#: lower than its package (``query.parse``, the condition grammar the config reads, needs
+#: only units and variables; ``config.safe_yaml`` and ``config.material_files``, which the
+#: materials read) or higher (``config.schema``, the JSON Schema of every config).
 LAYERS = {
-    "_version": 0, "units": 0, "safe_yaml": 0.05, "files": 0.05, "examples": 0.05, "variables": 0.1,
-    "material_files": 0.15, "materials": 0.2, "query.parse": 0.25, "config": 0.3,
+    "_version": 0, "units": 0, "config.safe_yaml": 0.05, "files": 0.05, "examples": 0.05,
+    "variables": 0.1, "config.material_files": 0.15, "materials": 0.2, "query.parse": 0.25,
+    "config": 0.3,
     "physics": 1,
     "kernels": 2,
     "engine": 3, "simconfig": 3, "simulate": 3.1,
     "storage": 4, "charts": 4, "query": 4,
     "sweep": 4.5, "fe": 4.5, "bench": 5, "bench_numpy": 4.9, "calibration": 5, "design": 5, "explore": 5, "explore_page": 5.1, "explore_html": 5.1,
-    "uncertainty": 5, "schema": 5,
+    "uncertainty": 5, "config.schema": 5,
     "cli": 6,
 }
 

@@ -25,7 +25,7 @@ from pydantic import BeforeValidator, ValidationError, field_validator, model_va
 
 from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
-from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
+from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import INPUTS, VARIABLES
 from .base import (
@@ -394,7 +394,7 @@ def apply_overrides(raw: dict, overrides) -> dict:
 
 def load_config(path, overrides=()) -> ResolvedConfig:
     """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
-    from ..material_files import anchor_material_files
+    from .material_files import anchor_material_files
 
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     return parse_config(apply_overrides(raw, overrides), str(path))
