@@ -51,6 +51,19 @@ def test_chart_names_are_the_configs():
     assert tuple(charts.CHARTS) == CHARTS
 
 
+def test_every_chart_function_is_the_registrys():
+    # one registry (config/charts.py): the functions, what each needs, how it is drawn
+    from nylonflex.config.charts import CHART_REGISTRY
+
+    assert tuple(CHART_REGISTRY) == CHARTS
+    for name, chart in CHART_REGISTRY.items():
+        assert charts.CHARTS[name] is getattr(charts, name)
+        assert chart.load() is charts.CHARTS[name]
+        assert charts.NEEDS[name] == chart.needs
+    # one figure holds every model in fig12b, fig12c and compare (docs/model.md s. 16)
+    assert charts.ALL_MODELS == ("fig12b", "fig12c", "compare")
+
+
 # charts of a plain cube; feasibility_map needs a sampled cube (tests/test_uncertainty.py)
 PLAIN_CHARTS = tuple(n for n in CHARTS if n != "feasibility_map")
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import CHARTS as _CHART_NAMES
+from ..config.charts import CHART_REGISTRY
 from ..files import save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
@@ -35,37 +35,24 @@ __all__ = ["CHARTS", "FORMATS", "RC", "SLICE_AXES", "chart_slice", "compare", "d
            "fig12c", "new_figure", "rc_context"]
 
 
-#: Chart name -> function, the names a config's ``charts`` list accepts.
-CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
-          "fig6": fig6, "fig7": fig7, "design_map": design_map,
-          "feasibility_map": feasibility_map, "compare": compare}
-assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
-
-
+#: Chart name -> function, the names a config's ``charts`` list accepts (the registry's,
+#: :data:`nylonflex.config.charts.CHART_REGISTRY`, in its order).
+CHARTS = {name: chart.load() for name, chart in CHART_REGISTRY.items()}
 #: Axes each chart draws along: a cube with a single value there cannot show it.
-NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
-         "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
-         "design_map": ("radius", "wall_thickness"),
-         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",)}
+NEEDS = {name: chart.needs for name, chart in CHART_REGISTRY.items()}
+#: Drawing time of each chart relative to fig4's: the longest are drawn first.
+COST = {name: chart.cost for name, chart in CHART_REGISTRY.items()}
+#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
+ALL_MODELS = tuple(name for name, chart in CHART_REGISTRY.items() if not chart.per_model)
 
 
 def _unmet(ds, name):
-    if name == "feasibility_map" and "feasibility" not in ds:
-        return "feasibility_map skipped: the cube has no feasibility (no 'requirements')"
-    short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
+    chart = CHART_REGISTRY[name]
+    if chart.variable is not None and chart.variable not in ds:
+        return f"{name} skipped: the cube has no {chart.variable} (no 'requirements')"
+    short = [axis for axis in chart.needs if ds.sizes[axis] < 2]
     return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
             "has 1") if short else None
-
-
-#: Drawing time of each chart relative to fig4's (the fig12 cube, this machine): the drawing
-#: processes take the longest first, so that none is left drawing alone at the end.
-COST = {"design_map": 4.0, "feasibility_map": 4.0, "fig12c": 3.2, "fig12b": 2.3,
-        "fig12a": 1.9, "fig7": 1.5, "fig6": 1.5, "compare": 1.2, "fig4": 1.0}
-assert set(COST) == set(CHARTS), "every chart needs a drawing cost"
-
-
-#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
-ALL_MODELS = ("fig12b", "fig12c", "compare")
 
 
 #: Axes a chart slice (``--at``) may fix.
@@ -204,7 +191,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         nylonflex did not write for this cube.
     """
     if not names:  # every chart the cube can show (feasibility only with requirements)
-        names = [n for n in CHARTS if n != "feasibility_map" or "feasibility" in ds]
+        names = [n for n, c in CHART_REGISTRY.items()
+                 if c.variable is None or c.variable in ds]
     names = list(names)
     unknown = [n for n in names if n not in CHARTS]
     if unknown:

@@ -46,12 +46,12 @@ def _materials(out):
 
 
 def _charts(out):
-    from ..charts import CHARTS, NEEDS
+    from ..config.charts import CHART_REGISTRY
 
     print("charts (config 'charts:' list, 'nylonflex chart CUBE --figure NAME'):", file=out)
-    for name, func in CHARTS.items():
-        print(f"  {name:<11} {_first_line(func.__doc__)} (needs 2+ values of "
-              f"{' and '.join(NEEDS[name])})", file=out)
+    for name, chart in CHART_REGISTRY.items():
+        print(f"  {name:<11} {_first_line(chart.load().__doc__)} (needs 2+ values of "
+              f"{' and '.join(chart.needs)})", file=out)
 
 
 def _variables(out):

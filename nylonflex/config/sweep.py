@@ -28,6 +28,7 @@ from ..query.parse import parse_requirements
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import INPUTS, VARIABLES
+from .charts import CHART_REGISTRY
 from .base import (
     Count,
     Number,
@@ -43,9 +44,8 @@ from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
 __all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", "cube_bytes",
            "load_config", "load_yaml", "parse_config", "range_error"]
 
-#: Figures a sweep config may name under ``charts``.
-CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
-          "feasibility_map", "compare")
+#: Figures a sweep config may name under ``charts`` (the chart registry's names).
+CHARTS = tuple(CHART_REGISTRY)
 
 
 
