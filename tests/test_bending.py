@@ -6,7 +6,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import dblquad
 
-import naive as ref
+from nylonflex import reference as ref
 from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
 from nylonflex.physics import bending, silicone
 

@@ -21,7 +21,7 @@ LAYERS = {
     "_version": 0, "units": 0, "config.safe_yaml": 0.05, "files": 0.05, "examples": 0.05,
     "variables": 0.1, "config.material_files": 0.15, "materials": 0.2, "query.parse": 0.25,
     "config": 0.3,
-    "physics": 1,
+    "physics": 1, "reference": 1,
     "kernels": 2,
     "engine": 3, "simconfig": 3, "simulate": 3.1,
     "storage": 4, "charts": 4, "query": 4,

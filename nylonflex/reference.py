@@ -1,5 +1,4 @@
-"""Slow, obviously right references for the fast solvers (like stumpy's ``tests/naive.py``;
-used by the tests only).
+"""Slow, obviously right references for the fast solvers (like stumpy's ``tests/naive.py``).
 
 Adaptive scipy quadrature of docs/model.md section 6's double integral exactly as written (no
 change of variables), bracketing root finders, and nothing shared with nylonflex's solvers
