@@ -555,7 +555,7 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
 def load_sim_config(path) -> SimConfig:
     """Read and validate a simulation config file (YAML); material files are read relative
     to its folder."""
-    from .material_files import anchor_material_files
+    from .config.material_files import anchor_material_files
 
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     return parse_sim_config(raw, str(path))

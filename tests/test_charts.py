@@ -51,10 +51,26 @@ def test_chart_names_are_the_configs():
     assert tuple(charts.CHARTS) == CHARTS
 
 
+def test_every_chart_function_is_the_registrys():
+    # one registry (config/charts.py): the functions, what each needs, how it is drawn
+    from nylonflex.config.charts import CHART_REGISTRY
+
+    assert tuple(CHART_REGISTRY) == CHARTS
+    for name, chart in CHART_REGISTRY.items():
+        assert charts.CHARTS[name] is getattr(charts, name)
+        assert chart.load() is charts.CHARTS[name]
+        assert charts.NEEDS[name] == chart.needs
+    # one figure holds every model in fig12b, fig12c and compare (docs/model.md s. 16)
+    assert charts.ALL_MODELS == ("fig12b", "fig12c", "compare")
+
+
 # charts of a plain cube; feasibility_map needs a sampled cube (tests/test_uncertainty.py),
 # the dynamics charts a supply (tests/test_dynamics.py)
+from nylonflex.config.charts import CHART_REGISTRY as _REGISTRY  # noqa: E402
+
+CHART_VARIABLE = {n: c.variable for n, c in _REGISTRY.items()}
 PLAIN_CHARTS = tuple(n for n in CHARTS if n != "feasibility_map"
-                     and n not in charts.DYNAMIC_CHARTS)
+                     and CHART_VARIABLE.get(n) is None)
 
 
 @pytest.mark.parametrize("name", PLAIN_CHARTS)

@@ -17,7 +17,7 @@ import nylonflex as nf
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.design import nondominated, parse_spec, run_design
-from nylonflex.query import Condition
+from nylonflex.query import parse_condition
 from nylonflex.sweep import run_sweep
 from nylonflex.units import InputError
 from nylonflex.variables import AXES, DESIGN, SUPPLY_ONLY, VARIABLES, to_display
@@ -72,7 +72,7 @@ def test_paper_first_question_meets_every_constraint_and_gives_1p2_newton(ds):
     res = run_design(spec([{"max": "tip_force_max"}], PAPER_Q1, refine=True), cube=ds)
     best = res.designs[0]
     for c in PAPER_Q1:
-        assert Condition(c).mask(np.array([best[Condition(c).name]]))[0], c
+        assert parse_condition(c).mask(np.array([best[parse_condition(c).name]]))[0], c
     # section 4: 1.2 N; the grid's best is (20 mm, 6 mm), a corner of the constraints
     assert best["tip_force_max"] >= 1.2
     grid_best = [d for d in res.designs if d["source"] == "grid"][0]
@@ -151,7 +151,7 @@ def test_refined_front_is_not_dominated_by_a_dense_brute_force(ds):
     d = nf.evaluate(*X)
     ok = np.ones(X[0].size, bool)
     for c in cons:
-        cond = Condition(c)
+        cond = parse_condition(c)
         ok &= cond.mask(d[cond.name] if cond.name in d else X[AXES.index(cond.name)])
     r, f = X[0][ok], d["tip_force_max"][ok]
     for radius, force in zip(front["radius"], front["tip_force_max"]):
@@ -216,7 +216,7 @@ def test_no_returned_design_violates_a_constraint(tiny):
         res = run_design(spec(objectives, constraints, refine), cube=ds)
         for d in res.designs:
             for c in constraints:
-                cond = Condition(c)
+                cond = parse_condition(c)
                 assert cond.mask(np.array([d[cond.name]]))[0], (c, d)
         if not res.designs:
             assert res.reasons
@@ -346,7 +346,7 @@ def test_resolution_gives_only_buildable_rechecked_distinct_designs(ds, objectiv
         exact = nf.evaluate(*(d[a] for a in AXES))  # re-checked: the exact model's values
         assert d["tip_force_max"] == exact["tip_force_max"]
         for c in constraints:
-            assert Condition(c).mask(np.array([d[Condition(c).name]]))[0], (c, d)
+            assert parse_condition(c).mask(np.array([d[parse_condition(c).name]]))[0], (c, d)
     F = [tuple(d[o.name] for o in res.spec.objectives) for d in res.designs]
     assert len(set(F)) == len(F)  # no two rows equal in every objective
     if len(objectives) == 1:  # the best on-resolution design is no better than the free one

@@ -241,7 +241,7 @@ def test_a_fit_thermal_file_replaces_both_constants_and_refuses_a_cooling_set(tm
     # same at every coil index (resistance_coil_index 0); cooling: beside it is refused
     from nylonflex.calibration import fit_thermal
     from nylonflex.config import parse_config
-    from nylonflex.material_files import write_material_file
+    from nylonflex.config.material_files import write_material_file
 
     lm, v, r_meas, lam, cap = 0.3, 5.0, 40.0, 0.05, 0.45
     t = np.linspace(0.0, 60.0, 40)

@@ -190,6 +190,9 @@ def test_curvature_solve_stops_after_one_evaluation_from_a_close_start(monkeypat
     assert len(evaluations) == 1
 
 
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="reads the compiled code "
+                    "(.ci/run runs this file with NUMBA_DISABLE_JIT=1 to measure the "
+                    "kernels' Python bodies)")
 def test_section_moment_compiles_to_a_loop_without_calls_to_log_or_exp():
     # the condition for LLVM to vectorise it: this llvmlite has no vector log or exp (SVML)
     @numba.njit(error_model="numpy")

@@ -14,7 +14,7 @@ from conftest import DEG, EXAMPLE_1, EXAMPLE_2
 from nylonflex.config import parse_config
 from nylonflex.physics import nylon, thermal, wrap
 from nylonflex.physics.bending import _material_moment_of, quadrature_nodes
-from nylonflex.physics.chamber import _gauge_pressure, _gauge_pressure_wall, _solid_fraction
+from nylonflex.physics.chamber import P_ATM, _gauge_pressure, _gauge_pressure_wall, _solid_fraction
 from nylonflex.physics.limits import MODELS, design_limits as python_loop
 from nylonflex.variables import SUPPLY_ONLY
 from nylonflex.physics.nylon import _temperature_for_stroke
@@ -258,3 +258,22 @@ def test_a_supply_cube_is_asked_with_its_supply(tmp_path):
     exact = nf.evaluate(**at, supply_voltage=12.0)
     assert res.data["limit"][0] == exact["limit"] == 2
     assert res.data["tip_force_max"][0] == float(exact["tip_force_max"])
+
+
+def test_the_grid_kernels_paper_eq10_force_takes_the_equibiaxial_hoop_stress():
+    # the grid kernel computes paper_eq10's S_theta(s) in a branch of its own
+    # (kernels/design.py); F_n = (p a + |S_theta| t) pitch / cos psi (paper eq. 9), so the
+    # ratio of paper_eq10's F_n to the paper's at one design and stroke is
+    # (p a + |S_eq10| t) / (p a + |S_paper| t), with p = p(s) of Boyle's law
+    paper = run_sweep(parse_config(SMALL))
+    eq10 = run_sweep(parse_config({**SMALL, "model": "paper_eq10"}))
+    s = eq10["stroke"].values
+    a = eq10["radius"].values[:, None, None, None, None]
+    t = eq10["wall_thickness"].values[None, :, None, None, None]
+    p = np.array([_gauge_pressure(x, P_ATM) for x in s])
+    s10 = np.array([abs(_equibiaxial_stress_and_slope(1 - x, MU, ALPHA)[0]) for x in s])
+    sp = np.array([abs(_stress_and_slope(1 - x, MU, ALPHA)[0]) for x in s])
+    f_paper = paper["nylon_force"].values
+    expected = f_paper * (p * a + s10 * t) / np.where(p * a + sp * t > 0, p * a + sp * t, 1)
+    np.testing.assert_allclose(eq10["nylon_force"].values, expected, rtol=1e-12, atol=1e-15)
+    assert not np.allclose(eq10["nylon_force"].values[..., 1:], f_paper[..., 1:], rtol=1e-6)

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..units import InputError, parse_quantity
 from .data import Table, column, read_table
-from ..material_files import anchor_material_files
+from ..config.material_files import anchor_material_files
 from ..variables import VARIABLES
 
 __all__ = ["Comparison", "validate_design", "design_from_config"]

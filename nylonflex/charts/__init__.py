@@ -2,8 +2,9 @@
 
 Charts read the :class:`xarray.Dataset` only; they never compute physics. Every axis label
 comes from the variable registry (:mod:`nylonflex.variables`) in the unit a designer reads
-(mm, deg, kPa, N), and every title names the slice of the cube it shows. matplotlib is
-imported lazily with the headless Agg backend (after ``xarray/plot/utils.py``).
+(mm, deg, kPa, N), and every title names the slice of the cube it shows. Figures are
+:class:`matplotlib.figure.Figure` objects made without pyplot (:func:`new_figure`): drawing
+never switches the caller's backend nor leaves figures in pyplot's state.
 
 Each chart is a function ``f(ds, **slice) -> matplotlib.figure.Figure``; the keyword
 arguments choose the slice in SI (default: the grid values nearest the paper's choices), and
@@ -19,65 +20,41 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import CHARTS as _CHART_NAMES
+from ..config.charts import CHART_REGISTRY
 from ..files import save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
-# _figure, _plt and _RC are shared with the uncertainty and design charts
-from ._common import FORMATS, _RC, _figure, _grid_value, _plt  # noqa: F401
+from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
 from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
 from .dynamics import cycle_rate_lines, cycle_rate_map, force_rate
 from .fig12 import fig12a, fig12b, fig12c
 from .maps import design_map, feasibility_map
 
-__all__ = ["CHARTS", "FORMATS", "SLICE_AXES", "chart_slice", "compare", "cycle_rate_lines",
+__all__ = ["CHARTS", "FORMATS", "RC", "SLICE_AXES", "chart_slice", "compare", "cycle_rate_lines",
            "cycle_rate_map", "design_map", "force_rate",
            "draw_charts", "feasibility_map", "fig4", "fig6", "fig7", "fig12a", "fig12b",
-           "fig12c"]
+           "fig12c", "new_figure", "rc_context"]
 
 
-#: Chart name -> function, the names a config's ``charts`` list accepts.
-CHARTS = {"fig12a": fig12a, "fig12b": fig12b, "fig12c": fig12c, "fig4": fig4,
-          "fig6": fig6, "fig7": fig7, "design_map": design_map,
-          "feasibility_map": feasibility_map, "compare": compare,
-          "cycle_rate_map": cycle_rate_map, "cycle_rate_lines": cycle_rate_lines,
-          "force_rate": force_rate}
-assert tuple(CHARTS) == tuple(_CHART_NAMES), "charts and config.CHARTS disagree"
-
-
+#: Chart name -> function, the names a config's ``charts`` list accepts (the registry's,
+#: :data:`nylonflex.config.charts.CHART_REGISTRY`, in its order).
+CHARTS = {name: chart.load() for name, chart in CHART_REGISTRY.items()}
 #: Axes each chart draws along: a cube with a single value there cannot show it.
-NEEDS = {"fig12a": ("stroke",), "fig12b": ("radius",), "fig12c": ("radius",),
-         "fig4": ("stroke",), "fig6": ("pressure",), "fig7": ("pressure",),
-         "design_map": ("radius", "wall_thickness"),
-         "feasibility_map": ("radius", "wall_thickness"), "compare": ("radius",),
-         "cycle_rate_map": ("radius", "wrap_angle"), "cycle_rate_lines": ("radius",),
-         "force_rate": ()}
-
-#: Charts of the per-design dynamics: only for a cube with a supply (docs/model.md s. 20).
-DYNAMIC_CHARTS = ("cycle_rate_map", "cycle_rate_lines", "force_rate")
+NEEDS = {name: chart.needs for name, chart in CHART_REGISTRY.items()}
+#: Drawing time of each chart relative to fig4's: the longest are drawn first.
+COST = {name: chart.cost for name, chart in CHART_REGISTRY.items()}
+#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
+ALL_MODELS = tuple(name for name, chart in CHART_REGISTRY.items() if not chart.per_model)
 
 
 def _unmet(ds, name):
-    if name == "feasibility_map" and "feasibility" not in ds:
-        return "feasibility_map skipped: the cube has no feasibility (no 'requirements')"
-    if name in DYNAMIC_CHARTS and "cycle_rate" not in ds:
-        return f"{name} skipped: the cube has no cycle_rate (its sweep had no 'supply')"
-    short = [axis for axis in NEEDS[name] if ds.sizes[axis] < 2]
+    chart = CHART_REGISTRY[name]
+    if chart.variable is not None and chart.variable not in ds:
+        return f"{name} skipped: the cube has no {chart.variable} ({chart.absent})"
+    short = [axis for axis in chart.needs if ds.sizes[axis] < 2]
     return (f"{name} skipped: it needs at least 2 values of {' and '.join(short)}; the cube "
             "has 1") if short else None
-
-
-#: Drawing time of each chart relative to fig4's (the fig12 cube, this machine): the drawing
-#: processes take the longest first, so that none is left drawing alone at the end.
-COST = {"design_map": 4.0, "feasibility_map": 4.0, "fig12c": 3.2, "fig12b": 2.3,
-        "fig12a": 1.9, "fig7": 1.5, "fig6": 1.5, "compare": 1.2, "fig4": 1.0,
-        "cycle_rate_map": 2.0, "force_rate": 2.0, "cycle_rate_lines": 1.2}
-assert set(COST) == set(CHARTS), "every chart needs a drawing cost"
-
-
-#: Charts that draw every model of a cube in one figure; the others are drawn once a model.
-ALL_MODELS = ("fig12b", "fig12c", "compare")
 
 
 #: Axes a chart slice (``--at``) may fix.
@@ -216,8 +193,8 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         nylonflex did not write for this cube.
     """
     if not names:  # every chart the cube can show (feasibility only with requirements)
-        names = [n for n in CHARTS if (n != "feasibility_map" or "feasibility" in ds)
-                 and (n not in DYNAMIC_CHARTS or "cycle_rate" in ds)]
+        names = [n for n, c in CHART_REGISTRY.items()
+                 if c.variable is None or c.variable in ds]
     names = list(names)
     unknown = [n for n in names if n not in CHARTS]
     if unknown:
@@ -292,16 +269,16 @@ def warm_up():
     (0.3-0.5 s) at a process's first indexing when dask is installed, which each
     drawing process would otherwise do again.
     """
+    import matplotlib.backends.backend_agg  # noqa: F401  (the PNG canvas)
+    import matplotlib.figure  # noqa: F401
     import xarray as xr
 
-    _plt()
     xr.DataArray(np.zeros(2), dims="x").isel(x=0)
 
 
 def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
     """Draw chart ``name`` (of ``model``'s slice of a cube of several) into ``path``."""
-    plt = _plt()
-    with plt.rc_context(_RC):
+    with rc_context():
         # a cube of several models: each figure once a model, its name in title and file
         one = ds if model is None else ds.sel(model=model, drop=True)
         fig = CHARTS[name](one, **kwargs)
@@ -317,5 +294,4 @@ def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
                 "svg": {"Date": None}}[fmt]
         extra = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
         save_figure(fig, path, format=fmt, metadata=meta, **extra)
-        plt.close(fig)
     return path

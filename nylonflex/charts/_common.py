@@ -1,6 +1,7 @@
 """What every chart shares: the palette and rc, the paper's worked examples, labels and
-titles from the variable registry, the grid-slice helpers, the footer and matplotlib's lazy
-import (Agg backend)."""
+titles from the variable registry, the grid-slice helpers, the footer, and
+:func:`new_figure`: a :class:`matplotlib.figure.Figure` made without pyplot, so drawing never
+changes a user's backend or pyplot state."""
 
 from __future__ import annotations
 
@@ -23,7 +24,8 @@ _FLAG_FILL = (0.55, 0.55, 0.55, 0.7)
 _DASHES = ((0, (6, 2)), (0, (3, 1.5)), (0, (1, 1.2)), (0, (6, 1.5, 1, 1.5)),
            (0, (10, 3)), (0, (2, 3)))
 
-_RC = {"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8.5,
+#: The charts' matplotlib style (sizes in points; ``savefig.dpi`` in dots per inch).
+RC = {"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8.5,
        "legend.title_fontsize": 8.5, "xtick.labelsize": 9, "ytick.labelsize": 9,
        "figure.titlesize": 11, "axes.grid": True, "grid.alpha": 0.3, "lines.linewidth": 1.6,
        "savefig.dpi": 200, "svg.fonttype": "none", "pdf.fonttype": 42}
@@ -35,23 +37,32 @@ _LENGTH_DEFAULT = 90e-3
 
 
 # ---------------------------------------------------------------------------- helpers
-def _plt():
-    import matplotlib
+def new_figure(nrows=1, ncols=1, size=(6.0, 4.2), rc=None, **kw):
+    """A new :class:`matplotlib.figure.Figure` and its ``(nrows, ncols)`` array of axes.
 
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    Built without pyplot: no figure manager, no global current figure, the caller's backend
+    untouched (a notebook keeps its own); the file format picks the canvas when the figure
+    is saved. ``size`` is in inches; ``rc`` (default :data:`RC`) styles what is created;
+    ``layout="constrained"`` unless ``kw`` says otherwise (``layout=None``).
+    """
+    from matplotlib import rc_context
+    from matplotlib.figure import Figure
 
-    return plt
-
-
-def _figure(nrows=1, ncols=1, size=(6.0, 4.2), **kw):
-    plt = _plt()
-    with plt.rc_context(_RC):
-        fig, axes = plt.subplots(nrows, ncols, figsize=size, layout="constrained",
-                                 squeeze=False, **kw)
+    layout = kw.pop("layout", "constrained")
+    with rc_context(RC if rc is None else rc):
+        fig = Figure(figsize=size, layout=layout)
+        axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
     return fig, axes
 
 
+def rc_context(rc=None):
+    """:func:`matplotlib.rc_context` of the charts' style (default :data:`RC`)."""
+    import matplotlib
+
+    return matplotlib.rc_context(RC if rc is None else rc)
+
+
+_figure = new_figure  # the name the chart modules of this package use
 
 
 def _text(name, si) -> str:
@@ -186,7 +197,7 @@ def _footer(fig, ds):
 
 
 def _suptitle(fig, title, subtitle):
-    fig.suptitle(f"{title}\n{subtitle}", fontsize=_RC["figure.titlesize"])
+    fig.suptitle(f"{title}\n{subtitle}", fontsize=RC["figure.titlesize"])
 
 
 def _stroke_max(ds):

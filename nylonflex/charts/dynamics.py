@@ -14,8 +14,8 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, to_display
-from ._common import (_COLOURS, _LENGTH_DEFAULT, _RC, _WRAP_DEFAULT, _coils, _eq, _footer,
-                      _label, _nearest)
+from ._common import (_COLOURS, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _footer,
+                      _label, _nearest, new_figure)
 
 __all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate"]
 
@@ -30,13 +30,8 @@ def _axes(ax, size):
     """``(fig, ax)``: the given axes and their figure, or a new figure (no pyplot)."""
     if ax is not None:
         return ax.figure, ax
-    from matplotlib.figure import Figure
-
-    import matplotlib
-
-    with matplotlib.rc_context(_RC):
-        fig = Figure(figsize=size, layout="constrained")
-        return fig, fig.add_subplot()
+    fig, axes = new_figure(size=size)
+    return fig, axes[0, 0]
 
 
 def _fixed(ds, free, **given):

@@ -11,7 +11,7 @@ from ..units import InputError
 from ..variables import to_display
 from ._common import (_EXAMPLES, _FLAG_FILL, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq,
                       _figure, _flag_text, _footer, _grid_value, _label, _nearest,
-                      _pick_few, _plt, _suptitle)
+                      _pick_few, _suptitle)
 
 
 # ---------------------------------------------------------------------------- design map
@@ -33,9 +33,9 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     -------
     matplotlib.figure.Figure
     """
+    from matplotlib import rc_context
     from matplotlib.patches import Patch
 
-    plt = _plt()
     length = _nearest(ds, "length", _LENGTH_DEFAULT if length is None else length)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
     coils = _coils(ds, coil_index)
@@ -65,7 +65,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
         ax.clabel(lines, fmt="%g N", fontsize=7.5)
         strength = np.where(np.isnan(lim), np.nan, (lim == 1).astype(float))
         if np.nanmax(np.nan_to_num(strength)) > 0:
-            with plt.rc_context({"hatch.color": "white", "hatch.linewidth": 0.8}):
+            with rc_context({"hatch.color": "white", "hatch.linewidth": 0.8}):
                 ax.contourf(x, y, strength, levels=[0.5, 1.5], colors="none",
                             hatches=["///"])
             ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
@@ -74,7 +74,7 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
                               .transpose("wall_thickness", "radius").values)
             if (v != 0).any():
                 bits |= int(np.bitwise_or.reduce(v[v != 0].astype(int)))
-                with plt.rc_context({"hatch.color": "k", "hatch.linewidth": 0.6}):
+                with rc_context({"hatch.color": "k", "hatch.linewidth": 0.6}):
                     ax.contourf(x, y, (v != 0).astype(float), levels=[0.5, 1.5],
                                 colors=[_FLAG_FILL], hatches=["\\\\"])
         for example in _map_examples(ds, length, psi, c):

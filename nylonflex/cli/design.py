@@ -35,7 +35,7 @@ def run(args) -> int:
         for line in summary(res)[1:]:  # machine formats: the explanation on stderr
             print(f"nylonflex design: {line.strip()}", file=sys.stderr)
     if args.chart:
-        from ..design.chart import draw_front
+        from ..charts.design import draw_front
 
         from pathlib import Path
 

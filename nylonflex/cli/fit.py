@@ -226,7 +226,7 @@ def run(args) -> int:
         write_material_file(res, args.out, name=args.name or None, overwrite=args.overwrite,
                             inputs=inputs)
     if args.chart:
-        from ..charts_fit import fit_chart
+        from ..charts.fit import fit_chart
 
         fit_chart(res, Path(args.chart) / f"fit_{args.kind}_{Path(args.data).stem}_"
                   f"{res.model}.png")

@@ -55,13 +55,13 @@ def _materials(out):
 
 
 def _charts(out):
-    from ..charts import CHARTS, DYNAMIC_CHARTS, NEEDS
+    from ..config.charts import CHART_REGISTRY
 
     print("charts (config 'charts:' list, 'nylonflex chart CUBE --figure NAME'):", file=out)
-    for name, func in CHARTS.items():
-        needs = [f"2+ values of {' and '.join(NEEDS[name])}"] if NEEDS[name] else []
-        needs += ["a supply"] if name in DYNAMIC_CHARTS else []
-        print(f"  {name:<11} {_first_line(func.__doc__)} (needs {', '.join(needs)})",
+    for name, chart in CHART_REGISTRY.items():
+        needs = [f"2+ values of {' and '.join(chart.needs)}"] if chart.needs else []
+        needs += [chart.needs_text] if chart.needs_text else []
+        print(f"  {name:<11} {_first_line(chart.load().__doc__)} (needs {', '.join(needs)})",
               file=out)
 
 

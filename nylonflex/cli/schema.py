@@ -6,7 +6,7 @@ HELP = "print the JSON Schema of a sweep, simulate or design config (for editors
 
 
 def add_arguments(p):
-    from ..schema import SCHEMAS
+    from ..config.schema import SCHEMAS
 
     p.add_argument("kind", choices=SCHEMAS, help="which config")
 
@@ -14,7 +14,7 @@ def add_arguments(p):
 def run(args) -> int:
     import json
 
-    from ..schema import json_schema
+    from ..config.schema import json_schema
 
     print(json.dumps(json_schema(args.kind), indent=2))
     return 0

@@ -46,7 +46,7 @@ def run(args) -> int:
                         max_designs=args.designs)
     if args.chart:
         path = Path(args.chart) / "sensitivity.png"
-        from ..uncertainty.chart import sensitivity_chart
+        from ..charts.sensitivity import sensitivity_chart
 
         sensitivity_chart(res, path)
         print(f"wrote {path}", file=sys.stderr)

@@ -25,7 +25,7 @@ def run(args) -> int:
     write_simulation(ds, out, inputs=[args.config])
     written = [str(out)]
     if not getattr(args, "no_charts", False):
-        from ..charts_sim import draw_simulation_charts
+        from ..charts.sim import draw_simulation_charts
 
         written += [str(p) for p in draw_simulation_charts(ds, out.parent, stem=out.stem)]
     for line in summary(cfg, ds):

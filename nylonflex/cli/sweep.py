@@ -50,19 +50,10 @@ def _progress(total, quiet):
 
 
 def run(args) -> int:
-    from contextlib import nullcontext
-
-    from ..charts_ahead import ChartsAhead
-
-    # the charts' process starts first, so that its imports (matplotlib, xarray, about a
-    # second) overlap the config and the sweep; it is ended at once if there is nothing
-    # to draw
-    charts = not (args.no_charts or args.dry_run)
-    with ChartsAhead() if charts else nullcontext() as ahead:
-        return _run(args, ahead)
+    return _run(args, charts=not (args.no_charts or args.dry_run))
 
 
-def _run(args, ahead) -> int:
+def _run(args, charts: bool) -> int:
     from contextlib import ExitStack
 
     from ..files import refuse_special
@@ -85,8 +76,6 @@ def _run(args, ahead) -> int:
             refuse_special(out, "--out")
             if args.dry_run:
                 return _dry_run(cfg, out, args, log)
-            if ahead is not None and not cfg.charts:
-                ahead.close()
             signals.enter_context(deferred_signals(on_second=_stop_at_once))
             unchanged = _up_to_date(cfg, out, args)
             prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
@@ -95,7 +84,7 @@ def _run(args, ahead) -> int:
                        scheduler=args.scheduler, progress=bar.update, log=log,
                        overwrite=args.overwrite)
     print(f"{out}  {cfg.n_designs:,} designs  complete")
-    if ahead is None or not cfg.charts:
+    if not charts or not cfg.charts:
         return 0
     from ._common import progress_bar
 
@@ -110,11 +99,24 @@ def _run(args, ahead) -> int:
     skip = lambda msg: print(f"nylonflex sweep: {msg}", file=sys.stderr)  # noqa: E731
     with progress_bar("charts", unit="chart", quiet=args.quiet, delay=0.0) as bar:
         # beside the cube: only this cube's earlier charts are replaced, others skipped
-        paths = ahead.draw(out, names, out.parent, "png", on_skip=skip,
-                           progress=bar, refuse_foreign=False)
+        paths = _draw(out, names, skip, bar)
     for path in paths:
         print(path)
     return 0
+
+
+def _draw(out, names, skip, progress) -> list:
+    """Draw the charts ``names`` of the complete cube ``out`` beside it; only this cube's
+    earlier charts are replaced (others are skipped, reported through ``skip``)."""
+    from ..charts import draw_charts
+    from ..storage import open_cube
+
+    ds = open_cube(out)
+    try:
+        return draw_charts(ds, names, out.parent, "png", on_skip=skip, progress=progress,
+                           refuse_foreign=False)
+    finally:
+        ds.close()
 
 
 def _up_to_date(cfg, out, args) -> bool:

@@ -29,7 +29,7 @@ def run(args) -> int:
     table = read_table(args.data)
     comps = validate_design(args.config, table)
     if args.chart:
-        from ..charts_fit import validate_chart
+        from ..charts.fit import validate_chart
 
         validate_chart(comps, Path(args.chart) / f"validate_{Path(args.data).stem}.png",
                        title=f"{Path(args.config).name} against {Path(args.data).name}")

@@ -25,10 +25,11 @@ from pydantic import BeforeValidator, ValidationError, field_validator, model_va
 
 from ..materials import Cooling, Nylon, Silicone, cooling_parameters, nylon_parameters, \
     silicone_parameters
-from ..requirements import parse_requirements
-from ..safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
+from ..query.parse import parse_requirements
+from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import INPUTS, VARIABLES
+from .charts import CHART_REGISTRY
 from .base import (
     Count,
     Number,
@@ -45,11 +46,8 @@ from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
 __all__ = ["CHARTS", "LIMITS", "SweepConfig", "apply_overrides", "check_range", "cube_bytes",
            "load_config", "load_yaml", "parse_config", "range_error"]
 
-#: Figures a sweep config may name under ``charts``.
-CHARTS = ("fig12a", "fig12b", "fig12c", "fig4", "fig6", "fig7", "design_map",
-          "feasibility_map", "compare",
-          # with a supply (issue 29; docs/model.md s. 20)
-          "cycle_rate_map", "cycle_rate_lines", "force_rate")
+#: Figures a sweep config may name under ``charts`` (the chart registry's names).
+CHARTS = tuple(CHART_REGISTRY)
 
 
 
@@ -428,7 +426,7 @@ def apply_overrides(raw: dict, overrides) -> dict:
 
 def load_config(path, overrides=()) -> ResolvedConfig:
     """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
-    from ..material_files import anchor_material_files
+    from .material_files import anchor_material_files
 
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     return parse_config(apply_overrides(raw, overrides), str(path))

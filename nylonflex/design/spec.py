@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..query import COLUMNS, Condition
+from ..query import COLUMNS, Condition, parse_constraint
 from ..variables import TRACKING
 from ..units import InputError
 from ..variables import AXES
@@ -116,16 +116,6 @@ def _objective(item, i) -> Objective:
         raise InputError(f"{where}: unknown name {name!r}; accepted: "
                          f"{', '.join(_OBJECTIVE_NAMES)}")
     return Objective(str(name), str(sense))
-
-
-def _constraint(text, i) -> Condition:
-    if not isinstance(text, str):
-        raise InputError(f"constraints[{i}]: expected a string like \"radius <= 20 mm\", "
-                         f"got {text!r}")
-    try:
-        return Condition(text)
-    except InputError as err:
-        raise InputError(str(err).replace("--where", f"constraints[{i}]", 1)) from None
 
 
 def _refine(value, multi):
@@ -242,7 +232,7 @@ def parse_spec(raw, source: str = "spec") -> DesignSpec:
         constraints = [constraints]
     if not isinstance(constraints, list):
         raise InputError("constraints: expected a list of strings like \"radius <= 20 mm\"")
-    constraints = tuple(_constraint(c, i) for i, c in enumerate(constraints))
+    constraints = tuple(parse_constraint(c, i) for i, c in enumerate(constraints))
     refine, starts, maxiter = _refine(raw.get("refine", True), len(objectives) > 1)
     loop = [n for n in (*names, *(c.name for c in constraints)) if n in TRACKING]
     if loop and (refine or raw.get("resolution")):

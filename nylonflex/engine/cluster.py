@@ -70,7 +70,7 @@ def _versions() -> dict:
     import numpy
 
     from .. import __version__
-    from ..kernels._compile import source_digest
+    from ..kernels import source_digest
 
     return {"nylonflex": __version__, "model": source_digest(), "numba": numba.__version__,
             "numpy": numpy.__version__}

@@ -22,7 +22,7 @@ import numpy as np
 from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
                          check_shear_modulus, nylon_parameters, silicone_kind,
                          silicone_parameters)
-from ..physics._formula import check_input, check_section, check_wrap_angle
+from ..physics import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)

@@ -86,7 +86,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
     import yaml
 
     from .. import __version__
-    from ..kernels._compile import source_digest
+    from ..kernels import source_digest
 
     def material(m):
         d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}

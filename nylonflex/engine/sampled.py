@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import ResolvedConfig, UncertaintySpec
-from ..requirements import parse_requirements
+from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
 from .pointwise import evaluate
 
@@ -186,7 +186,7 @@ def sample_statistics(out: dict, quantiles, requirements=()) -> dict:
         :func:`evaluate`'s result of shape (*D, S).
     quantiles : sequence of float
         Probability levels in (0, 1) [1].
-    requirements : sequence of str or Requirement
+    requirements : sequence of str or Condition
         All must hold; ``feasibility`` is the fraction of samples where they do [1].
 
     Returns

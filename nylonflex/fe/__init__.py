@@ -45,7 +45,7 @@ def require_felupe():
 
 
 def _design(radius, wall_thickness, length, base_thickness):
-    from ..physics._formula import check_input
+    from ..physics import check_input
 
     a = float(check_input("radius", radius))
     t = float(check_input("wall_thickness", wall_thickness))

@@ -11,23 +11,26 @@ LLVM ``bitcast`` each, with the same result.
 
 Numba's cache checks only the timestamp of the file that holds a kernel, not of the
 formulas it compiles in from other files, so the cache folder is keyed on a digest of every
-physics and kernel source: an edited formula can never run stale machine code.
+physics and kernel source (:mod:`.cache`): an edited formula can never run stale machine
+code. That folder is set only while a kernel is decorated (:func:`_kernel_cache_dir`); the
+process's own Numba setting is left as it was.
 """
 
 from __future__ import annotations
 
-import hashlib
 import importlib
 import os
 import pkgutil
 import types
-from functools import lru_cache
+from contextlib import contextmanager
 from pathlib import Path
 
 import numba
 from llvmlite import ir
 from numba.core import types as nb_types
 from numba.extending import intrinsic, overload, register_jitable
+
+from .cache import cache_dir
 
 
 def _import_numba_arraymath():
@@ -86,28 +89,19 @@ JIT_OPTIONS = {"cache": os.environ.get("NYLONFLEX_NO_CACHE") is None, "nogil": T
                "error_model": "numpy", "fastmath": False}
 
 
-@lru_cache(maxsize=1)
-def source_digest() -> str:
-    """Digest of every physics and kernel source file (16 hex digits)."""
-    root = Path(__file__).resolve().parents[1]
-    digest = hashlib.sha256()
-    for sub in ("physics", "kernels"):
-        for path in sorted((root / sub).glob("*.py")):
-            digest.update(path.name.encode())
-            digest.update(path.read_bytes())
-    return digest.hexdigest()[:16]
-
-
-def _cache_dir() -> str:
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
-        "nylonflex", "numba")
-    return os.path.join(base, source_digest())
-
-
-# Set before any kernel is decorated: numba reads it when a dispatcher's cache is created.
-# An unwritable folder makes numba fall back to its usual __pycache__ locations.
-numba.config.CACHE_DIR = _cache_dir()
+@contextmanager
+def _kernel_cache_dir():
+    """Numba's cache folder set to :func:`cache_dir` while a kernel is decorated, then put
+    back: Numba fixes a dispatcher's cache path when it is made, so the kernels cache under
+    the digest of their sources while the process's own setting (another library's kernels,
+    a notebook's) is left as it was. An unwritable folder makes Numba fall back to its
+    usual __pycache__ locations."""
+    saved = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = cache_dir()
+    try:
+        yield
+    finally:
+        numba.config.CACHE_DIR = saved
 
 
 def is_formula(obj) -> bool:
@@ -183,7 +177,8 @@ def jit_kernel(func=None, *, parallel=False):
             f = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__,
                                    f.__closure__)
             f.__qualname__ = f.__qualname__ + "_parallel"
-        return numba.njit(parallel=parallel, **JIT_OPTIONS)(f)
+        with _kernel_cache_dir():
+            return numba.njit(parallel=parallel, **JIT_OPTIONS)(f)
 
     return wrap if func is None else wrap(func)
 

@@ -27,6 +27,8 @@ from contextlib import contextmanager
 import numba
 from numba.core import event
 
+from .cache import cache_dir
+
 __all__ = ["FAMILIES", "MEASURED", "CompileWarning", "compile_seconds", "family",
            "notice_text", "notices_to"]
 
@@ -75,7 +77,7 @@ def family(dispatcher) -> str | None:
 
 def _record_path() -> str:
     # beside the digest-keyed cache folders: a changed model keeps the machine's figures
-    return os.path.join(os.path.dirname(numba.config.CACHE_DIR.rstrip(os.sep)),
+    return os.path.join(os.path.dirname(cache_dir().rstrip(os.sep)),
                         "compile_seconds.json")
 
 

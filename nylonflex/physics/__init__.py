@@ -3,7 +3,9 @@
 One module per domain: :mod:`.nylon` (stroke, coil-index table, eq. 1), :mod:`.thermal`
 (eq. 3), :mod:`.chamber` (Boyle), :mod:`.silicone` (Ogden), :mod:`.wrap` (wrap geometry and
 nylon force), :mod:`.bending` (moments, curvature, angle, tip force) and :mod:`.limits`
-(design limits). This package imports neither Numba, xarray nor matplotlib.
+(design limits); :func:`check_input` and its two shorthands check an input against the
+registry's range for callers above (the evaluator, the FE twin). This package imports
+neither Numba, xarray nor matplotlib.
 """
 
 from .bending import (
@@ -13,6 +15,7 @@ from .bending import (
     pressure_moment,
     tip_force,
 )
+from ._formula import check_input, check_section, check_wrap_angle
 from .chamber import P_ATM, chamber_pressure, volume_ratio
 from .limits import design_limits, stroke_limit
 from .nylon import (
@@ -46,6 +49,9 @@ __all__ = [
     "bending_stress",
     "cauchy_stress",
     "chamber_pressure",
+    "check_input",
+    "check_section",
+    "check_wrap_angle",
     "curvature",
     "design_limits",
     "free_strain",

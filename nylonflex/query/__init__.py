@@ -32,13 +32,15 @@ from .format import (_cell, _describe_at, _records, _sig3, _unit, flag_names,  #
                      format_csv, format_json, format_table, held_back, rows_note,
                      shown_columns)
 from .parse import (_FIELDS, _LIMIT_WORDS, _MODEL_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
-                    HEADLINE, INTERPOLATED, OPTIONAL, Condition, _parse_sort, _quantity,
-                    default_columns, parse_at, parse_columns, parse_where)
+                    HEADLINE, INTERPOLATED, OPS, OPTIONAL, Condition, _parse_sort,
+                    _quantity, default_columns, parse_at, parse_columns, parse_condition,
+                    parse_constraint, parse_requirements, parse_where)
 from .scan import (_GRID_RTOL, _SLAB_VALUES, QueryResult, _exact_rows,  # noqa: F401
                    _exact_settings, _locate, _select_model, _slab_rows, _sorted, at_value,
                    query_cube)
 
-__all__ = ["EXACT", "GRID", "HEADLINE", "INTERPOLATED", "Condition", "QueryResult",
+__all__ = ["EXACT", "GRID", "HEADLINE", "INTERPOLATED", "OPS", "Condition", "QueryResult",
            "default_columns", "flag_names", "format_csv", "format_json", "format_table",
-           "held_back", "parse_at", "parse_columns", "parse_where", "query_cube", "rows_note",
+           "held_back", "parse_at", "parse_columns", "parse_condition",
+           "parse_constraint", "parse_requirements", "parse_where", "query_cube", "rows_note",
            "shown_columns"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -68,37 +69,97 @@ def parse_at(text) -> dict:
     return out
 
 
+#: Every comparison the grammar knows, and the inequalities alone (``requirements:``).
+OPS = ("<", "<=", "==", "!=", ">=", ">")
+INEQUALITIES = ("<", "<=", ">=", ">")
+_COMPARE = {"<=": np.less_equal, ">=": np.greater_equal, "<": np.less, ">": np.greater}
+_PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
+#: Names a ``requirements:`` entry may constrain: the float design variables.
+REQUIREMENT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
+
+
+@dataclass(frozen=True)
 class Condition:
-    """One ``--where`` condition: ``name op value`` with ``value`` in SI."""
+    """One condition ``name op value`` of the query grammar, ``value`` in SI.
 
-    _OPS = {"<=": np.less_equal, ">=": np.greater_equal, "<": np.less, ">": np.greater,
-            "==": None, "=": None, "!=": None}
-    _PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
+    The one grammar of ``--where``, a sweep's ``requirements:`` and a design's
+    ``constraints:``; build one from text with :func:`parse_condition`.
 
-    def __init__(self, text: str):
-        if str(text).strip() == "valid":  # issue 10: clean designs, validity == 0
-            text = "validity == 0"
-        m = self._PATTERN.match(str(text))
-        if not m:
-            raise InputError(f"--where: expected 'NAME OP VALUE [UNIT]' with OP one of "
-                             f"<, <=, ==, !=, >=, >, got {text!r}")
-        self.name, op, value = m.groups()
-        if self.name not in COLUMNS + OPTIONAL:
-            raise InputError(f"--where: unknown name {self.name!r}; accepted: {_FIELDS}")
-        self.op = "==" if op == "=" else op
-        self.value = float(_quantity(self.name, value, f"--where {self.name}"))
-        self.text = str(text).strip()
+    Attributes
+    ----------
+    name : str
+        An axis or design variable (registry name).
+    op : str
+        One of :data:`OPS`.
+    value : float
+        The bound, in the variable's SI unit (attrs["units"] of its cube variable).
+    text : str
+        The condition as typed (for messages and provenance); not compared.
+    """
 
-    def mask(self, x: np.ndarray) -> np.ndarray:
+    name: str
+    op: str
+    value: float
+    text: str = field(default="", compare=False)
+
+    def mask(self, x) -> np.ndarray:
         """True where ``x`` [SI] meets the condition (NaN never does)."""
+        x = np.asarray(x)
         if self.op in ("==", "!="):
             # equality to a typed value up to its float noise (7.5 mm, 8 deg, 1)
             near = np.isclose(x, self.value, rtol=1e-9, atol=1e-12 * max(1.0, abs(self.value)))
             return near if self.op == "==" else ~near & ~np.isnan(x)
-        return self._OPS[self.op](x, self.value)
+        return _COMPARE[self.op](x, self.value)
+
+    holds = mask
 
     def __repr__(self):
-        return f"Condition({self.text!r})"
+        return f"Condition({self.text or f'{self.name} {self.op} {self.value!r}'!r})"
+
+
+def parse_condition(text, field: str = "--where", names=None, ops=OPS,
+                    finite: bool = False) -> Condition:
+    """Parse ``"tip_force_max >= 0.5 N"`` into a :class:`Condition` (``value`` in SI).
+
+    A bare number is in the name's display unit (N, kPa, mm, deg, ...); ``limit`` also takes
+    its flag words (``stroke``, ``supply``, ...); the text ``valid`` means ``validity == 0``.
+
+    Parameters
+    ----------
+    text : str
+        The condition as typed.
+    field : str
+        Where it came from, named in every message (``--where``, ``requirements[0]``,
+        ``constraints[2]``).
+    names : sequence of str, optional
+        The names accepted (default: every query column, :data:`COLUMNS` and
+        :data:`OPTIONAL`).
+    ops : sequence of str
+        The comparisons accepted (default: all of :data:`OPS`; ``=`` is read as ``==``).
+    finite : bool
+        Refuse an infinite or NaN value.
+
+    Raises
+    ------
+    InputError
+        Not ``NAME OP VALUE [UNIT]``, an operator or name not accepted, or a bad value.
+    """
+    names = tuple(COLUMNS + OPTIONAL if names is None else names)
+    if str(text).strip() == "valid" and "validity" in names:  # issue 10: validity == 0
+        text = "validity == 0"
+    m = _PATTERN.match(str(text))
+    op = None if not m else "==" if m.group(2) == "=" else m.group(2)
+    if op not in ops:
+        raise InputError(f"{field}: expected 'NAME OP VALUE [UNIT]' with OP one of "
+                         f"{', '.join(ops)}, got {text!r}")
+    name, _, value = m.groups()
+    if name not in names:
+        accepted = _FIELDS if names == COLUMNS + OPTIONAL else ", ".join(names)
+        raise InputError(f"{field}: unknown name {name!r}; accepted: {accepted}")
+    number = float(_quantity(name, value, f"{field} {name}"))
+    if finite and not np.isfinite(number):
+        raise InputError(f"{field}: the value must be finite, got {value!r}")
+    return Condition(name, op, number, str(text).strip())
 
 
 def parse_where(texts) -> list[Condition]:
@@ -106,7 +167,38 @@ def parse_where(texts) -> list[Condition]:
 
     ``model == NAME`` stays a string: :func:`query_cube` selects that model's slice.
     """
-    return [t if _MODEL_WHERE.match(str(t)) else Condition(t) for t in texts or ()]
+    return [t if _MODEL_WHERE.match(str(t)) else parse_condition(t) for t in texts or ()]
+
+
+def parse_requirements(texts, field: str = "requirements") -> tuple[Condition, ...]:
+    """Parse a sweep's ``requirements:`` (all must hold) into :class:`Condition` objects:
+    inequalities on the float design variables, finite values.
+
+    Raises
+    ------
+    InputError
+        Not a list of strings, or a bad requirement (named by its index).
+    """
+    if texts is None:
+        return ()
+    if isinstance(texts, str) or not isinstance(texts, (list, tuple)):
+        raise InputError(f"{field}: must be a list of strings like 'tip_force_max >= 0.5 N'")
+    return tuple(parse_condition(t, f"{field}[{i}]", REQUIREMENT_NAMES, INEQUALITIES,
+                                 finite=True) for i, t in enumerate(texts))
+
+
+def parse_constraint(text, i: int) -> Condition:
+    """Parse a design's ``constraints[i]``: any query column, any comparison.
+
+    Raises
+    ------
+    InputError
+        Not a string, or a bad condition (named ``constraints[i]``).
+    """
+    if not isinstance(text, str):
+        raise InputError(f"constraints[{i}]: expected a string like \"radius <= 20 mm\", "
+                         f"got {text!r}")
+    return parse_condition(text, f"constraints[{i}]")
 
 
 def _parse_sort(text):

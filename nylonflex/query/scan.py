@@ -13,7 +13,7 @@ import numpy as np
 from ..units import InputError, from_si
 from ..variables import AXES, DESIGN, VARIABLES
 from .parse import (_MODEL_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
-                    _parse_sort, parse_at, parse_columns)
+                    _parse_sort, parse_at, parse_columns, parse_condition)
 
 # Values this close (relative to the axis span) to a grid value are that grid value.
 _GRID_RTOL = 1e-6
@@ -344,7 +344,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     every = chosen == "all"
     chosen = None if every else chosen
     ds, where = _select_model(ds, where)
-    conditions = [c if isinstance(c, Condition) else Condition(c) for c in where]
+    conditions = [c if isinstance(c, Condition) else parse_condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
     if "model" in ds.dims:  # every model at once: the model names each row

@@ -103,7 +103,7 @@ class _Started:
 
 
 def _versions() -> dict:
-    from ..kernels._compile import source_digest
+    from ..kernels import source_digest
 
     return {"format": JOURNAL_FORMAT, "nylonflex_version": __version__,
             "model_digest": source_digest()}

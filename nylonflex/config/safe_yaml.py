@@ -13,7 +13,7 @@ from pathlib import Path
 
 import yaml
 
-from .units import InputError, short
+from ..units import InputError, short
 
 __all__ = ["YAML_MAX_DEPTH", "YAML_MAX_EXPANDED", "load_yaml", "read_yaml"]
 

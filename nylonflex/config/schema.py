@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Any, Literal, Union
 
-from .config.base import _Strict
-from .config.sweep import FixedThickness, Grid
+from .base import _Strict
+from .sweep import FixedThickness, Grid
 
 __all__ = ["SCHEMAS", "json_schema"]
 
@@ -51,8 +51,8 @@ class DesignSpecModel(_Strict):
 
 
 def _models() -> dict:
-    from .simconfig import SimConfigModel
-    from .config.sweep import SweepConfig
+    from ..simconfig import SimConfigModel
+    from .sweep import SweepConfig
 
     return {"sweep": SweepConfig, "simulate": SimConfigModel, "design": DesignSpecModel}
 

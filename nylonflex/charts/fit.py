@@ -1,6 +1,7 @@
 """Charts of calibration: a fit with its residuals, and a design's model against its data.
 
-Matplotlib (Agg), imported lazily; labels from the variable names with display units.
+Each a :class:`matplotlib.figure.Figure` made without pyplot (the caller's backend
+untouched); labels from the variable names with display units.
 """
 
 from __future__ import annotations
@@ -9,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import save_figure
+from ..files import save_figure
 
-__all__ = ["fit_chart", "validate_chart"]
+__all__ = ["fit_chart", "fit_figure", "validate_chart", "validate_figure"]
 
 #: quantity -> (label, display unit, factor from SI, offset from SI)
 _DISPLAY = {
@@ -33,20 +34,20 @@ def _d(name, v, residual=False):
     return np.asarray(v) * f + (0.0 if residual else o), f"{label} [{unit}]"
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def fit_chart(result, path) -> Path:
-    """Data, fit and residuals of a :class:`~nylonflex.calibration.FitResult` (one PNG)."""
-    plt = _plt()
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True,
-                                  gridspec_kw={"height_ratios": [3, 1]})
+    """Write :func:`fit_figure` of ``result`` into ``path`` (PNG at 120 dpi); returns it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return save_figure(fit_figure(result), path, dpi=120)
+
+
+def fit_figure(result):
+    """Data, fit and residuals of a :class:`~nylonflex.calibration.FitResult`
+    (a :class:`matplotlib.figure.Figure`)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 5.6))
+    ax, axr = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]})
     if result.kind == "muscle":
         x, xl = _d("force", result.x)
         xl = "model force [N]"
@@ -68,18 +69,24 @@ def fit_chart(result, path) -> Path:
     axr.set_ylabel("residual\n" + rl.split("[")[-1].join(["[", ""]))
     axr.set_xlabel(xl)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig
 
 
 def validate_chart(comparisons, path, title="") -> Path:
-    """Model against data, one panel per measured quantity (one PNG)."""
-    plt = _plt()
+    """Write :func:`validate_figure` into ``path`` (PNG at 120 dpi); returns it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return save_figure(validate_figure(comparisons, title), path, dpi=120)
+
+
+def validate_figure(comparisons, title=""):
+    """Model against data, one panel per measured quantity (a
+    :class:`matplotlib.figure.Figure`)."""
+    from matplotlib.figure import Figure
+
     n = len(comparisons)
-    fig, axes = plt.subplots(1, n, figsize=(5.2 * n, 4.2), squeeze=False)
+    fig = Figure(figsize=(5.2 * n, 4.2))
+    axes = fig.subplots(1, n, squeeze=False)
     for ax, c in zip(axes[0], comparisons):
         x, xl = _d(c.x_name, c.x)
         y, yl = _d(c.quantity, c.data)
@@ -94,8 +101,4 @@ def validate_chart(comparisons, path, title="") -> Path:
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig

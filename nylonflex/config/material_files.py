@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..units import InputError
 from .safe_yaml import read_yaml
-from .units import InputError
 
 __all__ = ["anchor_material_files", "material_document", "read_material_set",
            "write_material_file"]
@@ -51,7 +51,7 @@ def material_document(result, name=None, fields=None) -> dict:
     fields : dict, optional
         For a nylon fit: ``{"base": set name, field: value, ...}`` to write.
     """
-    from . import __version__
+    from .._version import __version__
 
     name = name or result.name or Path(result.data["path"]).stem
     doc = {"kind": "silicone" if result.kind == "silicone" else "nylon", "name": name,
@@ -97,7 +97,7 @@ def write_material_file(result, path, name=None, overwrite=False, fields=None,
     InputError
         The file exists and ``overwrite`` is false, or it may not be written (see above).
     """
-    from .files import refuse_special, write_atomic
+    from ..files import refuse_special, write_atomic
 
     path = Path(path)
     inputs = (result.data.get("path", ""), *inputs)

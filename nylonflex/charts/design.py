@@ -1,4 +1,4 @@
-"""The Pareto-front chart of a design result (matplotlib, Agg, imported lazily).
+"""The Pareto-front chart of a design result (a Figure made without pyplot).
 
 Two or more objectives: the first two, the cube's feasible designs as a grey cloud, the
 grid front and the refined front. One objective: the objective against the first free axis,
@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from ..files import save_figure
+from ._common import new_figure, rc_context
 from ..variables import AXES, display_label, to_display
 
-__all__ = ["draw_front"]
+__all__ = ["draw_front", "front_figure"]
 
 
 def _sorted_step(ax, x, y, **kw):
@@ -24,7 +25,7 @@ def _sorted_step(ax, x, y, **kw):
 
 
 def draw_front(res, out_dir) -> Path:
-    """Draw ``res`` into ``out_dir/<name>.png``; return the path.
+    """Draw :func:`front_figure` of ``res`` into ``out_dir/<name>.png``; return the path.
 
     Parameters
     ----------
@@ -32,11 +33,16 @@ def draw_front(res, out_dir) -> Path:
     out_dir : path
         Created when missing; an existing chart of the same name is replaced.
     """
-    from ..charts import _RC, _figure, _plt
-
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     path = out_dir / f"{res.spec.name}.png"
+    with rc_context():
+        return save_figure(front_figure(res), path)
+
+
+def front_figure(res):
+    """The front (two or more objectives) or the best design (one) of a
+    :class:`~nylonflex.design.DesignResult`, as a :class:`matplotlib.figure.Figure`."""
     objs = res.spec.objectives
     if len(objs) >= 2:
         xname, yname = objs[1].name, objs[0].name
@@ -44,9 +50,8 @@ def draw_front(res, out_dir) -> Path:
         free = [a for a in AXES if a not in res.scan.fixed and
                 res.scan.ranges[a][1] > res.scan.ranges[a][0]]
         xname, yname = (free[0] if free else "radius"), objs[0].name
-    plt = _plt()
-    with plt.rc_context(_RC):
-        fig, axes = _figure(size=(6.4, 4.6))
+    with rc_context():
+        fig, axes = new_figure(size=(6.4, 4.6))
         ax = axes[0, 0]
         cloud = res.scan.cloud
         if len(cloud["radius"]):
@@ -82,6 +87,4 @@ def draw_front(res, out_dir) -> Path:
             ax.text(0.99, 0.02, text, transform=ax.transAxes, ha="right", va="bottom",
                     fontsize=7.5, color="0.3")
         ax.legend(loc="upper left")
-        save_figure(fig, path)
-        plt.close(fig)
-    return path
+    return fig

@@ -1,7 +1,8 @@
 """Charts of a closed-loop simulation: the paper's figure 9 and figure 10(a).
 
-Drawn from the simulation Dataset only (no physics here); matplotlib is imported lazily,
-on the Agg backend. Axes are labelled in the units a designer reads: deg, s, kPa, W.
+Drawn from the simulation Dataset only (no physics here), each a
+:class:`matplotlib.figure.Figure` made without pyplot (the caller's backend untouched).
+Axes are labelled in the units a designer reads: deg, s, kPa, W.
 """
 
 from __future__ import annotations
@@ -11,18 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import save_figure
+from ..files import save_figure
 
 __all__ = ["draw_simulation_charts", "figure9", "figure10a"]
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _config_reference_kind(ds, j=0):
@@ -59,25 +51,23 @@ def _running_mean(t, x, window):
     return (c[i] - c[lo]) / (i - lo)
 
 
-def figure9(ds, path):
+def figure9(ds):
     """Figure 9: bend angle, its estimate and the reference against time, with the heating.
 
     Parameters
     ----------
     ds : xarray.Dataset
         A single-actuator simulation (dims ``time``).
-    path : str or Path
-        Image file to write.
 
     Returns
     -------
-    Path
-        ``path``.
+    matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    from matplotlib.figure import Figure
+
     t = ds["time"].values
-    fig, (ax, axp) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 5.2),
-                                  gridspec_kw={"height_ratios": [3, 1]})
+    fig = Figure(figsize=(7.5, 5.2))
+    ax, axp = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]})
     ax.plot(t, np.degrees(ds["bend_angle"].values), color="C0", lw=2.4, label="bend angle")
     ax.plot(t, np.degrees(ds["bend_angle_estimate"].values), color="C1", lw=0.9, ls=":",
             label="estimate from pressure")
@@ -107,12 +97,10 @@ def figure9(ds, path):
     axp.set_ylim(0, max(float(ds["power"].max()) * 1.5, 0.1))  # room for the legend
     axp.grid(alpha=0.3)
     fig.tight_layout()
-    save_figure(fig, path, dpi=130)
-    plt.close(fig)
-    return Path(path)
+    return fig
 
 
-def figure10a(ds, path):
+def figure10a(ds):
     """Figure 10(a): each actuator's chamber pressure against time, for a gripper run.
 
     Below the pressures, each actuator's angle against its reference and the power drawn
@@ -122,18 +110,17 @@ def figure10a(ds, path):
     ----------
     ds : xarray.Dataset
         A simulation with dims (``actuator``, ``time``).
-    path : str or Path
-        Image file to write.
 
     Returns
     -------
-    Path
-        ``path``.
+    matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    from matplotlib.figure import Figure
+
     t = ds["time"].values
-    fig, (axp, axa, axw) = plt.subplots(3, 1, sharex=True, figsize=(7.5, 7.0),
-                                        gridspec_kw={"height_ratios": [3, 2, 1.2]})
+    fig = Figure(figsize=(7.5, 7.0))
+    axp, axa, axw = fig.subplots(3, 1, sharex=True,
+                                 gridspec_kw={"height_ratios": [3, 2, 1.2]})
     for j, name in enumerate(ds["actuator"].values):
         c = f"C{j}"
         axp.plot(t, ds["pressure"].values[j] / 1e3, color=c, lw=1.6, label=str(name))
@@ -156,9 +143,7 @@ def figure10a(ds, path):
     axw.set_ylim(0, max(float(total.max()) * 1.15, 0.1))
     axw.grid(alpha=0.3)
     fig.tight_layout()
-    save_figure(fig, path, dpi=130)
-    plt.close(fig)
-    return Path(path)
+    return fig
 
 
 def draw_simulation_charts(ds, folder, stem="sim"):
@@ -167,5 +152,5 @@ def draw_simulation_charts(ds, folder, stem="sim"):
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     if "actuator" in ds.dims:
-        return [figure10a(ds, folder / f"{stem}_figure10a.png")]
-    return [figure9(ds, folder / f"{stem}_figure9.png")]
+        return [save_figure(figure10a(ds), folder / f"{stem}_figure10a.png", dpi=130)]
+    return [save_figure(figure9(ds), folder / f"{stem}_figure9.png", dpi=130)]

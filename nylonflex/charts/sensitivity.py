@@ -1,4 +1,4 @@
-"""The bar chart of Sobol' indices (matplotlib, Agg, imported lazily)."""
+"""The bar chart of Sobol' indices (a Figure made without pyplot)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ from pathlib import Path
 import numpy as np
 
 from ..files import save_figure
+from ._common import RC, new_figure, rc_context
 from ..variables import display_label
 
-__all__ = ["sensitivity_chart"]
+__all__ = ["sensitivity_chart", "sensitivity_figure"]
 
 
 def sensitivity_chart(result, path) -> Path:
@@ -26,13 +27,20 @@ def sensitivity_chart(result, path) -> Path:
     -------
     pathlib.Path
     """
-    from ..charts import _RC, _figure, _plt
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with rc_context():
+        return save_figure(sensitivity_figure(result), path, bbox_inches="tight",
+                           pad_inches=0.08)
 
-    plt = _plt()
+
+def sensitivity_figure(result):
+    """Bars of first-order and total indices of a :class:`SensitivityResult` with their
+    95 % intervals, one panel an output (a :class:`matplotlib.figure.Figure`)."""
     outputs = list(result.indices)
     params = list(result.parameters)
-    with plt.rc_context(_RC):
-        fig, axes = _figure(1, len(outputs), size=(max(4.0, 1.1 * len(params) + 2.0)
+    with rc_context():
+        fig, axes = new_figure(1, len(outputs), size=(max(4.0, 1.1 * len(params) + 2.0)
                                                     * len(outputs), 4.2), sharey=True)
         x = np.arange(len(params))
         for ax, o in zip(axes[0], outputs):
@@ -55,9 +63,5 @@ def sensitivity_chart(result, path) -> Path:
         where = "one design" if result.designs == 1 else \
             f"mean over {result.designs} grid designs"
         fig.suptitle(f"Sobol' sensitivity indices ({where}; {result.samples} model runs a "
-                     "design; bars: 95 % intervals)", fontsize=_RC["figure.titlesize"])
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        save_figure(fig, path, bbox_inches="tight", pad_inches=0.08)
-        plt.close(fig)
-    return path
+                     "design; bars: 95 % intervals)", fontsize=RC["figure.titlesize"])
+    return fig

@@ -1,0 +1,37 @@
+"""Where the kernels' compiled code is cached, keyed on the model's sources.
+
+Numba's cache checks only the timestamp of the file that holds a kernel, not of the
+formulas it compiles in from other files, so the cache folder is keyed on a digest of every
+physics and kernel source: an edited formula can never run stale machine code. This module
+imports no Numba: the digest also names the model in a cube's provenance.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from functools import lru_cache
+from pathlib import Path
+
+__all__ = ["cache_dir", "source_digest"]
+
+
+@lru_cache(maxsize=1)
+def source_digest() -> str:
+    """Digest of every physics and kernel source file (16 hex digits)."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for sub in ("physics", "kernels"):
+        for path in sorted((root / sub).glob("*.py")):
+            digest.update(path.name.encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def cache_dir() -> str:
+    """The kernels' Numba cache folder: ``$NUMBA_CACHE_DIR`` (default
+    ``~/.cache/nylonflex/numba``) / the :func:`source_digest` of the model sources."""
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
+        "nylonflex", "numba")
+    return os.path.join(base, source_digest())
