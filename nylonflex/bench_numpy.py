@@ -175,7 +175,7 @@ def grid_numpy(cfg) -> dict:
     a1, t1 = ax["radius"], ax["wall_thickness"]
     lengths, wraps = ax["length"], ax["wrap_angle"]
     strokes, pressures = cv["stroke"], cv["pressure"]
-    s_max_c, f_lim_c, width_c = _coil_table(cfg)
+    s_max_c, f_lim_c, width_c = _coil_table(cfg)[:3]
     na, nt, nl, nc, npsi = a1.size, t1.size, lengths.size, s_max_c.size, wraps.size
     # per section (a, t): node table and the bend-angle curve
     a = np.repeat(a1, nt)

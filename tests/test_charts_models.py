@@ -132,8 +132,9 @@ def test_query_prints_the_model_in_every_row(ds):
     # the paper's first example: 1.20 N with a full range of motion (docs/model.md s. 8)
     assert res.data["tip_force_max"][0] == pytest.approx(1.20, abs=0.005)
     table = format_table(res).splitlines()
-    assert table[1].split()[0] == "model"
-    assert [line.split()[0] for line in table[3:6]] == MODELS
+    # the header (long names wrap over lines above it to fit 120 columns), units, rows
+    head = next(i for i, line in enumerate(table) if line.split()[:1] == ["model"])
+    assert [line.split()[0] for line in table[head + 2:head + 5]] == MODELS
     records = json.loads(format_json(res))["designs"]
     assert [r["model"] for r in records] == MODELS
     rows = list(csv.reader(io.StringIO(format_csv(res))))

@@ -20,7 +20,7 @@ def add_arguments(w):
 
 def _control(notice):
     """The closed-loop kernels: a 0.1 s simulation of the paper's example 2."""
-    from ..engine.warmup import _timed
+    from ..engine.warmup import timed
     from ..simulate import parse_sim_config, run_simulation
 
     cfg = parse_sim_config({
@@ -32,7 +32,7 @@ def _control(notice):
         "reference": {"kind": "sine", "mean": "85 deg", "amplitude": "30 deg",
                       "frequency": "0.04 Hz"},
     })
-    return _timed(lambda: run_simulation(cfg), notice)
+    return timed(lambda: run_simulation(cfg), notice)
 
 
 def run(args) -> int:

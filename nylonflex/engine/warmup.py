@@ -18,14 +18,14 @@ from contextlib import nullcontext
 
 from ..config import ResolvedConfig
 
-__all__ = ["COMPILE_NOTICE", "KERNELS", "warm_up_codec", "warm_up_grid", "warm_up_kernels",
+__all__ = ["COMPILE_NOTICE", "KERNELS", "timed", "warm_up_codec", "warm_up_grid", "warm_up_kernels",
            "warm_up_points"]
 
 #: How every compile notice begins (the rest names the kernel and its estimate).
 COMPILE_NOTICE = "compiling "
 
 
-def _timed(call, notice, after=None):
+def timed(call, notice, after=None):
     """Run ``call()`` with the compile notices going to ``notice`` (None: a
     :class:`~nylonflex.kernels.compiling.CompileWarning`).
 
@@ -68,7 +68,7 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     tiny = dataclasses.replace(
         cfg, axes={k: v[:1] for k, v in cfg.axes.items()},
         curves={k: v[:2] for k, v in cfg.curves.items()})
-    return _timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
+    return timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
 
 
 def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0) -> float:
@@ -105,7 +105,7 @@ def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0
         for n in loops:  # the serial and/or the threaded loop
             evaluate(np.full(n, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
 
-    return _timed(call, notice, after)
+    return timed(call, notice, after)
 
 
 def warm_up_codec(*, notice=None) -> float:
@@ -120,7 +120,7 @@ def warm_up_codec(*, notice=None) -> float:
             src = np.zeros((n, size), dtype=np.uint8)
             shuffle_bytes(src, np.empty((size, n), dtype=np.uint8))
 
-    return _timed(call, notice)
+    return timed(call, notice)
 
 
 def _tiny_config():
