@@ -188,11 +188,12 @@ def run_fe(args) -> int:
                 f"within 10 %: {within} of {r.size}")
 
     c = res["coefficients"]
-    print(f"fe_calibrated  exp({c[0]:+.4f} {c[1]:+.4f} x {c[2]:+.4f} x^2), x = ln(t/a)")
+    print(f"lateral_pressure's moment corrected by exp({c[0]:+.4f} {c[1]:+.4f} x "
+          f"{c[2]:+.4f} x^2), x = ln(t/a)")
     print(f"  {res['designs_used']} designs, {res['points']} FE angles (mesh {args.mesh}, "
           "Richardson-extrapolated)")
     print(line("lateral_pressure / FE", res["lateral_over_fe"]))
-    print(line("fe_calibrated / FE", res["calibrated_over_fe"]))
+    print(line("corrected / FE", res["calibrated_over_fe"]))
     print(line("leave-one-out / FE", res["loo_calibrated_over_fe"]))
     print(f"wrote {out}")
     return 0
