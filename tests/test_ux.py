@@ -63,7 +63,7 @@ def test_warm_up_notices_only_when_numba_compiles(monkeypatch):
     assert warmup.warm_up_grid(parse_config(TINY)) >= 0.0
     assert warmup.warm_up_points() >= 0.0
     assert warmup.warm_up_grid(parse_config(TINY), notice=seen.append) == 0.0
-    assert warmup._timed(lambda: time.sleep(0.3), seen.append) == 0.0  # slow, not compiling
+    assert warmup.timed(lambda: time.sleep(0.3), seen.append) == 0.0  # slow, not compiling
     assert seen == []
 
 
