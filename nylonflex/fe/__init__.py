@@ -39,7 +39,6 @@ def require_felupe():
     """Import FElupe, or raise :class:`InputError` saying how to install it."""
     try:
         import felupe  # noqa: F401
-        import tensortrax  # noqa: F401
     except ImportError:
         raise InputError(INSTALL_HINT) from None
 
