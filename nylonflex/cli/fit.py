@@ -127,7 +127,6 @@ def format_table(res) -> str:
 
 def run_fe(args) -> int:
     """``fit fe``: the training runs (journaled beside --out), the fit, its JSON file."""
-    import json
     import os
     from datetime import datetime, timezone
     from pathlib import Path

@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..units import InputError
-from .runs import journaled_runs
+from .runs import journaled_runs, plan_silicone
 
 __all__ = ["TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
            "run_training", "training_plan"]
@@ -98,7 +98,7 @@ def _solve(task):
     d, sil, mesh = task
     res = fe_bend(d["radius"], d["wall_thickness"], d["length"], d["pressures"],
                   base_thickness=d["base_thickness"],
-                  silicone={"set": "tc5005", "mu": list(sil["mu"]), "alpha": list(sil["alpha"])},
+                  silicone=plan_silicone(sil),
                   mesh=mesh)
     return {"bend_angle": res["bend_angle"].tolist(),
             "coarser_bend_angle": res["coarser_bend_angle"].tolist()}
@@ -130,8 +130,7 @@ def fit_correction(plan, done, *, silicone=None) -> dict:
     from ..physics.limits import model_bend_angle
 
     rows = plan["designs"]
-    sil = silicone or {"set": "tc5005", "mu": plan["silicone"]["mu"],
-                       "alpha": plan["silicone"]["alpha"]}
+    sil = silicone or plan_silicone(plan["silicone"])
     pts = []  # (design index, pressure, FE angle)
     for k, d in enumerate(rows):
         fe = extrapolated(done[k]["bend_angle"], done[k]["coarser_bend_angle"])

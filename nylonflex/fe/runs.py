@@ -13,7 +13,13 @@ from pathlib import Path
 
 from ..units import InputError
 
-__all__ = ["journaled_runs"]
+__all__ = ["journaled_runs", "plan_silicone"]
+
+
+def plan_silicone(sil):
+    """A plan's Ogden constants (``{"mu": [...], "alpha": [...]}``) as a silicone nylonflex
+    accepts: a set with its fields replaced (only mu and alpha enter the FE and the angles)."""
+    return {"set": "tc5005", "mu": list(sil["mu"]), "alpha": list(sil["alpha"])}
 
 
 def _map(tasks, workers, scheduler, solve):

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from .runs import journaled_runs
+from .runs import journaled_runs, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
            "fidelity_summary", "run_verify", "sample_designs"]
@@ -91,18 +91,12 @@ def _plan(ds, attrs, n, seed, mesh):
             "cube_config_sha256": str(attrs.get("config_sha256", ""))}
 
 
-def _silicone(sil):
-    """The plan's Ogden constants as a silicone nylonflex accepts (a set with its fields
-    replaced: only mu and alpha enter the FE and the angles)."""
-    return {"set": "tc5005", "mu": list(sil["mu"]), "alpha": list(sil["alpha"])}
-
-
 def _solve(task):
     """One FE run (a task of the executor): the design's angles and error estimates."""
     from . import fe_bend
 
     d, sil, mesh = task
-    silicone = _silicone(sil)
+    silicone = plan_silicone(sil)
     res = fe_bend(d["radius"], d["wall_thickness"], d["length"], d["pressures"],
                   base_thickness=d["base_thickness"], silicone=silicone, mesh=mesh)
     return {"bend_angle": res["bend_angle"].tolist(),
@@ -176,7 +170,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh="default", s
     for model in ANGLE_MODELS:
         ang = np.array([np.atleast_1d(bend_angle(pressure[k], r["radius"], r["wall_thickness"],
                                                  r["length"], base_thickness=r["base_thickness"],
-                                                 silicone=_silicone(sil), model=model)) for k, r in enumerate(rows)])
+                                                 silicone=plan_silicone(sil), model=model)) for k, r in enumerate(rows)])
         data[f"{model}_bend_angle"] = (("design", "level"), ang)
         with np.errstate(invalid="ignore", divide="ignore"):
             ratios.append(np.where(fe > 0, ang / fe, np.nan))
