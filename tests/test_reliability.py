@@ -712,6 +712,55 @@ def test_a_signal_in_a_finaliser_is_never_swallowed(tmp_path, where, sig):
     ds.close()
 
 
+_EARLY_SIGNAL = """
+import os, signal, sys
+import nylonflex.config as config
+
+SIG, FALLOUT = int(sys.argv[1]), sys.argv[2]
+load = config.load_config
+
+
+def load_config(*args, **kwargs):
+    # a signal while the config's modules are imported, its exception dropped on the way
+    # (a finaliser drops it), and an ImportError after it: what numpy does when a signal
+    # lands in its C extension's import
+    try:
+        os.kill(os.getpid(), SIG)
+        for _ in range(10**6):
+            pass
+    except KeyboardInterrupt:
+        pass
+    if FALLOUT == "import":
+        raise ImportError("numpy half imported")
+    return load(*args, **kwargs)
+
+
+config.load_config = load_config
+from nylonflex.cli import main
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("fallout", ["import", "none"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["INT", "TERM"])
+def test_a_signal_before_the_sweeps_own_handler_is_a_stop(tmp_path, sig, fallout):
+    # CI once saw "failed: ImportError" (exit 1) for a SIGINT during numpy's import: a
+    # signal at any point is a stop (128 + it), and a dropped one still stops the sweep
+    # before its first slab
+    cfg = write_config(tmp_path, MULTI)
+    out = tmp_path / "cube.h5"
+    proc = subprocess.run([sys.executable, "-c", _EARLY_SIGNAL, str(int(sig)), fallout,
+                           "sweep", str(cfg), "--out", str(out), "--no-charts"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 128 + sig, (proc.returncode, proc.stderr)
+    assert "Traceback" not in proc.stderr and "failed" not in proc.stderr, proc.stderr
+    assert "interrupted" in proc.stderr or "--resume" in proc.stderr, proc.stderr
+    if out.exists():
+        ds = open_cube(out, quiet=True)
+        assert ds.attrs["complete"] == 0
+        ds.close()
+
+
 _SIGNAL_AT = """
 import os, random, signal, sys, threading, time
 delay, sig = float(sys.argv[1]), int(sys.argv[2])

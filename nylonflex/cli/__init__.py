@@ -142,15 +142,63 @@ def _block_unused_dask(command):
         sys.modules["dask"] = None
 
 
+#: SIGINT and SIGTERM (numbers) that reached the running command before a sweep's
+#: ``deferred_signals`` scope took them over (:class:`_early_signals`).
+EARLY_SIGNALS: list = []
+
+
 def main(argv=None) -> int:
     """The command line: run the command in ``argv`` (default ``sys.argv[1:]``) and return
     its exit status (:func:`run` is the console script around it)."""
     _lighten_process()
+    EARLY_SIGNALS.clear()
     try:
-        return _main(argv)
+        with _early_signals():
+            return _main(argv)
     except KeyboardInterrupt:  # Ctrl-C while the parser's modules are imported
         print("nylonflex: interrupted", file=sys.stderr)
         return interrupted_status()
+
+
+class _early_signals:
+    """From a command's start, SIGINT and SIGTERM are recorded (:data:`EARLY_SIGNALS`) and
+    raise ``KeyboardInterrupt``; the handlers before it are put back at the end.
+
+    Without it, a signal that lands while numpy's C extension is being imported leaves
+    numpy half-initialised: Python's KeyboardInterrupt can be lost on the way (a finaliser
+    drops it) and the next ``import numpy`` fails with an ImportError, which the command
+    would report as a failure (exit 1) instead of a stop. With the record, any exception
+    after a signal is a stop (:func:`_main`), and a sweep's ``deferred_signals`` scope
+    starts with it, so the sweep stops before its first slab. SIGTERM used to end the
+    process at once (status -15) until the sweep's own handler was set; it now stops the
+    command as Ctrl-C does, with status 143. Handlers someone else set (an embedding
+    program's) are left alone, and nothing is done outside the main thread.
+    """
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        self.previous = {}
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        defaults = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: signal.SIG_DFL}
+        for sig, default in defaults.items():
+            if signal.getsignal(sig) is default:
+                self.previous[sig] = signal.signal(sig, _record_signal)
+        return self
+
+    def __exit__(self, *exc):
+        import signal
+
+        for sig, old in self.previous.items():
+            signal.signal(sig, old)
+        return False
+
+
+def _record_signal(signum, frame):
+    EARLY_SIGNALS.append(int(signum))
+    raise KeyboardInterrupt
 
 
 def interrupted_status() -> int:
@@ -158,7 +206,9 @@ def interrupted_status() -> int:
     convention (130 for Ctrl-C, 143 for SIGTERM)."""
     import signal
 
-    slabs = sys.modules.get("nylonflex.engine.slabs")  # only it records signals
+    if EARLY_SIGNALS:
+        return 128 + EARLY_SIGNALS[0]
+    slabs = sys.modules.get("nylonflex.engine.slabs")  # it records the sweep's signals
     sig = slabs.stopping_signal() if slabs is not None else None
     return 128 + int(sig or signal.SIGINT)
 
@@ -189,14 +239,15 @@ def _main(argv=None) -> int:
     except KeyboardInterrupt:
         print("nylonflex: interrupted", file=sys.stderr)
         return interrupted_status()
-    except ValueError as exc:  # InputError and the physics' range checks: bad input
-        if args.debug:
-            raise
-        print(f"nylonflex {args.command}: error: {one_line(exc)}", file=sys.stderr)
-        return EXIT_INPUT
     except Exception as exc:  # noqa: BLE001 - one line for the user, --debug for the rest
         if args.debug:
             raise
+        if EARLY_SIGNALS:  # a signal's fallout (a half-imported numpy): a stop
+            print("nylonflex: interrupted", file=sys.stderr)
+            return interrupted_status()
+        if isinstance(exc, ValueError):  # InputError and the physics' range checks
+            print(f"nylonflex {args.command}: error: {one_line(exc)}", file=sys.stderr)
+            return EXIT_INPUT
         print(f"nylonflex {args.command}: failed: {type(exc).__name__}: {one_line(exc)}",
               file=sys.stderr)
         return EXIT_FAILURE

@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from . import EARLY_SIGNALS
+
 HELP = "evaluate a design space into a cube"
 
 
@@ -76,7 +78,7 @@ def _run(args, charts: bool) -> int:
             refuse_special(out, "--out")
             if args.dry_run:
                 return _dry_run(cfg, out, args, log)
-            signals.enter_context(deferred_signals(on_second=_stop_at_once))
+            signals.enter_context(deferred_signals(on_second=_stop_at_once, earlier=EARLY_SIGNALS))
             unchanged = _up_to_date(cfg, out, args)
             prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
         with _progress(cfg.n_designs, args.quiet) as bar:

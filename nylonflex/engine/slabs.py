@@ -65,7 +65,7 @@ def stopping_signal() -> int | None:
 
 
 @contextlib.contextmanager
-def deferred_signals(on_second=None):
+def deferred_signals(on_second=None, earlier=()):
     """Record SIGINT and SIGTERM instead of acting on them; yields the list of signals seen.
 
     ``on_second`` (a callable) runs on the second signal (e.g. raise to stop at once);
@@ -73,7 +73,10 @@ def deferred_signals(on_second=None):
     one's record, so a Ctrl-C that came while a run was being set up (compiling, opening
     files) is seen by the slab loop, which then stops before it computes anything; while
     the inner scope is open its ``on_second`` applies. Outside the main thread it does
-    nothing.
+    nothing. ``earlier`` (signal numbers) are signals the caller saw before the outermost
+    scope opened (the command line's own record, from its process's start): the scope begins
+    with them, so a signal that came while modules were imported stops the run too, even
+    where a finaliser dropped the exception it raised.
     """
     global _SCOPE
     if threading.current_thread() is not threading.main_thread():
@@ -86,7 +89,9 @@ def deferred_signals(on_second=None):
         finally:
             _SCOPE["actions"].pop()
         return
-    scope = _SCOPE = {"seen": [], "actions": [on_second]}
+    scope = _SCOPE = {"seen": [int(sig) for sig in earlier], "actions": [on_second]}
+    if scope["seen"] and not _FIRST_SIGNAL:
+        _FIRST_SIGNAL.append(scope["seen"][0])
 
     def handler(signum, frame):
         scope["seen"].append(signum)
