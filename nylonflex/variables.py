@@ -25,7 +25,7 @@ __all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONL
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.
 MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment",
-          "lateral_pressure")
+          "lateral_pressure", "fe_calibrated")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")

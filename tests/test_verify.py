@@ -92,7 +92,7 @@ def test_fidelity_map_and_info(cube, monkeypatch, tmp_path):
     monkeypatch.setattr(verify, "_solve", _fake([]))
     path = verify.run_verify(cube, 5, mesh="coarse")
     fig = fidelity_map(xr.open_dataset(path, engine="h5netcdf").load())
-    assert len(fig.axes) == 4  # three models and the colour bar
+    assert len(fig.axes) == 5  # four models and the colour bar
     fig.savefig(tmp_path / "map.png")
     assert main(["info", str(cube)]) == 0
 

@@ -136,6 +136,7 @@ def run_fe(args) -> int:
     from .. import __version__
     from ..fe import MESH_NAMES, require_felupe
     from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
+    from ..physics.calibrated import CORRECTION, TERMS
     from ..fe.verify import MAX_DESIGNS
     from ..files import refuse_special, write_atomic
     from ..units import InputError, json_text
@@ -162,7 +163,8 @@ def run_fe(args) -> int:
                             log=lambda m: print(f"nylonflex fit fe: {m}", file=sys.stderr))
     res = fit_correction(plan, done)
     doc = {"model": "fe_calibrated",
-           "correction": "M = (M_P + p Q_L) exp(c0 + c1 x + c2 x^2), x = ln(t/a)",
+           "correction": CORRECTION,
+           "terms": list(TERMS),
            "coefficients": res["coefficients"],
            "provenance": {"command": "nylonflex fit fe " + " ".join(sys.argv[3:]),
                           "nylonflex_version": __version__,
@@ -187,13 +189,19 @@ def run_fe(args) -> int:
                 f"within 10 %: {within} of {r.size}")
 
     c = res["coefficients"]
-    print(f"lateral_pressure's moment corrected by exp({c[0]:+.4f} {c[1]:+.4f} x "
-          f"{c[2]:+.4f} x^2), x = ln(t/a)")
+    print("fe_calibrated: lateral_pressure's angle times exp(" + " ".join(
+        f"{v:+.4f}" + ("" if term == "1" else f" {term}") for v, term in zip(c, TERMS))
+        + "), q = p a/(mu0 t)")
     print(f"  {res['designs_used']} designs, {res['points']} FE angles (mesh {args.mesh}, "
           "Richardson-extrapolated)")
     print(line("lateral_pressure / FE", res["lateral_over_fe"]))
     print(line("corrected / FE", res["calibrated_over_fe"]))
     print(line("leave-one-out / FE", res["loo_calibrated_over_fe"]))
+    idx = np.asarray(res["design_index"])
+    loo = np.abs(np.asarray(res["loo_calibrated_over_fe"]) - 1.0) <= 0.1
+    whole = sum(bool(loo[idx == k].all()) for k in np.unique(idx))
+    print(f"  designs with every leave-one-out angle within 10 %: {whole} of "
+          f"{res['designs_used']}")
     print(f"wrote {out}")
     return 0
 

@@ -1,23 +1,20 @@
-"""``nylonflex fit fe``: FE runs over the design space, and a correction of the
-lateral-pressure moment fitted to them (the study toward ``fe_calibrated``).
+"""``nylonflex fit fe``: FE runs over the design space, and ``fe_calibrated``'s correction
+fitted to them.
 
-The correction is a smooth function of the section's one free dimensionless group,
-x = ln(t/a) (the training designs have b = t, the fig12 cube's choice):
+The correction scales ``lateral_pressure``'s bend angle (``physics.calibrated``):
 
-    M_cal = (M_P + p Q_L) exp(c0 + c1 x + c2 x^2)
+    theta_cal = theta_lateral exp(c0 + c1 ln(t/a) + c2 ln(L/a) + c3 q/(1+q)),
+    q = p a / (mu0 t)
 
-which stays linear in p, as every variant's moment is (docs/model.md s. 18), so a kernel
-could take it through ``physics.limits._model_moment``. It is not a model variant yet: its
-leave-one-design-out error is no better than about 20 % (docs/fidelity.md), because the
-FE's departure from the balance also grows with the bend and with the actuator's
-shortness (L/a), which a length-free moment cannot carry. The runs are fitted by
-``nylonflex fit fe``: designs filling the space designers sweep
-(:data:`TRAINING_RANGES`, a scrambled Latin hypercube), each solved at the pressures where
-``lateral_pressure`` bends :data:`TARGET_ANGLES`, on the coarse mesh and the one below it,
-their Richardson extrapolation taken as the FE angle (within about 1 % of the fine mesh on
-both worked examples, docs/fidelity.md). The fit minimises the squared log ratio of the
-calibrated to the FE angle; its leave-one-design-out error is reported with the
-coefficients, the training designs and their FE angles in one JSON file with provenance.
+The runs: designs filling the space designers sweep (:data:`TRAINING_RANGES`, a scrambled
+Latin hypercube, b = t as in the fig12 cube), each solved at the pressures where
+``lateral_pressure`` bends :data:`TARGET_ANGLES`, on the coarse mesh and the one below
+it, their Richardson extrapolation taken as the FE angle (within about 1 % of the fine
+mesh on both worked examples, docs/fidelity.md). The fit is linear least squares of the
+log ratio ln(theta_FE / theta_lateral) on the four terms; its leave-one-design-out error
+(each design's angles predicted by the fit to all the others) is reported with the
+coefficients, the training designs and their FE angles in one JSON file with provenance,
+the file ``physics/fe_calibrated.json`` ships.
 """
 
 from __future__ import annotations
@@ -26,11 +23,12 @@ import math
 
 import numpy as np
 
+from ..physics.calibrated import TERMS
 from ..units import InputError
 from .runs import journaled_runs, plan_silicone
 
 __all__ = ["TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
-           "run_training", "training_plan"]
+           "initial_shear_modulus", "run_training", "training_plan"]
 
 #: The design space the training designs fill [m] (the fig12 and big20m sweeps').
 TRAINING_RANGES = {"radius": (5e-3, 25e-3), "wall_thickness": (1e-3, 6e-3),
@@ -38,13 +36,22 @@ TRAINING_RANGES = {"radius": (5e-3, 25e-3), "wall_thickness": (1e-3, 6e-3),
 #: ``lateral_pressure``'s bend angles at which each training design is solved [rad].
 TARGET_ANGLES = (math.radians(20.0), math.radians(50.0))
 #: Number of coefficients of the correction (:func:`correction_terms`).
-N_TERMS = 3
+N_TERMS = 4
 
 
-def correction_terms(radius, wall_thickness):
-    """The correction's regressors (1, x, x^2), x = ln(t/a), stacked on the last axis."""
-    x = np.log(np.asarray(wall_thickness, float) / np.asarray(radius, float))
-    return np.stack([np.ones_like(x), x, x * x], axis=-1)
+def correction_terms(pressure, radius, wall_thickness, length, mu0):
+    """The correction's regressors (1, ln(t/a), ln(L/a), q/(1+q)), q = p a/(mu0 t),
+    stacked on the last axis (``physics.calibrated.TERMS``; pressure and mu0 [Pa], lengths
+    [m])."""
+    p, a, t, L = (np.asarray(v, float) for v in (pressure, radius, wall_thickness, length))
+    p, a, t, L = np.broadcast_arrays(p, a, t, L)
+    q = p * a / (mu0 * t)
+    return np.stack([np.ones_like(q), np.log(t / a), np.log(L / a), q / (1.0 + q)], axis=-1)
+
+
+def initial_shear_modulus(silicone) -> float:
+    """mu0 = sum(mu_i alpha_i) / 2 of a silicone set [Pa]."""
+    return 0.5 * float(np.sum(np.asarray(silicone.mu) * np.asarray(silicone.alpha)))
 
 
 def _pressure_at(angle, design, silicone):
@@ -124,15 +131,16 @@ def extrapolated(fine, coarse):
 def fit_correction(plan, done, *, silicone=None) -> dict:
     """Fit the correction to the journaled runs; returns the coefficients, the per-point
     ratios of calibrated and lateral_pressure angles to FE, and the leave-one-design-out
-    errors (a design's points predicted by the fit to all other designs)."""
-    from scipy.optimize import least_squares
-
+    ratios (a design's points predicted by the fit to all other designs)."""
+    from ..materials import silicone_parameters
     from ..physics.limits import model_bend_angle
 
     rows = plan["designs"]
     sil = silicone or plan_silicone(plan["silicone"])
     pts = []  # (design index, pressure, FE angle)
     for k, d in enumerate(rows):
+        if k not in done:
+            continue
         fe = extrapolated(done[k]["bend_angle"], done[k]["coarser_bend_angle"])
         for p, th in zip(d["pressures"], fe):
             if np.isfinite(th) and th > 0:
@@ -146,31 +154,23 @@ def fit_correction(plan, done, *, silicone=None) -> dict:
     t = np.array([rows[k]["wall_thickness"] for k in idx])
     L = np.array([rows[k]["length"] for k in idx])
     p = np.array([pp for _, pp, _ in pts])
-    X = correction_terms(a, t)
-
-    def angles(c, sel):
-        # the moment scaled by f = exp(X c): the same angle as the pressure scaled by f,
-        # since every variant's moment is linear in p
-        f = np.exp(X[sel] @ c)
-        return np.array([model_bend_angle(pp * ff, aa, tt, ll, silicone=sil,
-                                          model="lateral_pressure")
-                         for pp, ff, aa, tt, ll in zip(p[sel], f, a[sel], t[sel], L[sel])])
+    lateral = np.array([model_bend_angle(pp, aa, tt, ll, silicone=sil, model="lateral_pressure")
+                        for pp, aa, tt, ll in zip(p, a, t, L)])
+    X = correction_terms(p, a, t, L, initial_shear_modulus(silicone_parameters(sil)))
+    y = np.log(fe / lateral)
 
     def fit(sel):
-        res = least_squares(lambda c: np.log(angles(c, sel) / fe[sel]), np.zeros(N_TERMS),
-                            method="lm", xtol=1e-12, ftol=1e-12)
-        return res.x
+        return np.linalg.lstsq(X[sel], y[sel], rcond=None)[0]
 
-    all_pts = np.ones(len(pts), bool)
-    coef = fit(all_pts)
-    calibrated = angles(coef, all_pts) / fe
-    lateral = angles(np.zeros(N_TERMS), all_pts) / fe
+    coef = fit(np.ones(len(pts), bool))
     loo = np.empty(len(pts))
     for k in np.unique(idx):
         out = idx == k
-        loo[out] = angles(fit(~out), out) / fe[out]
-    return {"coefficients": coef.tolist(), "points": len(pts),
+        loo[out] = np.exp(X[out] @ fit(~out)) * lateral[out] / fe[out]
+    return {"coefficients": coef.tolist(), "terms": list(TERMS), "points": len(pts),
             "designs_used": int(len(np.unique(idx))),
             "design_index": idx.tolist(), "pressure": p.tolist(), "fe_bend_angle": fe.tolist(),
-            "calibrated_over_fe": calibrated.tolist(), "lateral_over_fe": lateral.tolist(),
+            "calibrated_over_fe": (np.exp(X @ coef) * lateral / fe).tolist(),
+            "lateral_over_fe": (lateral / fe).tolist(),
             "loo_calibrated_over_fe": loo.tolist()}
+

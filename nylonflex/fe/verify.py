@@ -20,11 +20,11 @@ from ..units import InputError
 from .runs import journaled_runs, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
-           "fidelity_summary", "run_verify", "sample_designs"]
+           "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
 
 #: The variants whose bend angle at a given pressure differs (the others change the
 #: muscle's side only): the ones the fidelity dataset compares.
-ANGLE_MODELS = ("paper", "cauchy_moment", "lateral_pressure")
+ANGLE_MODELS = ("paper", "cauchy_moment", "lateral_pressure", "fe_calibrated")
 #: The paper's worked examples (docs/model.md s. 8), included when the cube's axes hold them.
 PAPER_EXAMPLES = ({"radius": 20e-3, "wall_thickness": 6e-3, "length": 90e-3,
                    "coil_index": 1.1, "wrap_angle": np.radians(8.0)},
@@ -42,6 +42,18 @@ def fidelity_path(cube) -> Path:
     """The fidelity dataset of a cube: ``<stem>.fidelity.nc`` beside it."""
     cube = Path(cube)
     return cube.with_name(cube.stem + ".fidelity.nc")
+
+
+def open_fidelity(cube):
+    """The fidelity dataset beside ``cube``, loaded (None where there is none; OSError or
+    ValueError where it cannot be read)."""
+    import xarray as xr
+
+    path = fidelity_path(cube)
+    if not path.is_file():
+        return None
+    with xr.open_dataset(path, engine="h5netcdf") as fid:
+        return fid.load()
 
 
 def _parts(cube) -> Path:

@@ -18,11 +18,12 @@ __all__ = ["cache_dir", "source_digest"]
 
 @lru_cache(maxsize=1)
 def source_digest() -> str:
-    """Digest of every physics and kernel source file (16 hex digits)."""
+    """Digest of every physics and kernel source file, and of the physics' data (the
+    ``fe_calibrated`` coefficients, compiled in as constants) (16 hex digits)."""
     root = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
-    for sub in ("physics", "kernels"):
-        for path in sorted((root / sub).glob("*.py")):
+    for sub, pattern in (("physics", "*.py"), ("kernels", "*.py"), ("physics", "*.json")):
+        for path in sorted((root / sub).glob(pattern)):
             digest.update(path.name.encode())
             digest.update(path.read_bytes())
     return digest.hexdigest()[:16]

@@ -32,8 +32,8 @@ from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _node_count, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _design_state, _design_values, _dynamic_values, _model_moment,
-                              _model_state_nodes,
+                              _curve_factor, _design_state, _design_values, _dynamic_values,
+                              _length_factor, _model_moment, _model_state_nodes,
                               _nylon_force_model, _reach,
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
                               _validity, _working_temperatures)
@@ -128,7 +128,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             kappa_curve[jp] = kappa
             rate_curve[jp], rate2_curve[jp] = _curvature_rates(lever_p, dm, d2m)
             for il in range(nl):
-                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il]
+                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * _curve_factor(
+                    model, pressure[jp], a, t, length[il], mu, alpha)
                 out_tip[ia, it, il, jp] = moment / length[il]
         # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
         n_curve = npr if not cauchy else 0
@@ -191,8 +192,11 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                         temps = _working_temperatures(model, ms[0], t_reach, scale, t_amb,
                                                       t_max, gamma, beta, t_g, sigma_g)
                         cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
-                    v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim,
-                                       length[il])
+                    # fe_calibrated's curvatures depend on the length: scaled here, as
+                    # the model state above is length-free
+                    lf = _length_factor(model, a, length[il])
+                    v = _design_values(st[0], st[1], st[2], st[3], st[4] * lf, st[5],
+                                       st[6] * lf, f_lim, length[il])
                     out_design[0, ia, it, il, ic, ip] = v[0]
                     out_flags[0, ia, it, il, ic, ip] = v[1]
                     out_design[1, ia, it, il, ic, ip] = v[2]
@@ -219,7 +223,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[16, ia, it, il, ic, ip] = dyn[2]
                     out_design[17, ia, it, il, ic, ip] = dyn[3]
                     out_design[18, ia, it, il, ic, ip] = dyn[4]
-                    out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4], a, t, b,
+                    out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4] * lf, a, t, b,
                                                               stretch_max,
                                                               length[il] / pitch, closes,
                                                               dyn[4])

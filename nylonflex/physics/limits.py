@@ -18,6 +18,7 @@ from ._formula import (check, check_input, check_section, check_wrap_angle, form
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
                       _taylor_start, quadrature_nodes)
+from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
@@ -31,8 +32,8 @@ __all__ = ["DESIGN_VARIABLES", "EFFICIENCY_BOUND", "MODELS", "VALIDITY_FLAGS", "
            "model_bend_angle", "stroke_limit"]
 
 from ..variables import MODELS  # noqa: E402  (the registry holds the names)
-PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE = \
-    range(6)
+PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE, \
+    FE_CALIBRATED = range(7)
 
 #: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
@@ -194,12 +195,13 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
     """The moment that bends the section at chamber pressure p [N m] in a model variant.
 
     The paper's end-cap moment M_P (eq. 16; every variant but ``lateral_pressure``, bit for
-    bit); ``lateral_pressure`` adds the pressure on the wall and floor, p times
-    :func:`~.bending._lateral_lever` (docs/model.md s. 18). Linear in p in every model:
+    bit); ``lateral_pressure`` (and ``fe_calibrated``, which corrects its curvature) adds the
+    pressure on the wall and floor, p times :func:`~.bending._lateral_lever` (docs/model.md
+    s. 18). Linear in p in every model:
     ``_model_moment(model, 1, ...)`` is dM/dp.
     """
     m = _pressure_moment(pressure, radius, base_thickness)
-    if model == LATERAL_PRESSURE:
+    if model == LATERAL_PRESSURE or model == FE_CALIBRATED:
         m += pressure * _lateral_lever(radius, wall_thickness, base_thickness)
     return m
 
@@ -282,6 +284,9 @@ def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, for
             guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
         kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
                                  cauchy)
+    if model == FE_CALIBRATED:  # the balance's curvatures, corrected (:mod:`.calibrated`)
+        kappa *= _section_correction(p, radius, wall_thickness, mu, alpha)
+        kappa_full *= _section_correction(p_full, radius, wall_thickness, mu, alpha)
     return s, limit, p, moment, kappa, force, kappa_full, closes
 
 
@@ -307,7 +312,27 @@ def _design_state(model, voltage, radius, wall_thickness, base_thickness, length
     ms = _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
                       s_max, force_coeff * (t_reach - t_amb), limited, mu, alpha, x_base,
                       w_base, phi_trig, w_phi, p_atm)
-    return ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6], ms[7], t_reach
+    lf = _length_factor(model, radius, length)
+    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
+
+
+@formula
+def _length_factor(model, radius, length):
+    """The factor a model applies to the curvature of a design of length L [-]: 1 but for
+    ``fe_calibrated`` (:func:`~.calibrated._length_correction`)."""
+    if model == FE_CALIBRATED:
+        return _length_correction(radius, length)
+    return 1.0
+
+
+@formula
+def _curve_factor(model, pressure, radius, wall_thickness, length, mu, alpha):
+    """The factor a model applies to the balance's curvature kappa(p) of a design of length
+    L [-]: 1 but for ``fe_calibrated`` (:mod:`.calibrated`)."""
+    if model == FE_CALIBRATED:
+        return _section_correction(pressure, radius, wall_thickness, mu, alpha) * \
+            _length_correction(radius, length)
+    return 1.0
 
 
 @formula
@@ -695,6 +720,6 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
         y, wy, wyy, work = _node_table(a_, t_, b_, *nodes)
         moment = _model_moment(code, p_, a_, t_, b_)
         return _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
-                                cauchy) * l_
+                                cauchy) * l_ * _curve_factor(code, p_, a_, t_, l_, mu, alpha)
 
     return scalar_or_array(np.vectorize(one, otypes=[float])(p, a, t, b, L))
