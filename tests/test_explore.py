@@ -269,3 +269,56 @@ def test_the_page_offers_the_config(ds):
 
     text = build_html(ds, source="cube.h5")
     assert "copy as config" in text and "@radius@" in text
+
+
+def _fidelity_beside(cube_path, ds):
+    """A fidelity dataset as ``nylonflex verify`` writes it, for two designs of the cube."""
+    import xarray as xr
+
+    from nylonflex.fe.verify import fidelity_path
+
+    n, levels = 2, [0.5, 1.0]
+    fid = xr.Dataset(
+        {"radius": ("design", [15e-3, 20e-3]), "wall_thickness": ("design", [2e-3, 6e-3]),
+         "length": ("design", [90e-3, 90e-3]), "coil_index": ("design", [1.7, 1.1]),
+         "wrap_angle": ("design", [8 * DEG, 8 * DEG]),
+         "pressure": (("design", "level"), [[2e3, 4e3], [5e3, 10e3]]),
+         "fe_bend_angle": (("design", "level"), [[0.3, 0.6], [0.4, np.nan]]),
+         "ratio": (("model", "design", "level"), [[[0.61, 0.62], [0.63, np.nan]],
+                                                  [[1.071, 1.072], [0.973, np.nan]]])},
+        coords={"design": np.arange(n), "level": levels,
+                "model": ["paper", "fe_calibrated"]}, attrs={"fe_mesh": "coarse"})
+    path = fidelity_path(cube_path)
+    fid.to_netcdf(path, engine="h5netcdf")
+    return path
+
+
+def test_the_page_lists_the_verified_designs_with_their_ratios(cube, ds, tmp_path):
+    import shutil
+
+    from nylonflex.explore.fidelity import fidelity_rows
+
+    here = tmp_path / "cube.h5"
+    shutil.copy(cube, here)
+    path = _fidelity_beside(here, ds)
+    out = tmp_path / "page.html"
+    assert main(["explore", str(here), "--html", str(out)]) == 0
+    text = out.read_text()
+    assert "FE fidelity" in text and path.name in text
+    # the summary line: per model, over the finite angles (3 of 4)
+    assert "median 0.620 (0.610-0.630), 0 of 3 within 10 %" in text
+    assert "median 1.071 (0.973-1.072), 3 of 3 within 10 %" in text
+    import xarray as xr
+
+    with xr.open_dataset(path, engine="h5netcdf") as fid:
+        rows = fidelity_rows(ds, fid.load())
+    assert rows["radius"] == [15.0, 15.0, 20.0, 20.0]  # mm, a row a design and level
+    assert rows["pressure"] == [2.0, 4.0, 5.0, 10.0]  # kPa
+    assert rows["ratio_fe_calibrated"][:3] == [1.071, 1.072, 0.973]
+    assert math.isnan(rows["ratio_fe_calibrated"][3])
+
+
+def test_a_page_without_a_fidelity_dataset_has_no_fidelity_part(cube, tmp_path):
+    out = tmp_path / "page.html"
+    assert main(["explore", str(cube), "--html", str(out)]) == 0
+    assert "FE fidelity" not in out.read_text()

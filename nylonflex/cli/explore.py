@@ -84,10 +84,11 @@ def run(args) -> int:
         return 1
     from ..explore.page import build_html, serve
 
+    fidelity = _fidelity(args.cube)
     if args.html:
         from ..files import write_atomic
 
-        text = build_html(ds, source=str(args.cube), where=where)
+        text = build_html(ds, source=str(args.cube), where=where, fidelity=fidelity)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
@@ -99,7 +100,22 @@ def run(args) -> int:
 
     try:
         serve(ds, port=args.port, source=str(args.cube), where=where,
-              show=not args.no_browser, ready=ready)
+              show=not args.no_browser, ready=ready, fidelity=fidelity)
     except KeyboardInterrupt:
         pass
     return 0
+
+
+def _fidelity(cube):
+    """(dataset, file name) of the cube's fidelity dataset (``nylonflex verify``), or None;
+    an unreadable one is a warning, and the page goes on without it."""
+    from ..fe.verify import fidelity_path, open_fidelity
+    from . import warn
+
+    try:
+        fid = open_fidelity(cube)
+    except (OSError, ValueError) as exc:
+        warn("explore", f"{fidelity_path(cube)}: unreadable ({type(exc).__name__}); the page "
+             "shows no FE fidelity")
+        return None
+    return None if fid is None else (fid, fidelity_path(cube).name)

@@ -54,20 +54,15 @@ def run(args) -> int:
 
 def _fidelity_lines(cube) -> list[str]:
     """The fidelity dataset beside the cube (``nylonflex verify``), summarised, if any."""
-    from pathlib import Path
-
-    from ..fe.verify import fidelity_path, fidelity_summary
+    from ..fe.verify import fidelity_path, fidelity_summary, open_fidelity
 
     path = fidelity_path(cube)
-    if not Path(path).is_file():
-        return []
-    import xarray as xr
-
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as fid:
-            fid.load()
+        fid = open_fidelity(cube)
     except (OSError, ValueError) as exc:
         return [f"fidelity  {path}: unreadable ({type(exc).__name__})"]
+    if fid is None:
+        return []
     head = (f"fidelity  {path.name}: {fid.sizes.get('design', 0)} designs, FE mesh "
             f"{fid.attrs.get('fe_mesh', '?')} (nylonflex verify)")
     return [head] + [f"          {line}" for line in fidelity_summary(fid)]

@@ -245,7 +245,7 @@ def _header(ds, p, source, served):
 
 
 def build_document(ds, *, source: str = "", where=(), served: bool = False, payload=None,
-                   doc=None):
+                   doc=None, fidelity=None):
     """The explorer page of a cube as a Bokeh document.
 
     Parameters
@@ -264,6 +264,9 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         builds one document per browser session).
     doc : bokeh.document.Document, optional
         The document to fill (a server session's); a new one by default.
+    fidelity : (xarray.Dataset, str), optional
+        The cube's fidelity dataset (``nylonflex verify``) and its file name: the page
+        lists its designs with each model's ratio to FE (:mod:`.fidelity`).
 
     Returns
     -------
@@ -424,13 +427,18 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
             + ": click a column's title to sort, a row to pick that design; the map marks "
             "the matching designs of its slice with a white dot.")), where_table]
 
+    fidelity_box = []
+    if fidelity is not None:
+        from .fidelity import fidelity_widgets
+
+        fidelity_box = fidelity_widgets(ds, fidelity[0], fidelity[1])
     controls = [variable] + ([Div(text="model variant"), model] if model else []) + \
         [row(map_x, map_y)] + list(sliders.values())
     layout = column(Div(width=1250, text=_header(ds, p, source, served)),
                     row(column(*controls, width=320),
                         column(readout, row(map_fig, lines_fig))),
                     *where_box,
-                    row(table, *curve_figs), note, hold)
+                    row(table, *curve_figs), note, hold, *fidelity_box)
     doc = Document() if doc is None else doc
     doc.add_root(layout)
     doc.title = f"nylonflex explorer: {ds.attrs.get('name', '')}"
@@ -438,7 +446,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     return doc
 
 
-def build_html(ds, *, source: str = "", where=()) -> str:
+def build_html(ds, *, source: str = "", where=(), fidelity=None) -> str:
     """The self-contained explorer page of a cube, as HTML text (bokeh's JS inlined).
 
     Parameters
@@ -449,6 +457,8 @@ def build_html(ds, *, source: str = "", where=()) -> str:
         The cube's path, named on the page.
     where : sequence of str or Condition
         ``--where`` conditions (see :func:`build_document`).
+    fidelity : (xarray.Dataset, str), optional
+        The cube's fidelity dataset and its name (see :func:`build_document`).
 
     Returns
     -------
@@ -457,14 +467,15 @@ def build_html(ds, *, source: str = "", where=()) -> str:
     from bokeh.embed import file_html
     from bokeh.resources import Resources
 
-    doc = build_document(ds, source=source, where=where)
+    doc = build_document(ds, source=source, where=where, fidelity=fidelity)
     text = file_html(doc, Resources(mode="inline"), title=doc.title)
     # Where Panel is imported in the same process, bokeh bundles its extensions' script
     # tags (relative URLs this page never uses and that could not load offline): drop them.
     return re.sub(r'<script[^>]*\bsrc="[^"]*"[^>]*>\s*</script>\s*', "", text)
 
 
-def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready=None):
+def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready=None,
+          fidelity=None):
     """Serve the page of :func:`build_document` on ``127.0.0.1:port`` until interrupted.
 
     The numbers are read from the cube once; each browser session gets its own document.
@@ -479,7 +490,7 @@ def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready
 
     def session(doc):
         build_document(ds, source=source, where=conditions, served=True, payload=payload,
-                       doc=doc)
+                       doc=doc, fidelity=fidelity)
 
     server = Server({"/": Application(FunctionHandler(session))}, port=port,
                     address="127.0.0.1",
