@@ -30,7 +30,9 @@ def add_arguments(p):
                    help="local processes, one FE run each (default 1)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="a Dask scheduler (tcp://HOST:PORT): the runs go to its workers")
-    p.add_argument("--mesh", default="default", metavar="coarse|default|fine")
+    p.add_argument("--mesh", default="coarse", metavar="coarse|default|fine",
+                   help="the FE mesh (default coarse); the FE angle is its Richardson "
+                        "extrapolation with the next coarser mesh")
     p.add_argument("--seed", type=_designs, default=0, help="the sample's seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
