@@ -106,7 +106,8 @@ def _slab_rows(ds, at_loc, r0, r1):
         mixed = (a["limit"] != b["limit"]) | a["limit"].isnull() | b["limit"].isnull()
         if name == "length":
             # F* = M*/L and theta* = kappa(p*) L (docs/model.md s. 8): interpolate the
-            # length-free M* and kappa*, exact along this axis, then scale back
+            # length-free M* and kappa*, exact along this axis, then scale back (for
+            # fe_calibrated kappa* carries (L/a)^c2, docs/model.md s. 21: smooth, not exact)
             la, lb = (float(ds["length"].values[k]) for k in at_loc["length"][:2])
             length = la * (1.0 - w) + lb * w
             a["tip_force_max"], b["tip_force_max"] = (a["tip_force_max"] * la,
