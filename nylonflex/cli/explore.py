@@ -61,7 +61,7 @@ def run(args) -> int:
     from ._common import open_cube_for
 
     if args.html:
-        from ..files import refuse_special
+        from ..storage.files import refuse_special
 
         out = Path(args.html)
         refuse_special(out, "--html", inputs=[args.cube])
@@ -85,7 +85,7 @@ def run(args) -> int:
     from ..explore.page import build_html, serve
 
     if args.html:
-        from ..files import write_atomic
+        from ..storage.files import write_atomic
 
         text = build_html(ds, source=str(args.cube), where=where)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
