@@ -35,7 +35,7 @@ def example_2():
 def write_cube(folder, raw):
     """Sweep a config mapping into ``folder/cube.h5``; return the path."""
     from nylonflex.config import parse_config
-    from nylonflex.sweep import run_sweep
+    from nylonflex.storage.sweep import run_sweep
 
     path = Path(folder) / "cube.h5"
     run_sweep(parse_config(raw), out=path).close()

@@ -3,7 +3,7 @@
 import numpy as np
 
 from nylonflex.bench import QUICK, bench_config
-from nylonflex.bench_numpy import MECHANICAL, grid_numpy
+from nylonflex.bench.yardstick import MECHANICAL, grid_numpy
 from nylonflex.engine.grid import compute_slab
 
 

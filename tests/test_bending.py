@@ -6,7 +6,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import dblquad
 
-from nylonflex import reference as ref
+from nylonflex.bench import reference as ref
 from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
 from nylonflex.physics import bending, silicone
 
@@ -27,7 +27,7 @@ def test_pressure_moment_is_first_moment_of_the_half_disc():
                                        (12e-3, 2e-3, 150.0)])
 def test_material_moment_matches_adaptive_quadrature(name, a, t, kappa):
     # docs/model.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12
-    # (nylonflex.reference)
+    # (nylonflex.bench.reference)
     mu, alpha = silicone_parameters(name).arrays()
     expected = ref.material_moment(kappa, a, t, t, mu, alpha)
     assert bending.material_moment(kappa, a, t, None, name) == pytest.approx(expected,

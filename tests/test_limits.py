@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from nylonflex import reference as ref
+from nylonflex.bench import reference as ref
 from conftest import DEG, EXAMPLE_1, EXAMPLE_2
 from nylonflex import design_limits
 from nylonflex.materials import nylon_parameters, silicone_parameters

@@ -105,7 +105,7 @@ def test_every_doc_the_code_and_docs_cite_exists():
 
 
 def test_settled_error_at_the_end_of_each_reference_level():
-    from nylonflex.simulate import settled_errors
+    from nylonflex.sim import settled_errors
 
     t = np.arange(6.0)
     ref = np.array([0, 0, 1, 1, 1, 2.0])   # levels end at indices 1, 4 and 5

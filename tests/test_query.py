@@ -19,7 +19,7 @@ from nylonflex import query
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import open_cube
-from nylonflex.sweep import run_sweep
+from nylonflex.storage.sweep import run_sweep
 from nylonflex.units import InputError
 
 AT_2 = "radius=7.5mm,wall_thickness=2mm,length=70mm,coil_index=1.7,wrap_angle=8deg"
@@ -115,8 +115,8 @@ def test_limit_between_disagreeing_grid_points_is_unknown(ds):
     a = ds["radius"].values
     at = dict(EXAMPLE_2, wrap_angle=20 * DEG, radius=0.5 * (a[i] + a[i + 1]))
     # the slab reader leaves it unknown; the query then takes it from the exact model
-    at_loc = {n: query.scan._locate(ds, n, v) for n, v in at.items()}
-    assert np.isnan(query.scan._slab_rows(ds, at_loc, i, i + 2)["limit"][0])
+    at_loc = {n: query.locate(ds, n, v) for n, v in at.items()}
+    assert np.isnan(query.slab_rows(ds, at_loc, i, i + 2)["limit"][0])
     res = query.query_cube(ds, at=at, interpolate=True)
     assert res.data["limit"][0] == nf.design_limits(**at)["limit"]
     assert "boundary" not in query.format_table(res)
@@ -408,9 +408,9 @@ def test_query_progress_callback(ds):
 ])
 def test_where_reads_variable_by_variable_and_finds_what_a_full_read_finds(ds, at, where):
     # the reference: every column of every slab read, then all conditions tested
-    at_loc = {n: query.scan._locate(ds, n, v) for n, v in (query.parse_at(at) if at
+    at_loc = {n: query.locate(ds, n, v) for n, v in (query.parse_at(at) if at
                                                             else {}).items()}
-    full = query.scan._slab_rows(ds, at_loc, 0, ds.sizes["radius"])
+    full = query.slab_rows(ds, at_loc, 0, ds.sizes["radius"])
     keep = np.ones(len(full["radius"]), dtype=bool)
     for c in query.parse_where(where):
         keep &= c.mask(full[c.name])
@@ -561,9 +561,9 @@ def test_interpolate_takes_the_flags_from_the_exact_model(ds, cube, capsys):
 def test_interpolated_flags_without_the_exact_model_are_unknown_where_corners_disagree(ds):
     # the slab reader itself (what a cube of several models gets): never a blend
     at = dict(FLIP, radius=11e-3)
-    at_loc = {n: query.scan._locate(ds, n, v) for n, v in at.items()}
-    rows = query.scan._slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
+    at_loc = {n: query.locate(ds, n, v) for n, v in at.items()}
+    rows = query.slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
     assert np.isnan(rows["validity"][0])
-    at_loc = {n: query.scan._locate(ds, n, v) for n, v in dict(at, radius=6e-3).items()}
-    rows = query.scan._slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
+    at_loc = {n: query.locate(ds, n, v) for n, v in dict(at, radius=6e-3).items()}
+    rows = query.slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
     assert rows["validity"][0] == 0  # both corners clean

@@ -32,7 +32,7 @@ import nylonflex.storage.run as run_mod
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
-from nylonflex.sweep import run_sweep
+from nylonflex.storage.sweep import run_sweep
 from nylonflex.units import InputError
 from nylonflex.variables import is_complete
 
@@ -356,7 +356,7 @@ def test_special_files_are_refused(small_cfg, tmp_path, capsys):
 
 
 def test_simulate_never_writes_over_a_cube(tmp_path, small_cfg):
-    from nylonflex.simulate import write_simulation
+    from nylonflex.sim import write_simulation
 
     raw, cfg = small_cfg
     out = tmp_path / "cube.h5"
@@ -929,7 +929,7 @@ def test_nylon_use_is_at_most_one_by_construction(monkeypatch):
 
 
 def test_a_simulation_over_its_budget_says_its_size_and_how_to_raise_it():
-    from nylonflex.simconfig import parse_sim_config
+    from nylonflex.config.simulate import parse_sim_config
 
     raw = {"name": "long", "time": {"duration": "1000 s", "step": "0.01 ms"},
            "reference": {"kind": "step", "initial": 0, "final": 120, "at": "1 s"}}

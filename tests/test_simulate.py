@@ -23,7 +23,7 @@ from nylonflex.cli import main
 from nylonflex.materials import silicone_parameters
 from nylonflex.kernels.control import _switch, angle_table, estimate_angle, plant_angle
 from nylonflex.physics.bending import NEWTON_RTOL, quadrature_nodes
-from nylonflex.simulate import (
+from nylonflex.sim import (
     PLANT_TABLE_POINTS,
     parse_sim_config,
     run_simulation,
@@ -273,7 +273,7 @@ def test_step_rise_time_matches_inverted_model():
 
 
 def test_step_metrics_on_a_known_curve():
-    from nylonflex.simulate import Reference, step_metrics
+    from nylonflex.sim import Reference, step_metrics
 
     t = np.linspace(0.0, 10.0, 1001)
     ref = Reference("step", {"initial": 0.0, "final": 1.0, "at": 1.0})

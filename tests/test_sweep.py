@@ -12,8 +12,8 @@ import yaml
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
-from nylonflex.engine.grid import _bytes_per_radius, plan_slabs
-from nylonflex.sweep import run_sweep
+from nylonflex.engine.grid import bytes_per_radius, plan_slabs
+from nylonflex.storage.sweep import run_sweep
 from nylonflex.variables import VARIABLES
 
 SMALL = {
@@ -88,7 +88,7 @@ def test_slabs_bound_memory():
     big = parse_config({**SMALL, "grid": {**SMALL["grid"],
                                           "radius": {"start": 5, "stop": 25, "num": 4000}}})
     slabs, chunk = plan_slabs(big)
-    per_radius = _bytes_per_radius(big)
+    per_radius = bytes_per_radius(big)
     assert len(slabs) > 1 and slabs[-1][1] == 4000
     assert all((i1 - i0) * per_radius <= 2**20 for i0, i1 in slabs)
     assert all((i1 - i0) % chunk == 0 for i0, i1 in slabs[:-1])

@@ -17,7 +17,7 @@ from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.engine.grid import cube_variables, plan_slabs
 from nylonflex.config.safe_yaml import read_yaml
-from nylonflex.simulate import parse_sim_config, run_simulation
+from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.units import InputError
 
 CONTROL = "configs/control.yaml"

@@ -41,7 +41,7 @@ def test_dry_run_prints_size_memory_time_and_writes_nothing(tmp_path, capsys):
 
 
 def test_estimate_sizes_match_the_written_cube(tmp_path):
-    from nylonflex.sweep import estimate
+    from nylonflex.storage.sweep import estimate
 
     cfg = parse_config(TINY)
     e = estimate(cfg)
@@ -74,7 +74,7 @@ def test_init_writes_the_examples_and_never_overwrites(tmp_path, capsys):
     from nylonflex.config import load_config
     from nylonflex.design import load_spec
     from nylonflex.examples import EXAMPLES
-    from nylonflex.simconfig import load_sim_config
+    from nylonflex.config.simulate import load_sim_config
 
     rc, out, _ = run(capsys, "init", tmp_path / "mine")
     repo = Path(__file__).resolve().parents[1]

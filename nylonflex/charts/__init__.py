@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config.charts import CHART_REGISTRY
-from ..files import save_figure
+from ..storage.files import save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
 from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
@@ -173,7 +173,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         The variable ``compare`` draws (default ``tip_force_max``).
     overwrite : bool
         Replace files nylonflex did not write for this cube [-] (a manifest in the folder,
-        :class:`nylonflex.files.OwnedFiles`, records the charts each cube drew).
+        :class:`nylonflex.storage.files.OwnedFiles`, records the charts each cube drew).
     refuse_foreign : bool
         With such a file in the way and no ``overwrite``: raise before drawing anything
         (True) or leave that chart undrawn with a line to ``on_skip`` (False) [-].
@@ -211,7 +211,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
             raise InputError(f"--variable: compare draws one of {', '.join(comparable(ds))}; "
                              f"got {variable!r}")
         chosen["variable"] = variable
-    from ..files import OwnedFiles
+    from ..storage.files import OwnedFiles
 
     owner = chart_owner(ds)
     ds = _short_attrs(ds)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..files import save_figure
+from ..storage.files import save_figure
 from ._common import new_figure, rc_context
 from ..variables import AXES, display_label, to_display
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..files import save_figure
+from ..storage.files import save_figure
 
 __all__ = ["draw_simulation_charts", "figure9", "figure10a"]
 

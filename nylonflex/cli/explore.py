@@ -61,7 +61,7 @@ def run(args) -> int:
     from ._common import open_cube_for
 
     if args.html:
-        from ..files import refuse_special
+        from ..storage.files import refuse_special
 
         out = Path(args.html)
         refuse_special(out, "--html", inputs=[args.cube])
@@ -86,7 +86,7 @@ def run(args) -> int:
 
     fidelity = _fidelity(args.cube)
     if args.html:
-        from ..files import write_atomic
+        from ..storage.files import write_atomic
 
         text = build_html(ds, source=str(args.cube), where=where, fidelity=fidelity)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])

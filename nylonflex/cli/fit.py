@@ -138,7 +138,7 @@ def run_fe(args) -> int:
     from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
     from ..physics.calibrated import CORRECTION, TERMS
     from ..fe.verify import MAX_DESIGNS
-    from ..files import refuse_special, write_atomic
+    from ..storage.files import refuse_special, write_atomic
     from ..units import InputError, json_text
     from ._common import progress_bar
 
@@ -220,7 +220,7 @@ def run(args) -> int:
     import os
     from pathlib import Path
 
-    from ..files import refuse_special
+    from ..storage.files import refuse_special
 
     # refused before the work: a link, a special file, the data file itself, or (without
     # --overwrite) any file

@@ -14,11 +14,11 @@ def add_arguments(m):
 
 
 def run(args) -> int:
-    from ..simulate import load_sim_config, run_simulation, summary, write_simulation
+    from ..sim import load_sim_config, run_simulation, summary, write_simulation
 
     cfg = load_sim_config(args.config)
     out = Path(args.out) if args.out else Path("sweeps") / cfg.name / "sim.h5"
-    from ..files import refuse_special
+    from ..storage.files import refuse_special
 
     refuse_special(out, "--out", inputs=[args.config])  # before the work
     ds = run_simulation(cfg)

@@ -58,7 +58,7 @@ def run(args) -> int:
 def _run(args, charts: bool) -> int:
     from contextlib import ExitStack
 
-    from ..files import refuse_special
+    from ..storage.files import refuse_special
 
     def log(msg):
         if not args.quiet:
@@ -71,7 +71,7 @@ def _run(args, charts: bool) -> int:
         with _collect_after_start():
             from ..config import load_config
             from ..engine.slabs import deferred_signals
-            from ..sweep import default_output, prepare, sweep_file
+            from ..storage.sweep import default_output, prepare, sweep_file
 
             cfg = load_config(args.config, args.set)
             out = Path(args.out) if args.out else default_output(cfg)
@@ -188,7 +188,7 @@ def _duration(seconds) -> str:
 
 
 def _dry_run(cfg, out, args, log) -> int:
-    from ..sweep import estimate
+    from ..storage.sweep import estimate
 
     if args.scheduler:
         log("dry run: the time is estimated for this machine's threads, not the cluster")

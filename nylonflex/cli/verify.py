@@ -45,7 +45,7 @@ def run(args) -> int:
     from ..charts.fidelity import fidelity_map
     from ..fe import require_felupe
     from ..fe.verify import fidelity_summary, run_verify
-    from ..files import save_figure
+    from ..storage.files import save_figure
     from ._common import progress_bar
 
     require_felupe()

@@ -21,7 +21,7 @@ def add_arguments(w):
 def _control(notice):
     """The closed-loop kernels: a 0.1 s simulation of the paper's example 2."""
     from ..engine.warmup import timed
-    from ..simulate import parse_sim_config, run_simulation
+    from ..sim import parse_sim_config, run_simulation
 
     cfg = parse_sim_config({
         "name": "warmup",

@@ -2,17 +2,13 @@
 
 - :mod:`.base`: strict pydantic models, the one range-error formatter, one-line messages;
 - :mod:`.sweep`: sweep configs (``nylonflex sweep``), :class:`ResolvedConfig`;
-- :mod:`.uncertainty`: their ``uncertainty:`` section.
-
-Simulate configs (:mod:`nylonflex.simconfig`) use the same machinery.
+- :mod:`.uncertainty`: their ``uncertainty:`` section;
+- :mod:`.simulate`: simulate configs (``nylonflex simulate``), the same machinery.
 """
 
 from .base import (
                    Count,
                    Number,
-                   _no_bool,
-                   _pydantic_message,
-                   _Strict,
                    check_range,
                    check_run_name,
                    range_error,
@@ -37,6 +33,4 @@ from .uncertainty import UncertainParameter, UncertaintySpec
 __all__ = ["CHARTS", "Count", "Number", "DESIGN_RANGES", "LIMITS", "ResolvedConfig", "SweepConfig",
            "UncertainParameter", "UncertaintySpec", "apply_overrides", "canonical_yaml",
            "check_range", "check_run_name", "cube_bytes", "load_config", "load_yaml",
-           "parse_config", "range_error", "read_yaml", "valid_name",
-           # shared with simconfig, the other config of the package's machinery
-           "_Strict", "_no_bool", "_pydantic_message"]
+           "parse_config", "range_error", "read_yaml", "valid_name"]

@@ -1,7 +1,7 @@
 """The config machinery every config shares: strict pydantic models, one range-error
 formatter, and pydantic's errors as one line naming the dotted field.
 
-Sweep configs (:mod:`.sweep`) and simulate configs (:mod:`nylonflex.simconfig`) both use it.
+Sweep configs (:mod:`.sweep`) and simulate configs (:mod:`.simulate`) both use it.
 """
 
 from __future__ import annotations

@@ -51,7 +51,7 @@ class DesignSpecModel(_Strict):
 
 
 def _models() -> dict:
-    from ..simconfig import SimConfigModel
+    from .simulate import SimConfigModel
     from .sweep import SweepConfig
 
     return {"sweep": SweepConfig, "simulate": SimConfigModel, "design": DesignSpecModel}

@@ -106,7 +106,7 @@ def _cube_materials(config_yaml, model):
 def _open(spec, cube):
     from ..config import parse_config
     from ..storage import open_cube
-    from ..sweep import run_sweep
+    from ..storage.sweep import run_sweep
 
     if cube is not None or spec.cube is not None:
         return open_cube(Path(cube if cube is not None else spec.cube), quiet=True)

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..query import COLUMNS, _cell, default_columns
+from ..query import COLUMNS, cell_text, default_columns
 from ..query.format import INTEGERS
 from ..variables import VARIABLES, to_display
 
@@ -132,7 +132,7 @@ def format_table(res) -> str:
     def cell(h, d):
         if h == "alternatives":
             return _alternatives_text(d.get("alternatives") or {})
-        return _cell(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
+        return cell_text(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
 
     cells = [[d["source"]] + [cell(h, d) for h in heads[1:]] for d in res.designs]
     widths = [max(len(h), len(u), *(len(r[j]) for r in cells))

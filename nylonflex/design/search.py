@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..query import COLUMNS, _locate, _slab_rows, at_value
+from ..query import COLUMNS, at_value, locate, slab_rows
 from ..variables import TRACKING
 from ..query.scan import radius_slabs
 from ..units import InputError
@@ -158,7 +158,7 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
             reasons.append(f"{name}: fixed to two different values; no design meets both")
             continue
         try:
-            at_loc[name] = _locate(ds, name, value)
+            at_loc[name] = locate(ds, name, value)
         except InputError:
             lo, hi = ranges[name]
             reasons.append(f"{name} == {_shown(name, value)}: the cube's {name} spans "
@@ -181,7 +181,7 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
     for r0, r1 in slabs:
         if done is not None and "radius" not in at_loc and not done[r0:r1].any():
             continue
-        rows = _slab_rows(ds, at_loc, r0, r1)
+        rows = slab_rows(ds, at_loc, r0, r1)
         known = ~np.isnan(rows["tip_force_max"])
         rows = _take(rows, known)
         n = int(known.sum())

@@ -17,8 +17,8 @@ from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_len
 from ..physics.wrap import muscle_width
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
 
-__all__ = ["FLOAT_DESIGN", "compute_slab", "coords", "cube_variables", "global_arrays",
-           "plan_slabs", "slab_variables"]
+__all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
+           "cube_variables", "global_arrays", "plan_slabs", "slab_variables"]
 
 #: The float design variables in the registry's order (the kernel's ``out.design`` rows).
 FLOAT_DESIGN = tuple(n for n, v in DESIGN.items() if v.dtype == "float64")
@@ -57,7 +57,9 @@ def coords(cfg: ResolvedConfig) -> dict:
     return out
 
 
-def _bytes_per_radius(cfg: ResolvedConfig) -> int:
+def bytes_per_radius(cfg: ResolvedConfig) -> int:
+    """Bytes [B] that one radius of ``cfg``'s cube holds uncompressed: every variable that
+    runs along ``radius``, over the other dimensions (the size of a slab per radius)."""
     sizes = {k: len(v) for k, v in coords(cfg).items()}
     sizes["model"] = len(cfg.models)
     return sum(int(np.prod([sizes[d] for d in dims[1:]])) * np.dtype(v.dtype).itemsize
@@ -70,7 +72,7 @@ def plan_slabs(cfg: ResolvedConfig) -> tuple[list[tuple[int, int]], int]:
     A slab holds as many radii as fit in ``cfg.slab_megabytes`` (at least one), a multiple
     of the chunk length so that slabs write whole chunks.
     """
-    per = _bytes_per_radius(cfg)
+    per = bytes_per_radius(cfg)
     na = cfg.shape[0]
     per_slab = min(na, max(1, int(cfg.slab_megabytes * 2**20) // per))
     # chunks of about 2 MB of one variable, never longer than a slab
@@ -137,10 +139,13 @@ def plan_is_implied(cfg: ResolvedConfig, slabs, chunk) -> bool:
     if not 1 <= n <= na:
         return False
     return slabs == _uniform_slabs(na, n) and \
-        chunk == min(n, _chunk_cap(_bytes_per_radius(cfg))) and n % chunk == 0
+        chunk == min(n, _chunk_cap(bytes_per_radius(cfg))) and n % chunk == 0
 
 
-def _coil_table(cfg: ResolvedConfig):
+def coil_table(cfg: ResolvedConfig):
+    """The kernels' per-coil-index table (:class:`~nylonflex.kernels.records.CoilTable`) of
+    ``cfg``'s coil-index axis: s_max [-], force limit [N], muscle width [m], r' [ohm/m] and
+    heat loss per length [W/(K m)], one contiguous float64 column each."""
     from ..kernels.records import CoilTable
 
     c = cfg.axes["coil_index"]
@@ -252,7 +257,7 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
                   tip_force=empty(shape("tip_force")))
     voltage = -1.0 if cfg.supply_voltage is None else float(cfg.supply_voltage)
     options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
-    kernel(grid, _coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
+    kernel(grid, coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
            _muscle(cfg), options, out)
     arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
     arrays.update(limit=out.flags[0], validity=out.flags[1], nylon_force=out.nylon_force,

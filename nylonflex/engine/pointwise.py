@@ -27,7 +27,7 @@ from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
-from ..physics.thermal import _coil_resistance, check_supply_rise
+from ..physics.thermal import check_supply_rise, coil_resistance
 from ..variables import DESIGN
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
@@ -140,7 +140,7 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     width = d_f * (c_flat + 1.0)
     muscle = _single_muscle(nylon) if n == 1 and isinstance(nylon, str) else \
         [flat(ny[k]) for k in _MUSCLE_FIELDS]
-    r_per_len = np.vectorize(_coil_resistance, otypes=[float])(
+    r_per_len = np.vectorize(coil_resistance, otypes=[float])(
         flat(ny["resistance_per_length"]), flat(ny["resistance_coil_index"]), c_flat)
     loss_per_len = _heat_loss(cooling, d_f, flat(ny["t_max"]), flat(ny["t_amb"]), c_flat,
                               flat(ny["heat_loss_per_length"]))

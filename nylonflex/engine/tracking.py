@@ -18,7 +18,7 @@ import numpy as np
 from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
-from ..physics.nylon import _stroke_scale, stroke
+from ..physics.nylon import stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length, steady_temperature
 from ..physics.wrap import muscle_length
 from ..variables import TRACKING
@@ -98,9 +98,9 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     with np.errstate(all="ignore"):
         p_group = np.ascontiguousarray(np.nanmax(p_top.reshape(len(a), len(t), -1), axis=2)
                                        if p_top.size else np.zeros((len(a), len(t))))
-    scale = np.array([float(_stroke_scale(c, np.asarray(ny.coil_index_table),
-                                          np.asarray(ny.stroke_max_table), ny.t_amb,
-                                          ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
+    scale = np.array([float(stroke_scale(c, np.asarray(ny.coil_index_table),
+                                         np.asarray(ny.stroke_max_table), ny.t_amb,
+                                         ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
                       for c in C])
     if spec.relative_to == "bend_angle_max":
         ref_scale = np.ascontiguousarray(nominal["bend_angle_max"], dtype=float)

@@ -56,7 +56,7 @@ def journaled_runs(parts, plan, tasks, solve, *, workers=1, scheduler=None, prog
     ``plan`` (JSON-able) identifies the runs: a folder holding another plan is refused.
     ``solve`` must be importable (it runs in other processes); its result JSON-able.
     """
-    from ..files import write_atomic
+    from ..storage.files import write_atomic
     from ..units import json_text
 
     parts = Path(parts)

@@ -150,7 +150,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     import xarray as xr
 
     from .. import __version__
-    from ..files import replacing
+    from ..storage.files import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
     from ..units import json_text

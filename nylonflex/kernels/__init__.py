@@ -1,4 +1,5 @@
-"""Numba kernels over design grids. Only :mod:`nylonflex.sweep` (and the simulator) call them.
+"""Numba kernels over design grids. Only :mod:`nylonflex.storage.sweep` (and the simulator)
+call them.
 
 :func:`source_digest` (of the physics and kernel sources) names the compiled model in a
 cube's provenance and keys :func:`cache_dir`, the kernels' own Numba cache folder; neither

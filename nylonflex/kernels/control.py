@@ -1,6 +1,6 @@
 """Numba kernels of the closed-loop simulation (docs/model.md section 10, paper figures 8-10).
 
-Private, unchecked kernels (the caller, :mod:`nylonflex.simulate`, validates and shapes
+Private, unchecked kernels (the caller, :mod:`nylonflex.sim`, validates and shapes
 everything):
 
 - :func:`angle_table` tabulates the model's bend angle and its slope against pressure on a

@@ -23,8 +23,8 @@ from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pres
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
-from .thermal import _coil_resistance, _cooling_time, _heating_power, _heating_time, \
-    _steady_temperature, check_supply_rise, coil_heat_loss_per_length
+from .thermal import _cooling_time, _heating_power, _heating_time, \
+    _steady_temperature, check_supply_rise, coil_heat_loss_per_length, coil_resistance
 from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
     _outer_perimeter, _pitch, _wrap_force
 
@@ -647,7 +647,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     for idx in np.ndindex(a.shape):
         ai, ti, bi, Li, ci, pi = (float(x[idx]) for x in (a, t, b, L, c, psi))
         force_limit = float(np.interp(ci, c_tab, ny.tensile_strength_table)) * ny.fibre_area
-        r_per_len = _coil_resistance(ny.resistance_per_length, ny.resistance_coil_index, ci)
+        r_per_len = coil_resistance(ny.resistance_per_length, ny.resistance_coil_index, ci)
         loss_per_len = ny.heat_loss_per_length if cooling is None else \
             coil_heat_loss_per_length(ci, ny, cooling)
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))

@@ -18,6 +18,7 @@ __all__ = [
     "nylon_force_limit",
     "stroke",
     "stroke_max",
+    "stroke_scale",
     "temperature_for_stroke",
     "tensile_strength",
     "thermomechanical_force",
@@ -42,7 +43,7 @@ def _stroke_shape_at(temperature, t_amb, gamma, beta, t_g, c, erf_amb):
 
 
 @formula
-def _stroke_scale(coil_index, c_table, smax_table, t_amb, t_max, gamma, beta, t_g, sigma_g):
+def stroke_scale(coil_index, c_table, smax_table, t_amb, t_max, gamma, beta, t_g, sigma_g):
     """Factor s_max(C) / s_ref(T_max) that scales alpha, beta, gamma to coil index C [-]."""
     return np.interp(coil_index, c_table, smax_table) / _stroke_shape(
         t_max, t_amb, gamma, beta, t_g, sigma_g
@@ -152,7 +153,7 @@ def _shape_args(ny):
 
 def _scale(coil_index, ny):
     c = _coil_index(coil_index, ny)
-    return _stroke_scale(c, np.asarray(ny.coil_index_table), np.asarray(ny.stroke_max_table),
+    return stroke_scale(c, np.asarray(ny.coil_index_table), np.asarray(ny.stroke_max_table),
                          ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
 
 

@@ -17,6 +17,7 @@ __all__ = [
     "AIR_PROPERTIES",
     "WATER_PROPERTIES",
     "coil_heat_loss_per_length",
+    "coil_resistance",
     "coil_resistance_per_length",
     "convection_loss_per_length",
     "MIN_SUPPLY_RISE",
@@ -194,7 +195,7 @@ def coil_heat_loss_per_length(coil_index, nylon="silver_nylon66", cooling=None):
 
 
 @formula
-def _coil_resistance(r_ref, c_ref, coil_index):
+def coil_resistance(r_ref, c_ref, coil_index):
     """r'(C) = r'_ref sqrt((pi C)^2 + 1) / sqrt((pi C_r)^2 + 1) [ohm/m]; r'_ref if C_r <= 0.
 
     Exactly r'_ref at C = C_r (x / x is 1 in floating point).
@@ -223,8 +224,8 @@ def coil_resistance_per_length(coil_index, nylon="silver_nylon66"):
     """
     ny = nylon_parameters(nylon)
     c = check("coil_index", coil_index, 0.0, lo_open=True)
-    out = np.vectorize(lambda ci: _coil_resistance(ny.resistance_per_length,
-                                                   ny.resistance_coil_index, ci),
+    out = np.vectorize(lambda ci: coil_resistance(ny.resistance_per_length,
+                                                  ny.resistance_coil_index, ci),
                        otypes=[float])(c)
     return scalar_or_array(out)
 

@@ -67,7 +67,10 @@ def _integer(x):
     return int(x) if math.isfinite(x) else None
 
 
-def _cell(name, x) -> str:
+def cell_text(name, x) -> str:
+    """The table text of value ``x`` [SI] of column ``name``: the model's name, the validity
+    flags by name, the limit by word, an axis in its display unit to 6 digits, any other
+    variable in its display unit to 3 significant digits."""
     if name == "model":
         return str(x)
     if name == "validity":
@@ -132,7 +135,7 @@ def format_table(res) -> str:
                 continue  # heating_time without a supply
             x = res.data[name][0]
             unit = _unit(name)
-            text = _cell(name, x)
+            text = cell_text(name, x)
             if name == "limit":
                 text = {"stroke": "stroke-limited (full range of motion)",
                         "strength": "strength-limited (the nylon's strength cuts in)",
@@ -147,7 +150,7 @@ def format_table(res) -> str:
     if res.at:
         print(f"at {_describe_at(res)}", file=out)
     heads = list(shown_columns(res, "table"))
-    cells = [[_cell(h, res.data[h][i]) for h in heads] for i in range(n)]
+    cells = [[cell_text(h, res.data[h][i]) for h in heads] for i in range(n)]
     for line in _columns_text(heads, cells):
         print(line, file=out)
     print(rows_note(res), file=out)

@@ -21,7 +21,7 @@ _GRID_RTOL = 1e-6
 _SLAB_VALUES = 2**20
 
 
-def _locate(ds, name, value):
+def locate(ds, name, value):
     """Where ``value`` [SI] sits on axis ``name``: ``(i0, i1, weight of i1, on_grid)``.
 
     Raises
@@ -89,7 +89,7 @@ class QueryResult:
         return len(self.data[COLUMNS[0]])
 
 
-def _slab_rows(ds, at_loc, r0, r1):
+def slab_rows(ds, at_loc, r0, r1):
     """Rows (SI arrays by column) of radius indices [r0, r1) after ``--at`` selection."""
     # read each given axis's bracketing pair (one index on a grid point), then collapse it
     index = {name: slice(i0, i1 + 1) for name, (i0, i1, _, _) in at_loc.items()
@@ -157,7 +157,7 @@ def _where_rows(ds, at_loc, r0, r1, conditions, room=None):
     designs after the ones before; the slab is left as soon as nothing matches. The other
     columns are then read over the final box of the rows kept only (none once ``--limit``
     rows are kept: the scan then reads the tested variables alone), and the matching rows
-    picked from it, in grid order, as :func:`_slab_rows` gives them.
+    picked from it, in grid order, as :func:`slab_rows` gives them.
     """
     fixed = {name: loc[0] for name, loc in at_loc.items() if name != "radius"}
     dims = [d for d in AXES if d not in fixed]
@@ -360,7 +360,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         if name in OPTIONAL and name not in ds:
             raise InputError(f"--columns: the cube has no {name}; sweep a config with "
                              "'requirements' (docs/uncertainty.md)")
-    at_loc = {name: _locate(ds, name, value) for name, value in at.items()}
+    at_loc = {name: locate(ds, name, value) for name, value in at.items()}
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
@@ -399,7 +399,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             # variable by variable (a cube of several models is read whole, per slab)
             rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
         else:
-            rows = _slab_rows(ds, at_loc, r0, r1)
+            rows = slab_rows(ds, at_loc, r0, r1)
         if flags == EXACT:
             rows = _exact_flags(rows, settings)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)

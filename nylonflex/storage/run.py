@@ -204,9 +204,9 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
 
 
 def _needed_gigabytes(cfg) -> float:
-    from ..engine.grid import _bytes_per_radius
+    from ..engine.grid import bytes_per_radius
 
-    return 2 * _bytes_per_radius(cfg) * cfg.shape[0] / 1e9
+    return 2 * bytes_per_radius(cfg) * cfg.shape[0] / 1e9
 
 
 def _disk_full(exc) -> bool:

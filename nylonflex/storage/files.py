@@ -21,7 +21,7 @@ import secrets
 import stat
 from pathlib import Path
 
-from .units import InputError
+from ..units import InputError
 
 __all__ = ["OwnedFiles", "create_new", "fsync_dir", "publish", "refuse_link",
            "refuse_special", "replacing", "save_figure", "write_atomic"]

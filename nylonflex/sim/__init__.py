@@ -8,7 +8,7 @@ small table built once per design, and a bang-bang controller switches the suppl
 gripper of figure 10: the switched-on muscles are in parallel on it, and its terminal
 voltage sags over its internal resistance.
 
-A config (YAML) is validated by :mod:`nylonflex.simconfig` before any kernel runs (its
+A config (YAML) is validated by :mod:`nylonflex.config.simulate` before any kernel runs (its
 names are re-exported here); every refusal is one :class:`~nylonflex.units.InputError` line
 naming the field. :func:`run_simulation` returns an :class:`xarray.Dataset` in SI with
 ``units`` and ``long_name`` on every variable; :func:`summary` gives the lines the
@@ -29,13 +29,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from . import __version__
-from .physics.bending import NEWTON_RTOL, quadrature_nodes
-from .physics.chamber import P_ATM, chamber_pressure
-from .physics.nylon import _stroke_scale, nylon_force_limit, stroke
-from .physics.thermal import coil_resistance_per_length
-from .physics.wrap import nylon_force
-from .simconfig import (  # noqa: F401 - the config layer's names, importable from here too
+from .. import __version__
+from ..config.simulate import (  # noqa: F401 - the config layer's names, importable from here too
     DEFAULTS,
     ActuatorSpec,
     Reference,
@@ -45,6 +40,11 @@ from .simconfig import (  # noqa: F401 - the config layer's names, importable fr
     parse_sim_config,
     top_temperature,
 )
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
+from ..physics.chamber import P_ATM, chamber_pressure
+from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
+from ..physics.thermal import coil_resistance_per_length
+from ..physics.wrap import nylon_force
 
 __all__ = [
     "PLANT_TABLE_POINTS",
@@ -168,7 +168,7 @@ def step_metrics(t, angle, ref: Reference):
 
 
 def _tables(a: ActuatorSpec, p_top: float):
-    from .kernels.control import angle_table
+    from ..kernels.control import angle_table
 
     mu, alpha = a.silicone.arrays()
     nodes = quadrature_nodes()
@@ -210,8 +210,8 @@ def run_simulation(cfg: SimConfig):
     """
     import xarray as xr
 
-    from .kernels.control import closed_loop
-    from .kernels.records import AngleTables, Control, Muscles, SimOut, Supply
+    from ..kernels.control import closed_loop
+    from ..kernels.records import AngleTables, Control, Muscles, SimOut, Supply
 
     n, m = len(cfg.actuators), cfg.n_steps
     t = np.arange(m) * cfg.step
@@ -222,9 +222,9 @@ def run_simulation(cfg: SimConfig):
         ny = a.nylon
         lm = actuator_muscle_length(a)
         top = top_temperature(cfg, a)
-        scale = float(_stroke_scale(a.coil_index, np.asarray(ny.coil_index_table),
-                                    np.asarray(ny.stroke_max_table), ny.t_amb, ny.t_max,
-                                    ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
+        scale = float(stroke_scale(a.coil_index, np.asarray(ny.coil_index_table),
+                                   np.asarray(ny.stroke_max_table), ny.t_amb, ny.t_max,
+                                   ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
         s_top = float(stroke(top, a.coil_index, ny))
         p_top = float(chamber_pressure(s_top)) * (1.0 + 1e-9)
         dpp, plant, slope, dpe, est = _tables(a, max(p_top, 1.0))
@@ -329,12 +329,12 @@ def write_simulation(ds, path, inputs=()) -> Path:
     """Write a simulation Dataset to NetCDF4/HDF5 (h5netcdf engine) at ``path``.
 
     Atomic: written to a new temporary file beside it, fsynced, then renamed
-    (:func:`nylonflex.files.replacing`). Only an earlier simulation is replaced; anything
+    (:func:`nylonflex.storage.files.replacing`). Only an earlier simulation is replaced; anything
     else at ``path`` (a cube, a config, a link, a special file, one of ``inputs``) is
     refused with an InputError.
     """
-    from .files import refuse_special, replacing
-    from .units import InputError
+    from ..storage.files import refuse_special, replacing
+    from ..units import InputError
 
     path = Path(path)
     refuse_special(path, "--out", inputs)

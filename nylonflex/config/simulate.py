@@ -1,11 +1,11 @@
 """YAML simulation configs: schema, defaults, units and ranges, validated before any work.
 
-The same machinery as the sweep configs of :mod:`nylonflex.config`: pydantic models (on
-its ``_Strict`` base) check the structure (keys, nesting, types, the ``actuators:`` list of
-a gripper), and its ``_pydantic_message`` words their errors; :func:`parse_sim_config`
-then merges defaults, top-level sections and each actuator's own sections key by key,
-parses units and checks every range with :func:`~nylonflex.config.check_range`. Every
-refusal is one :class:`~nylonflex.units.InputError` line naming the dotted field and what
+The same machinery as the sweep configs (:mod:`.sweep`): pydantic models (on the
+``_Strict`` base of :mod:`.base`) check the structure (keys, nesting, types, the
+``actuators:`` list of a gripper), and its ``_pydantic_message`` words their errors;
+:func:`parse_sim_config` then merges defaults, top-level sections and each actuator's own
+sections key by key, parses units and checks every range with :func:`.base.check_range`.
+Every refusal is one :class:`~nylonflex.units.InputError` line naming the dotted field and what
 it accepts.
 
 The one physical check, that the supply cannot heat a muscle past a stroke of 0.5, needs
@@ -34,13 +34,15 @@ from pydantic import (
     field_validator,
 )
 
-from .config import (DESIGN_RANGES, _no_bool, _pydantic_message, _Strict, check_range,
-                     check_run_name, range_error, read_yaml)
-from .materials import Nylon, Silicone, nylon_parameters, silicone_parameters
-from .physics.nylon import stroke
-from .physics.thermal import muscle_resistance, steady_temperature
-from .physics.wrap import muscle_length
-from .units import InputError, from_si
+from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
+from ..physics.nylon import stroke
+from ..physics.thermal import muscle_resistance, steady_temperature
+from ..physics.wrap import muscle_length
+from ..units import InputError, from_si
+from .base import _no_bool, _pydantic_message, _Strict, check_range, check_run_name, range_error
+from .material_files import anchor_material_files
+from .safe_yaml import read_yaml
+from .sweep import DESIGN_RANGES
 
 __all__ = [
     "DEFAULTS",
@@ -555,7 +557,5 @@ def parse_sim_config(raw, source: str = "config") -> SimConfig:
 def load_sim_config(path) -> SimConfig:
     """Read and validate a simulation config file (YAML); material files are read relative
     to its folder."""
-    from .config.material_files import anchor_material_files
-
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     return parse_sim_config(raw, str(path))

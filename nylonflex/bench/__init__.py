@@ -2,7 +2,11 @@
 
 Timings on shared machines are noisy, so the figures that matter are the ratios measured in
 the same process: the per-design speed-up over the adaptive-quadrature reference, and the kernel's speed-up
-over a plain NumPy implementation of the same structure (:mod:`nylonflex.bench_numpy`).
+over a plain NumPy implementation of the same structure (:mod:`.yardstick`).
+
+Both yardsticks live in this subpackage because ``nylonflex bench`` times them at run time
+(an installed package has no tests/ or benchmarks/): :mod:`.reference`, the independent
+scipy reference the tests also hold the model to, and :mod:`.yardstick`.
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import parse_config
+from ..config import parse_config
 
 #: The benchmark grid of issue 3: 100 x 40 x 10 x 5 x 10 = 2,000,000 designs with curves.
 FULL = {"radius": 100, "wall_thickness": 40, "length": 10, "coil_index": 5, "wrap_angle": 10,
@@ -70,7 +74,7 @@ def sampled_config(quick: bool = False):
 
 def _sampled_seconds(quick: bool) -> tuple[float, int]:
     """Seconds of a sampled sweep in memory, and its evaluations (designs x samples)."""
-    from .sweep import run_sweep
+    from ..storage.sweep import run_sweep
 
     cfg = sampled_config(quick)
     t0 = time.perf_counter()
@@ -82,9 +86,9 @@ def _sampled_seconds(quick: bool) -> tuple[float, int]:
 
 def _reference_design(cfg, a, t, c, psi):
     """One design's s*, kappa(s_max) and kappa* by scipy quadrature and brentq."""
+    from ..physics.chamber import chamber_pressure
+    from ..physics.nylon import nylon_force_limit, stroke_max
     from . import reference as ref
-    from .physics.chamber import chamber_pressure
-    from .physics.nylon import nylon_force_limit, stroke_max
 
     mu, alpha = cfg.silicone.arrays()
     s_max = float(stroke_max(c, cfg.nylon))
@@ -101,7 +105,7 @@ def random_designs(n: int, seed: int = 2026) -> dict:
     Radius, wall and length log-uniform over the registry's ranges, coil index uniform over
     the default table, wrap angle uniform over its range; SI.
     """
-    from .variables import COORDS
+    from ..variables import COORDS
 
     rng = np.random.default_rng(seed)
     log_uniform = lambda v: np.exp(rng.uniform(np.log(v.lo), np.log(v.hi), n))  # noqa: E731
@@ -115,8 +119,8 @@ def random_designs(n: int, seed: int = 2026) -> dict:
 def _pointwise_seconds(n: int) -> tuple[float, float, int]:
     """Per-design time [s] of ``nf.evaluate`` on ``n`` random designs, and of the uncompiled
     python loop (:func:`nylonflex.physics.design_limits`) on a 50th of them, same run."""
-    from .engine import evaluate
-    from .physics import design_limits as python_loop
+    from ..engine import evaluate
+    from ..physics import design_limits as python_loop
 
     d = random_designs(n)
     evaluate(**{k: v[:64] for k, v in d.items()})  # compile or load the cache
@@ -132,7 +136,7 @@ def _pointwise_seconds(n: int) -> tuple[float, float, int]:
 def _single_vs_batch_cpu(n: int = 20_000, calls: int = 2000) -> tuple[float, float]:
     """CPU seconds [s] of ``nf.evaluate`` for one design, and per design of an ``n``-design
     batch, measured back to back in this process (issue 27: at most 20x)."""
-    from .engine import evaluate
+    from ..engine import evaluate
 
     d = random_designs(n, seed=27)
     one = {k: float(v[0]) for k, v in d.items()}
@@ -163,7 +167,7 @@ def _matmul_gflops(n: int = 1024) -> float:
 def _closed_loop_seconds(duration: float) -> tuple[float, float]:
     """Loop time [s] of the figure-9 closed loop over ``duration`` [s] at 10 ms, and the
     whole run's (tables and output included), once compiled."""
-    from .simulate import parse_sim_config, run_simulation
+    from ..sim import parse_sim_config, run_simulation
 
     cfg = parse_sim_config({
         "name": "bench",
@@ -188,11 +192,11 @@ def _solve_count(ds) -> int:
 
 
 def _numpy_yardstick(cfg) -> tuple[float, float]:
-    """Seconds of the NumPy yardstick (:mod:`nylonflex.bench_numpy`) on ``cfg``'s whole grid
+    """Seconds of the NumPy yardstick (:mod:`.yardstick`) on ``cfg``'s whole grid
     and of the threaded kernel on the same grid in one slab, back to back (after the
     sweep, so that its memory does not count in the sweep's peak)."""
-    from .bench_numpy import grid_numpy
-    from .engine.grid import compute_slab
+    from ..engine.grid import compute_slab
+    from .yardstick import grid_numpy
 
     t0 = time.perf_counter()
     grid_numpy(cfg)
@@ -207,9 +211,9 @@ def run_bench(quick: bool = False, log=None) -> dict:
 
     ``log`` receives each line of the report as it is measured; the figures are returned.
     """
-    from .engine.grid import compute_slab, plan_slabs
-    from .storage import open_cube
-    from .sweep import sweep_file
+    from ..engine.grid import compute_slab, plan_slabs
+    from ..storage import open_cube
+    from ..storage.sweep import sweep_file
 
     sizes = QUICK if quick else FULL
     cfg = bench_config(sizes)
@@ -297,7 +301,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
     say(f"  NumPy yardstick            {t_numpy:8.2f} s  {result['numpy_designs_per_s']:>12,.0f}"
         f" designs/s  (same structure vectorised over designs, mechanics only)")
     say(f"  kernel vs NumPy            {result['kernel_vs_numpy']:>12.1f} x  (kernel "
-        f"{t_kernel_whole:.2f} s on the same grid, same run; nylonflex/bench_numpy.py)")
+        f"{t_kernel_whole:.2f} s on the same grid, same run; nylonflex/bench/yardstick.py)")
     say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
     say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
         "same run)")

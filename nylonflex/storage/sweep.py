@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .config import ResolvedConfig
+from ..config import ResolvedConfig
 
 __all__ = ["default_output", "estimate", "prepare", "run_sweep", "sweep_file"]
 
@@ -54,18 +54,18 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     nylonflex.storage.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
-    from .engine.grid import check_physics
+    from ..engine.grid import check_physics
 
     check_physics(cfg)
     if out is None:
-        from .engine.slabs import deferred_signals
+        from ..engine.slabs import deferred_signals
 
-        from .storage.accessor import CubeAccessor  # noqa: F401 - registers ds.nf
+        from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
         with deferred_signals(on_second=_interrupt):
             _warm_up(cfg, workers, scheduler, log)
             return _in_memory(cfg, workers, scheduler, progress)
-    from .storage import open_cube
+    from .reader import open_cube
 
     sweep_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
                progress=progress, log=log, overwrite=overwrite)
@@ -79,9 +79,9 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
     The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
     command line uses it: a sweep without charts never imports xarray.
     """
-    from .engine.grid import check_physics
-    from .engine.slabs import deferred_signals
-    from .storage import sweep_to_file
+    from ..engine.grid import check_physics
+    from ..engine.slabs import deferred_signals
+    from .run import sweep_to_file
 
     check_physics(cfg)  # before any file
     # from here on Ctrl-C and SIGTERM are recorded, never raised inside a finaliser (where
@@ -99,14 +99,13 @@ def _interrupt():
 
 
 def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
-    """Import and load (or compile) what a sweep of ``cfg`` runs: the kernel, the storage.
+    """Import and load (or compile) what a sweep of ``cfg`` runs: the kernel.
 
     :func:`sweep_file` and :func:`run_sweep` do it themselves; a caller may do it first to
     keep the start apart (the command line does, with the garbage collector paused).
     Parameters as :func:`run_sweep`'s.
     """
-    from . import storage  # noqa: F401 - h5py, hdf5plugin
-    from .engine.grid import check_physics
+    from ..engine.grid import check_physics
 
     check_physics(cfg)
     _warm_up(cfg, workers, scheduler, log)
@@ -121,8 +120,8 @@ def _warm_up(cfg, workers, scheduler, log):
     """Compile (or load) the local kernel first, so that the run's timings exclude it."""
     if scheduler is not None or (cfg.sha256, workers) in _WARMED:
         return
-    from .engine.slabs import set_workers
-    from .engine.warmup import warm_up_grid
+    from ..engine.slabs import set_workers
+    from ..engine.warmup import warm_up_grid
 
     set_workers(workers)
     compiled = warm_up_grid(cfg, notice=log)
@@ -132,14 +131,14 @@ def _warm_up(cfg, workers, scheduler, log):
 
 
 def _in_memory(cfg, workers, scheduler, progress):
-    from .engine.grid import plan_slabs
-    from .engine.provenance import provenance
-    from .engine.slabs import LocalExecutor, MemorySink, run_slabs
+    from ..engine.grid import plan_slabs
+    from ..engine.provenance import provenance
+    from ..engine.slabs import LocalExecutor, MemorySink, run_slabs
 
     if scheduler is None:
         executor = LocalExecutor(workers)
     else:
-        from .engine.cluster import DaskExecutor
+        from ..engine.cluster import DaskExecutor
 
         executor = DaskExecutor(scheduler)
     slabs, _ = plan_slabs(cfg)
@@ -152,7 +151,7 @@ def _in_memory(cfg, workers, scheduler, progress):
         raise KeyboardInterrupt
     import numpy as np
 
-    from .engine.provenance import typed_info
+    from ..engine.provenance import typed_info
 
     return sink.dataset({**provenance(cfg), **typed_info(executor.info()),
                          "complete": np.int8(1)})
@@ -169,7 +168,7 @@ def _packed_bytes(value, chunks, codec) -> int:
     """Bytes of ``value`` stored in ``chunks`` with the cube's codec (name)."""
     import itertools
 
-    from .storage.cube import CODECS, _encode_chunk
+    from .cube import CODECS, _encode_chunk
 
     codec = CODECS[codec]
     if codec.encode is None:  # lz4: HDF5 compresses; zstd's size is close enough here
@@ -216,18 +215,18 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         (compute), ``compress_seconds`` [s] and ``seconds`` [s] (estimated wall time,
         compute plus compression; they partly overlap, so a bound), ``compile_seconds`` [s].
     """
-    from .engine.grid import check_physics
+    from ..engine.grid import check_physics
 
     check_physics(cfg)  # what a sweep would refuse, a dry run refuses
     import time
 
     import numpy as np
 
-    from .engine.grid import _bytes_per_radius, compute_slab, global_arrays, plan_slabs
-    from .engine.slabs import set_workers
-    from .engine.warmup import warm_up_grid
-    from .storage.cube import _chunks
-    from .variables import VARIABLES
+    from ..engine.grid import bytes_per_radius, compute_slab, global_arrays, plan_slabs
+    from ..engine.slabs import set_workers
+    from ..engine.warmup import warm_up_grid
+    from ..variables import VARIABLES
+    from .cube import _chunks
 
     set_workers(workers)
     compiled = warm_up_grid(cfg, notice=notice)
@@ -255,10 +254,10 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
     picks = range(len(starts) * size)
     sample = len(picks) * per_radius
     ratio = packed / raw if raw else 1.0
-    per_slab = max(i1 - i0 for i0, i1 in slabs) * _bytes_per_radius(cfg)
+    per_slab = max(i1 - i0 for i0, i1 in slabs) * bytes_per_radius(cfg)
     globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
     axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
-    raw_total = n_radius * _bytes_per_radius(cfg) + globals_bytes + axes_bytes
+    raw_total = n_radius * bytes_per_radius(cfg) + globals_bytes + axes_bytes
     rate = sample / compute if compute > 0 else float("inf")
     compress_seconds = compress * cfg.n_designs / sample
     return {

@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 
-from .physics.bending import NEWTON_RTOL, quadrature_nodes
-from .physics.chamber import P_ATM
-from .physics.limits import STROKE_RTOL
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
+from ..physics.chamber import P_ATM
+from ..physics.limits import STROKE_RTOL
 
 __all__ = ["MECHANICAL", "grid_numpy"]
 
@@ -168,14 +168,14 @@ def _stroke_limit(f_lim, s_max, a, t, lever, mu, alpha):
 def grid_numpy(cfg) -> dict:
     """The mechanical variables and curves of ``cfg``'s whole grid (paper model, no
     supply), as :func:`nylonflex.engine.grid.compute_slab` shapes them [SI]."""
-    from .engine.grid import _coil_table
+    from ..engine.grid import coil_table
 
     mu, alpha = cfg.silicone.arrays()
     ax, cv = cfg.axes, cfg.curves
     a1, t1 = ax["radius"], ax["wall_thickness"]
     lengths, wraps = ax["length"], ax["wrap_angle"]
     strokes, pressures = cv["stroke"], cv["pressure"]
-    s_max_c, f_lim_c, width_c = _coil_table(cfg)[:3]
+    s_max_c, f_lim_c, width_c = coil_table(cfg)[:3]
     na, nt, nl, nc, npsi = a1.size, t1.size, lengths.size, s_max_c.size, wraps.size
     # per section (a, t): node table and the bend-angle curve
     a = np.repeat(a1, nt)
