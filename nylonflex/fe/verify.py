@@ -48,11 +48,11 @@ def fidelity_path(cube) -> Path:
 def open_fidelity(cube):
     """The fidelity dataset beside ``cube``, loaded (None where there is none; OSError or
     ValueError where it cannot be read)."""
-    import xarray as xr
-
     path = fidelity_path(cube)
     if not path.is_file():
-        return None
+        return None  # before xarray is imported: info stays light without one
+    import xarray as xr
+
     with xr.open_dataset(path, engine="h5netcdf") as fid:
         return fid.load()
 
