@@ -6,6 +6,7 @@ against a brute-force O(n^2) check; every design against the constraints it was 
 """
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -403,3 +404,33 @@ def test_table_lists_the_merged_alternatives(cube, tmp_path, capsys):
     rc, out, _ = run(capsys, path, "--format", "json")
     doc = json.loads(out)
     assert any(d["alternatives"].get("wrap_angle") for d in doc["designs"])
+
+
+def test_a_design_answer_under_another_model_is_that_models():
+    # a grid spec names its model; a cube spec answers under the cube's own model (it used
+    # to re-check a fe_calibrated cube's designs under paper)
+    grid = {**SMALL["grid"], "radius": {"values": [15, 20], "units": "mm"}}
+    question = {"objectives": [{"max": "tip_force_max"}],
+                "constraints": ["range_fraction >= 1", "bend_angle_max >= 40 deg",
+                                "length == 90 mm", "coil_index == 1.1"],
+                "refine": {"starts": 2, "maxiter": 20}}
+    by_grid = run_design({"grid": grid, "model": "fe_calibrated", **question})
+    cube = run_sweep(parse_config({**SMALL, "grid": grid, "model": "fe_calibrated"}))
+    by_cube = run_design(parse_spec({"cube": "unused.h5", **question}), cube=cube)
+    for res in (by_grid, by_cube):
+        d = res.designs[0]
+        exact = nf.evaluate(*(d[a] for a in AXES), model="fe_calibrated")
+        assert d["bend_angle_max"] == exact["bend_angle_max"]
+        assert d["bend_angle_max"] >= math.radians(40)
+    assert by_grid.designs[0]["tip_force_max"] == by_cube.designs[0]["tip_force_max"]
+    paper = nf.evaluate(*(by_grid.designs[0][a] for a in AXES))
+    assert paper["bend_angle_max"] != by_grid.designs[0]["bend_angle_max"]
+
+
+def test_a_cube_of_several_models_is_refused_in_one_line():
+    grid = {**SMALL["grid"], "radius": {"values": [15, 20], "units": "mm"}}
+    cube = run_sweep(parse_config({**SMALL, "grid": grid,
+                                   "model": ["paper", "fe_calibrated"]}))
+    with pytest.raises(InputError, match="holds 2 model variants"):
+        run_design(parse_spec({"cube": "unused.h5", "objectives": [{"max": "tip_force_max"}]}),
+                   cube=cube)

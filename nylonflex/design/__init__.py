@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..query import COLUMNS
+from ..units import InputError
 from .refine import Model, evaluate_rows, meets, refine
 from .resolution import check_fixed, merge_equal, snap
 from .search import CUBE_ONLY, GridScan, nondominated, scan_grid
@@ -69,6 +70,8 @@ class DesignResult:
     dropped: int = 0
     improvement: dict = field(default_factory=dict)
     snapped: dict = field(default_factory=dict)
+    #: The model variant the designs were scanned, re-checked and refined under.
+    model: str = "paper"
 
     @property
     def feasible(self) -> bool:
@@ -86,21 +89,30 @@ class DesignResult:
 
 
 def _materials(ds, spec):
-    """The model with the materials (and supply) the cube was computed with, from its
-    attributes; evaluations are remembered per cube config and model variant."""
-    silicone, nylon, base, supply, cooling, memo = _cube_materials(ds.attrs["config_yaml"],
-                                                                   spec.model)
-    return Model(silicone, nylon, base, spec.model, memo, supply_voltage=supply,
+    """The model with the materials, model variant (and supply) the cube was computed with,
+    from its attributes; evaluations are remembered per cube config.
+
+    The cube's own variant re-checks and refines its designs (a cube swept with
+    ``model: fe_calibrated`` is answered under it, whatever the spec's default); a cube of
+    several variants is refused, since its rows would mix them.
+    """
+    silicone, nylon, base, supply, cooling, model, memo = _cube_materials(
+        ds.attrs["config_yaml"])
+    if not isinstance(model, str):
+        raise InputError(f"cube: holds {len(model)} model variants ({', '.join(model)}); "
+                         "design answers one: sweep the grid with one model, or give a "
+                         "grid: spec with model: NAME")
+    return Model(silicone, nylon, base, model, memo, supply_voltage=supply,
                  cooling=cooling)
 
 
 @functools.lru_cache(maxsize=8)
-def _cube_materials(config_yaml, model):
+def _cube_materials(config_yaml):
     from ..engine.provenance import evaluate_settings
 
     s = evaluate_settings({"config_yaml": config_yaml})
     return (s["silicone"], s["nylon"], s["base_thickness"], s.get("supply_voltage"),
-            s.get("cooling"), {})
+            s.get("cooling"), s["model"], {})
 
 
 def _open(spec, cube):
@@ -210,7 +222,7 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
     if multi or spec.resolution:
         designs, snapped["merged"] = merge_equal(designs, spec.objectives)
     return DesignResult(spec, designs, grid, refined_front, scan, model.evaluations,
-                        dropped, improvement, snapped)
+                        dropped, improvement, snapped, model=model.model)
 
 
 def _on_resolution(model, spec, scan, grid, new):

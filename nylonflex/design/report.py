@@ -53,7 +53,8 @@ def _shown(name, x) -> str:
 def summary(res) -> list:
     """Lines that say what was asked, what the grid gave and what refinement added."""
     spec, scan = res.spec, res.scan
-    lines = [f"design '{spec.name}': " + ", ".join(str(o) for o in spec.objectives)
+    under = "" if getattr(res, "model", "paper") == "paper" else f" (model {res.model})"
+    lines = [f"design '{spec.name}'{under}: " + ", ".join(str(o) for o in spec.objectives)
              + (" subject to " + "; ".join(c.text for c in spec.constraints)
                 if spec.constraints else "")]
     if not res.designs:

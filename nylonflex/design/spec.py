@@ -34,8 +34,8 @@ __all__ = ["DesignSpec", "Objective", "load_spec", "parse_spec"]
 
 _KEYS = ("name", "cube", "grid", "silicone", "nylon", "base_thickness", "model",
          "objectives", "constraints", "refine", "resolution")
-#: The model variants a spec may name; the lead's evaluator brings the others.
-MODELS = ("paper",)
+#: The model variants a ``grid:`` spec may name (a ``cube:`` spec uses the cube's own).
+from ..variables import MODELS  # noqa: E402
 #: Default refinement budget: multi-starts (one objective) or front seeds (several), and
 #: SLSQP iterations per start.
 DEFAULT_STARTS = {"single": 4, "multi": 40}
@@ -217,6 +217,8 @@ def parse_spec(raw, source: str = "spec") -> DesignSpec:
         for key in ("silicone", "nylon", "base_thickness"):
             if key in raw:
                 sweep[key] = raw[key]
+        if model != "paper":
+            sweep["model"] = model
     objectives = raw.get("objectives")
     if isinstance(objectives, (str, dict)):
         objectives = [objectives]
