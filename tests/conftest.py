@@ -1,6 +1,5 @@
 import math
 import os
-from pathlib import Path
 
 import pytest
 from hypothesis import settings
@@ -30,14 +29,3 @@ def example_1():
 @pytest.fixture
 def example_2():
     return dict(EXAMPLE_2)
-
-
-def write_cube(folder, raw):
-    """Sweep a config mapping into ``folder/cube.h5``; return the path."""
-    from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
-
-    path = Path(folder) / "cube.h5"
-    run_sweep(parse_config(raw), out=path).close()
-    return path
-

@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import write_cube
+from helpers import write_cube
 
 from nylonflex import charts
 from nylonflex.cli import main

@@ -7,7 +7,7 @@ import io
 import json
 
 import pytest
-from conftest import write_cube
+from helpers import write_cube
 
 from nylonflex import charts
 from nylonflex.cli import main

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import write_cube
+from helpers import write_cube
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import write_cube
+from helpers import write_cube
 
 from nylonflex import explore
 from nylonflex.cli import main

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 import yaml
-from conftest import write_cube
+from helpers import write_cube
 
 from nylonflex.cli import main
 from nylonflex.config import parse_config

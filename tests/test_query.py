@@ -12,7 +12,8 @@ import re
 import h5py
 import numpy as np
 import pytest
-from conftest import DEG, EXAMPLE_1, EXAMPLE_2, write_cube
+from conftest import DEG, EXAMPLE_1, EXAMPLE_2
+from helpers import write_cube
 
 import nylonflex as nf
 from nylonflex import query

@@ -26,12 +26,13 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
+from helpers import stable, write_config
 
 import nylonflex.storage.journal as journal_mod
 import nylonflex.storage.run as run_mod
 from nylonflex.cli import main
 from nylonflex.config import parse_config
-from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
+from nylonflex.storage import Journal, exclusive, open_cube
 from nylonflex.storage.sweep import run_sweep
 from nylonflex.units import InputError
 from nylonflex.variables import is_complete
@@ -52,16 +53,6 @@ MULTI = {
 }
 
 
-def stable(ds):
-    ds = ds.copy()
-    ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS}
-    return ds
-
-
-def write_config(folder, raw, name="cfg.yaml"):
-    path = folder / name
-    path.write_text(yaml.safe_dump(raw))
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -8,10 +8,11 @@ import pytest
 from killing import kill_after_slabs
 import xarray as xr
 import yaml
+from helpers import stable, write_config
 
 from nylonflex.cli import main
 from nylonflex.config import parse_config
-from nylonflex.storage import VOLATILE_ATTRS, Journal, exclusive, open_cube
+from nylonflex.storage import Journal, exclusive, open_cube
 from nylonflex.engine.grid import bytes_per_radius, plan_slabs
 from nylonflex.storage.sweep import run_sweep
 from nylonflex.variables import VARIABLES
@@ -31,17 +32,6 @@ SMALL = {
 }
 
 
-def stable(ds):
-    """The dataset without the attributes that differ between two runs."""
-    ds = ds.copy()
-    ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS}
-    return ds
-
-
-def write_config(tmp_path, raw, name="cfg.yaml"):
-    path = tmp_path / name
-    path.write_text(yaml.safe_dump(raw))
-    return path
 
 
 def test_round_trip_file_equals_memory(tmp_path):

@@ -189,7 +189,7 @@ def test_query_where_feasibility(sampled_cube, capsys):
 
 
 def test_query_feasibility_on_a_plain_cube_is_refused(tmp_path, capsys):
-    from conftest import write_cube
+    from helpers import write_cube
 
     path = write_cube(tmp_path, SMALL)
     assert main(["query", str(path), "--where", "feasibility >= 0.9"]) == 2

@@ -2,7 +2,7 @@
 
 import pytest
 import yaml
-from conftest import write_cube  # noqa: F401
+from helpers import write_cube  # noqa: F401
 
 from nylonflex.cli import main
 from nylonflex.config import parse_config

@@ -17,7 +17,7 @@ import pytest
 import xarray as xr
 
 import nylonflex.fe.verify as verify
-from conftest import write_cube
+from helpers import write_cube
 from nylonflex.units import InputError
 
 pytest.importorskip("felupe")
