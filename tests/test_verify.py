@@ -140,3 +140,14 @@ def test_a_killed_verify_resumes(tmp_path):
     half = fid.sel(level=0.5)
     assert (half["fe_bend_angle"] >= half["fe_mesh_bend_angle"]).all()
     json.loads((parts / "plan.json").read_text())
+
+
+@pytest.mark.parametrize("flag", ["--designs", "--workers", "--seed"])
+def test_a_non_integer_flag_is_one_line_naming_it(flag, capsys, tmp_path):
+    from nylonflex.cli import main
+
+    with pytest.raises(SystemExit) as stop:  # argparse's own exit, status 2
+        main(["verify", str(tmp_path / "c.h5"), flag, "abc"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"argument {flag}: must be an integer, got 'abc'" in err[0]

@@ -13,27 +13,28 @@ angle over the FE's, per design and pressure. Each FE run is journaled: a killed
 resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map."""
 
 
-def _designs(text):
-    from ..units import InputError
+def _integer(text):
+    """An integer flag's value (argparse names the flag in its message)."""
+    import argparse
 
     try:
         return int(text)
     except ValueError:
-        raise InputError(f"--designs: must be an integer, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
 
 
 def add_arguments(p):
     p.add_argument("cube")
-    p.add_argument("--designs", type=_designs, default=24, metavar="N",
+    p.add_argument("--designs", type=_integer, default=24, metavar="N",
                    help="designs to sample (default 24, at most 500)")
-    p.add_argument("--workers", type=_designs, default=1, metavar="N",
+    p.add_argument("--workers", type=_integer, default=1, metavar="N",
                    help="local processes, one FE run each (default 1)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="a Dask scheduler (tcp://HOST:PORT): the runs go to its workers")
     p.add_argument("--mesh", default="coarse", metavar="coarse|default|fine",
                    help="the FE mesh (default coarse); the FE angle is its Richardson "
                         "extrapolation with the next coarser mesh")
-    p.add_argument("--seed", type=_designs, default=0, help="the sample's seed (default 0)")
+    p.add_argument("--seed", type=_integer, default=0, help="the sample's seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
