@@ -299,3 +299,28 @@ def test_design_answers_the_tracking_question_and_simulate_agrees():
     sim = run_simulation(parse_sim_config(_control(design=design)))
     assert sim.attrs["rms_error"] <= math.radians(2.0)
     assert sim.attrs["rms_error"] == pytest.approx(best["tracking_rms_error"], rel=1e-9)
+
+
+def test_tracking_map_shows_the_cubes_own_values():
+    from matplotlib.figure import Figure
+
+    from nylonflex.charts import CHARTS, tracking_map
+    from nylonflex.units import InputError
+
+    grid = {"radius": {"values": ["10 mm", "15 mm", "20 mm"]},
+            "wall_thickness": {"values": ["2 mm", "3 mm"]}}
+    ds = nf.run_sweep(parse_config(_sweep_of(_control(), grid)))
+    assert CHARTS["tracking_map"] is tracking_map
+    host = Figure()
+    ax = host.add_subplot()
+    assert tracking_map(ds, ax=ax) is host
+    assert ax.get_ylabel() == "wall thickness [mm]"
+    assert "RMS tracking error" in ax.get_title()
+    # the filled contours span the cube's RMS errors [deg] of that slice
+    want = np.degrees(ds["tracking_rms_error"].isel(length=0, coil_index=0, wrap_angle=0)
+                      .values)
+    filled = [c for c in ax.collections if hasattr(c, "levels")][0]
+    assert filled.levels.min() <= want.min() and filled.levels.max() >= want.max()
+    assert filled.levels.max() - filled.levels.min() < 2 * (want.max() - want.min())
+    with pytest.raises(InputError, match="tracking_rms_error: the cube has none"):
+        tracking_map(ds.drop_vars([v for v in ds.data_vars if v.startswith("tracking_")]))

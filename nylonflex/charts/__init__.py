@@ -27,14 +27,14 @@ from ..variables import VARIABLES, to_display
 from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
 from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
-from .dynamics import cycle_rate_lines, cycle_rate_map, force_rate
+from .dynamics import cycle_rate_lines, cycle_rate_map, force_rate, tracking_map
 from .fig12 import fig12a, fig12b, fig12c
 from .maps import design_map, feasibility_map
 
 __all__ = ["CHARTS", "FORMATS", "RC", "SLICE_AXES", "chart_slice", "compare", "cycle_rate_lines",
            "cycle_rate_map", "design_map", "force_rate",
            "draw_charts", "feasibility_map", "fig4", "fig6", "fig7", "fig12a", "fig12b",
-           "fig12c", "new_figure", "rc_context"]
+           "fig12c", "new_figure", "rc_context", "tracking_map"]
 
 
 #: Chart name -> function, the names a config's ``charts`` list accepts (the registry's,

@@ -1,6 +1,6 @@
-"""How fast a design moves (issue 29; docs/model.md s. 20): a cycle-rate map over two axes,
-cycle rate against radius per coil index (figure-12 style), and the trade-off of tip force
-against cycle rate.
+"""How fast a design moves (issue 29; docs/model.md s. 19-20): a cycle-rate map over two
+axes, cycle rate against radius per coil index (figure-12 style), the trade-off of tip force
+against cycle rate, and the closed loop's bandwidth (or tracking error) map.
 
 Each chart is ``f(ds, *, ax=None, **slice) -> matplotlib.figure.Figure``: drawn into ``ax``
 when given (its figure is returned), else into a new :class:`matplotlib.figure.Figure`
@@ -17,7 +17,7 @@ from ..variables import AXES, to_display
 from ._common import (_COLOURS, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _footer,
                       _label, _nearest, new_figure)
 
-__all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate"]
+__all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate", "tracking_map"]
 
 
 def _need_rate(ds):
@@ -76,27 +76,75 @@ def cycle_rate_map(ds, *, ax=None, x="radius", y="wrap_angle", radius=None,
     matplotlib.figure.Figure
     """
     _need_rate(ds)
-    for name in (x, y):
-        if name not in AXES or x == y:
-            raise InputError(f"cycle_rate_map: x and y must be two of {', '.join(AXES)}, "
+    return _map(ds, "cycle_rate", "Cycle rate: heat to 95 % of the stroke at the supply, "
+                "cool to 5 %", "magma", ax=ax, x=x, y=y, radius=radius,
+                wall_thickness=wall_thickness, length=length, coil_index=coil_index,
+                wrap_angle=wrap_angle)
+
+
+#: What a tracking cube's map shows, best first: the bandwidth where the sweep searched for
+#: it, else the RMS error of the reference it tracked (docs/model.md s. 19).
+_TRACKING = (("tracking_bandwidth", "Tracking bandwidth: the highest sine frequency tracked "
+              "within the stated error", "viridis"),
+             ("tracking_rms_error", "RMS tracking error of the closed loop", "viridis_r"))
+
+
+def tracking_map(ds, *, ax=None, x="radius", y="wall_thickness", radius=None,
+                 wall_thickness=None, length=None, coil_index=None, wrap_angle=None):
+    """Tracking bandwidth (else RMS tracking error) over two design axes, the others fixed.
+
+    The bandwidth where the sweep searched for it (``tracking: bandwidth:``), else the RMS
+    error of the reference the closed loop tracked; a design whose loop did not run is a
+    blank cell.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A nylonflex cube swept with ``tracking:``.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new figure.
+    x, y : str
+        The two axes of the map; default radius and wall thickness.
+    radius, wall_thickness, length, coil_index, wrap_angle : float, optional
+        The fixed axes [SI]; default nearest 15 mm, 2 mm, 90 mm, 1.7 and 8 deg.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    for name, title, cmap in _TRACKING:
+        if name in ds:
+            return _map(ds, name, title, cmap, ax=ax, x=x, y=y, radius=radius,
+                        wall_thickness=wall_thickness, length=length,
+                        coil_index=coil_index, wrap_angle=wrap_angle)
+    raise InputError("tracking_rms_error: the cube has none (it needs a sweep with "
+                     "'tracking:', e.g. configs/fig12_tracking.yaml)")
+
+
+def _map(ds, name, title, cmap, *, ax, x, y, **given):
+    """Variable ``name`` over axes ``x`` and ``y``, the others fixed (``given`` [SI])."""
+    for axis in (x, y):
+        if axis not in AXES or x == y:
+            raise InputError(f"{name} map: x and y must be two of {', '.join(AXES)}, "
                              f"got {x!r} and {y!r}")
-    fixed = _fixed(ds, (x, y), radius=radius, wall_thickness=wall_thickness, length=length,
-                   coil_index=coil_index, wrap_angle=wrap_angle)
-    cut = ds["cycle_rate"].sel(**fixed).transpose(y, x).load()
+    fixed = _fixed(ds, (x, y), **given)
+    cut = ds[name].sel(**fixed).transpose(y, x).load()
     fig, ax = _axes(ax, (6.4, 4.6))
     xs, ys = to_display(x, ds[x].values), to_display(y, ds[y].values)
-    rate = to_display("cycle_rate", cut.values)
-    if len(xs) > 1 and len(ys) > 1:
-        filled = ax.contourf(xs, ys, rate, levels=12, cmap="magma")
-        lines = ax.contour(xs, ys, rate, levels=filled.levels[2::3], colors="white",
+    values = to_display(name, cut.values)
+    finite = np.isfinite(values)
+    if len(xs) > 1 and len(ys) > 1 and finite.all() and np.ptp(values) > 0:
+        filled = ax.contourf(xs, ys, values, levels=12, cmap=cmap)
+        lines = ax.contour(xs, ys, values, levels=filled.levels[2::3], colors="white",
                            linewidths=0.6)
         ax.clabel(lines, fmt="%.3g", fontsize=7.5)
-    else:
-        filled = ax.pcolormesh(xs, ys, rate, cmap="magma", shading="nearest")
-    fig.colorbar(filled, ax=ax, label=_label("cycle_rate"))
+    else:  # a line of designs, a flat field or gaps: cells, gaps left blank
+        filled = ax.pcolormesh(xs, ys, np.ma.masked_invalid(values), cmap=cmap,
+                               shading="nearest")
+    fig.colorbar(filled, ax=ax, label=_label(name))
     ax.set_xlabel(_label(x))
     ax.set_ylabel(_label(y))
-    _title(ax, "Cycle rate: heat to 95 % of the stroke at the supply, cool to 5 %", fixed)
+    _title(ax, title, fixed)
     _footer(fig, ds)
     return fig
 

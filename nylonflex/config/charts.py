@@ -75,4 +75,8 @@ CHART_REGISTRY = {c.name: c for c in (
           variable="cycle_rate", absent="its sweep had no 'supply'", needs_text="a supply"),
     Chart("force_rate", "dynamics:force_rate", (), cost=2.0, variable="cycle_rate",
           absent="its sweep had no 'supply'", needs_text="a supply"),
+    # the closed loop of every design: only for a cube swept with tracking: (s. 19)
+    Chart("tracking_map", "dynamics:tracking_map", ("radius", "wall_thickness"), cost=2.0,
+          variable="tracking_rms_error", absent="its sweep had no 'tracking'",
+          needs_text="a sweep with tracking:"),
 )}
