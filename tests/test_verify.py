@@ -151,3 +151,47 @@ def test_a_non_integer_flag_is_one_line_naming_it(flag, capsys, tmp_path):
     assert stop.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"argument {flag}: must be an integer, got 'abc'" in err[0]
+
+
+_INTERRUPTED_POOL = """
+import signal, sys, time
+sys.path.insert(0, sys.argv[1])
+
+
+def stop(signum, frame):  # what the command line does with SIGTERM (and Ctrl-C)
+    raise KeyboardInterrupt
+
+
+signal.signal(signal.SIGTERM, stop)
+from nylonflex.fe.runs import journaled_runs
+import slowsolve
+
+tasks = [{"k": k} for k in range(6)]
+start = time.monotonic()
+try:
+    journaled_runs(sys.argv[2], {"plan": 1}, tasks, slowsolve.solve, workers=2)
+except KeyboardInterrupt:
+    print("stopped after", round(time.monotonic() - start, 1), flush=True)
+"""
+
+
+def test_an_interrupted_pool_stops_its_runs_at_once(tmp_path):
+    # a stop of the parent (SIGTERM here: a background job ignores SIGINT) ends the queued
+    # and running FE runs instead of waiting for them (minutes each); the journaled stay
+    (tmp_path / "slowsolve.py").write_text(
+        "import time\n"
+        "def solve(task):\n"
+        "    time.sleep(0.5 if task['k'] == 0 else 60)\n"
+        "    return {'k': task['k']}\n")
+    parts = tmp_path / "runs.parts"
+    proc = subprocess.Popen([sys.executable, "-c", _INTERRUPTED_POOL, str(tmp_path),
+                             str(parts)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not (parts / "design-0000.json").exists():
+        time.sleep(0.2)
+    assert (parts / "design-0000.json").exists()
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=30)  # not the 60 s of the runs still going
+    assert "stopped after" in out, err
+    assert sorted(p.name for p in parts.glob("design-*.json")) == ["design-0000.json"]

@@ -42,10 +42,21 @@ def _map(tasks, workers, scheduler, solve):
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as ex:
+    ex = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"))
+    try:
         futures = {ex.submit(solve, t): i for i, t in tasks}
         for fut in as_completed(futures):
             yield futures[fut], fut.result()
+    except BaseException:
+        # Ctrl-C, SIGTERM or a failed run: the queued runs are cancelled and the running
+        # ones stopped (what is journaled stays; a resume solves the rest). Leaving the
+        # pool's context would instead wait for every queued run, minutes each.
+        running = list((getattr(ex, "_processes", None) or {}).values())  # before
+        ex.shutdown(wait=False, cancel_futures=True)  # shutdown forgets them
+        for proc in running:
+            proc.terminate()
+        raise
+    ex.shutdown(wait=True)
 
 
 def journaled_runs(parts, plan, tasks, solve, *, workers=1, scheduler=None, progress=None,
