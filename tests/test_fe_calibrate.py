@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from nylonflex.fe.calibrate import (TARGET_ANGLES, correction_terms, extrapolated,
-                                    fit_correction, initial_shear_modulus, training_plan)
+                                    fit_correction, training_plan)
 from nylonflex.materials import silicone_parameters
 from nylonflex.physics.limits import model_bend_angle
 
@@ -22,7 +22,7 @@ def _synthetic(plan, coef, noise=0.0, seed=0):
     """'FE' angles: lateral_pressure's angle scaled by exp(X c) (times a log-normal noise,
     one draw a design, so a design's two angles err together), as mesh pairs whose
     Richardson extrapolation is that angle."""
-    mu0 = initial_shear_modulus(silicone_parameters("tc5005"))
+    mu0 = silicone_parameters("tc5005").initial_shear_modulus
     rng = np.random.default_rng(seed)
     done = {}
     for k, d in enumerate(plan["designs"]):
@@ -51,7 +51,7 @@ def test_fit_recovers_a_known_correction(plan):
     # leave-one-out predicts a design it has not seen, exactly when the truth is in the family
     np.testing.assert_allclose(res["loo_calibrated_over_fe"], 1.0, atol=1e-6)
     # lateral_pressure/FE is the truth's factor undone
-    mu0 = initial_shear_modulus(silicone_parameters("tc5005"))
+    mu0 = silicone_parameters("tc5005").initial_shear_modulus
     rows = [plan["designs"][k] for k in res["design_index"]]
     X = correction_terms(res["pressure"], [d["radius"] for d in rows],
                          [d["wall_thickness"] for d in rows], [d["length"] for d in rows], mu0)
@@ -78,7 +78,7 @@ def test_the_kernels_correction_is_the_fitted_form():
     mu, alpha = sil.arrays()
     for p, a, t, L in [(2e3, 20e-3, 6e-3, 90e-3), (9e3, 7.5e-3, 2e-3, 70e-3),
                        (0.0, 25e-3, 1e-3, 150e-3)]:
-        X = correction_terms(p, a, t, L, initial_shear_modulus(sil))
+        X = correction_terms(p, a, t, L, sil.initial_shear_modulus)
         expected = math.exp(float(X @ np.asarray(COEFFICIENTS)))
         got = _section_correction(p, a, t, mu, alpha) * _length_correction(a, L)
         assert got == pytest.approx(expected, rel=1e-12)

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 import nylonflex as nf
-from nylonflex.fe.calibrate import correction_terms, initial_shear_modulus
+from nylonflex.fe.calibrate import correction_terms
 from nylonflex.materials import silicone_parameters
 from nylonflex.physics.calibrated import COEFFICIENTS, TERMS, calibration
 
-MU0 = initial_shear_modulus(silicone_parameters("tc5005"))
+MU0 = silicone_parameters("tc5005").initial_shear_modulus
 
 
 def _factor(p, a, t, L):
