@@ -36,14 +36,11 @@ def fidelity_rows(ds, fid) -> dict:
 
 def fidelity_summary_html(fid, source: str) -> str:
     """The fidelity part's heading: per model, model/FE over every verified angle."""
-    parts = []
-    for model in fid["model"].values:
-        r = fid["ratio"].sel(model=model).values.ravel()
-        r = r[np.isfinite(r)]
-        if r.size:
-            within = int(np.sum(np.abs(r - 1.0) <= 0.1))
-            parts.append(f"<code>{html.escape(str(model))}</code> median {np.median(r):.3f} "
-                         f"({r.min():.3f}-{r.max():.3f}), {within} of {r.size} within 10 %")
+    from ..fe.verify import fidelity_stats
+
+    parts = [f"<code>{html.escape(st['model'])}</code> median {st['median']:.3f} "
+             f"({st['min']:.3f}-{st['max']:.3f}), {st['within']} of {st['n']} within 10 %"
+             for st in fidelity_stats(fid)]
     return (f"<b>FE fidelity</b> ({html.escape(source)}: {fid.sizes['design']} designs held "
             f"against the FE twin by <code>nylonflex verify</code>, mesh "
             f"{html.escape(str(fid.attrs.get('fe_mesh', '?')))}): model / FE bend angle at "

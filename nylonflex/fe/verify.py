@@ -21,7 +21,7 @@ from .calibrate import extrapolated
 from .runs import journaled_runs, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
-           "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
+           "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
 
 #: The variants whose bend angle at a given pressure differs (the others change the
 #: muscle's side only): the ones the fidelity dataset compares.
@@ -227,16 +227,23 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     return path
 
 
-def fidelity_summary(fid) -> list[str]:
-    """One line a model of a fidelity dataset: model/FE over every design and pressure."""
+def fidelity_stats(fid) -> list[dict]:
+    """Per model of a fidelity dataset, model/FE over every design and pressure where the FE
+    reached it: ``model``, ``median``, ``min``, ``max`` [1], ``within`` (how many within
+    10 %) and ``n``; models with no finite ratio are left out."""
     out = []
     for model in fid["model"].values:
         r = fid["ratio"].sel(model=model).values.ravel()
         r = r[np.isfinite(r)]
-        if not r.size:
-            continue
-        within = np.mean(np.abs(r - 1) <= 0.1) * 100
-        out.append(f"{model:<17} model/FE median {np.median(r):.3f}, range "
-                   f"{r.min():.3f}-{r.max():.3f}, within 10 %: {within:.0f} % "
-                   f"({r.size} FE angles)")
+        if r.size:
+            out.append({"model": str(model), "median": float(np.median(r)),
+                        "min": float(r.min()), "max": float(r.max()),
+                        "within": int(np.sum(np.abs(r - 1.0) <= 0.1)), "n": int(r.size)})
     return out
+
+
+def fidelity_summary(fid) -> list[str]:
+    """One line a model of a fidelity dataset: model/FE over every design and pressure."""
+    return [f"{s['model']:<17} model/FE median {s['median']:.3f}, range "
+            f"{s['min']:.3f}-{s['max']:.3f}, within 10 %: {100 * s['within'] / s['n']:.0f} % "
+            f"({s['n']} FE angles)" for s in fidelity_stats(fid)]
