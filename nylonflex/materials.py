@@ -242,6 +242,15 @@ class Cooling:
         """The set's name, fluid and speed (for YAML provenance and the config hash)."""
         return {"name": self.name, "fluid": self.fluid, "speed": self.speed}
 
+    @property
+    def label(self) -> str:
+        """The set's name, with its speed where that is not the named set's own
+        (``"forced_air 5 m/s"``): the coordinate of a cube of several cooling sets."""
+        own = COOLING_PARAMETERS.get(self.name, {}).get("speed")
+        if own is not None and float(own) == self.speed:
+            return self.name
+        return f"{self.name} {self.speed:g} m/s"
+
 
 def cooling_parameters(cooling) -> Cooling:
     """The named cooling environment, or ``{"set": name, "speed": m/s}`` (speed overridden).

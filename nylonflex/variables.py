@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AXES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY", "TRACKING",
-           "UNCERTAIN",
+__all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
+           "THERMAL", "TRACKING", "UNCERTAIN",
            "VARIABLES", "Variable", "display_label", "quantile_name", "range_text",
            "slab_done_attrs", "to_display"]
 
@@ -90,10 +90,22 @@ class Variable:
             out["flag_meanings"] = meanings
         return out
 
-    def dims_for(self, models) -> tuple[str, ...]:
-        """Dimensions in a cube of ``models`` (a string ``model`` dimension last when there
-        are several and this variable depends on the model)."""
-        return self.dims + ("model",) if self.by_model and len(models) > 1 else self.dims
+    def dims_for(self, models, coolings=(), supply: bool = False) -> tuple[str, ...]:
+        """Dimensions in a cube of ``models`` and ``coolings`` (their names): a string
+        ``model`` dimension when there are several models and this variable depends on the
+        model, then a string ``cooling`` dimension when there are several cooling sets and
+        it depends on the heat loss (:meth:`by_cooling`)."""
+        dims = self.dims + ("model",) if self.by_model and len(models) > 1 else self.dims
+        if len(coolings) > 1 and self.by_cooling(supply):
+            dims = dims + ("cooling",)
+        return dims
+
+    def by_cooling(self, supply: bool) -> bool:
+        """Whether this design variable depends on the cooling set: the heat loss sets the
+        holding power, its voltage and the cooling time (:data:`THERMAL`); with a
+        ``supply`` it also caps the temperature, T_ss = T_amb + V^2/(r' lambda' l_m^2), and
+        so the usable stroke and all that follows from it (docs/model.md s. 9, 15)."""
+        return self.by_model and self.dims == AXES and (supply or self.name in THERMAL)
 
 
 #: CF flag values and meanings of the flag variables.
@@ -109,6 +121,14 @@ _MASKS = {"validity": ((1, 2, 4, 8, 16),
 #: Variables that are in a cube only when its config gives a supply.
 SUPPLY_ONLY = ("heating_time", "cycle_time", "cycle_rate", "heating_energy", "mechanical_work",
                "efficiency")
+
+#: Design variables that depend on the cooling set even without a supply (docs/model.md
+#: s. 15): lambda' l_m (T* - T_amb), its voltage, and the time constant c'/lambda'.
+THERMAL = ("heating_power", "heating_voltage", "cooling_time")
+
+#: The string dimensions of a cube, in the order they follow the others: several model
+#: variants (docs/model.md s. 16), several cooling sets (s. 9).
+CATEGORIES = ("model", "cooling")
 
 #: CF standard names (CF standard name table) where CF has one for a cube variable: the
 #: two flag variables say the status and the quality of each design's values. The design
@@ -279,6 +299,11 @@ TRACKING = {v.name: v for v in [
 #: The string coordinate of a cube of several model variants (docs/model.md s. 16).
 MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each slice "
            "(docs/model.md s. 16)", "1", "dimensionless", "str")
+
+#: The string coordinate of a cube of several cooling sets (docs/model.md s. 9).
+COOLING = _v("cooling", ["cooling"], "1", "cooling environment", "the cooling set of each "
+             "slice: its name, and its speed where it is not the set's own (docs/model.md "
+             "s. 9)", "1", "dimensionless", "str")
 
 #: The mask of the radii a sweep has stored (1) or not yet (0).
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",

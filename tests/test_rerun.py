@@ -36,6 +36,10 @@ CASES = {
         "requirements": ["tip_force_max >= 0.1 N"]},
     "fitted": {"silicone": {"file": str(REPO / "configs" / "fits" /
                                         "ecoflex_0050_ogden2.yaml")}},
+    # a cooling set, and several as an axis with models (docs/model.md s. 9)
+    "cooling": {"cooling": {"set": "forced_air", "speed": 3.5}, "supply": {"voltage": 12}},
+    "coolings": {"cooling": ["still_air", {"set": "forced_air", "speed": 3.5}, "still_water"],
+                 "model": ["paper", "lateral_pressure"], "supply": {"voltage": 12}},
 }
 
 
@@ -68,7 +72,7 @@ def test_info_config_sweeps_to_the_same_cube_bit_for_bit(tmp_path, capsys, case)
     assert a.keys() == b.keys()
     for name in a:
         assert a[name].dtype == b[name].dtype, name
-        if a[name].dtype.kind == "O":  # the model names
+        if a[name].dtype.kind == "O":  # the model (cooling set) names
             assert a[name].tolist() == b[name].tolist(), name
         else:
             assert a[name].tobytes() == b[name].tobytes(), name  # bit for bit, NaNs too

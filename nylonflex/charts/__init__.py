@@ -140,8 +140,23 @@ def chart_owner(ds) -> str:
     return f"cube named {str(ds.attrs.get('name', '?'))[:200]}"
 
 
-def _chart_file(name, model, fmt) -> str:
-    return f"{name}.{fmt}" if model is None else f"{name}_{model}.{fmt}"
+def _chart_file(name, where, fmt) -> str:
+    """``fig12a.png``, or with the slice of a cube of several models and cooling sets
+    ``fig12a_paper_forced_air_5mps.png`` (``where``: {dimension: name}, None: whole)."""
+    parts = [name, *(str(v).replace(" m/s", "mps").replace(" ", "_")
+                     for v in (where or {}).values())]
+    return "_".join(parts) + f".{fmt}"
+
+
+def _slices(ds, name) -> list:
+    """The slices chart ``name`` is drawn once for: each (model, cooling set) of a cube of
+    several, a model left whole where the chart draws every model itself; [None]: once."""
+    models = [str(m) for m in ds["model"].values] if "model" in ds.dims and \
+        name not in ALL_MODELS else [None]
+    coolings = [str(c) for c in ds["cooling"].values] if "cooling" in ds.dims else [None]
+    out = [{k: v for k, v in (("model", m), ("cooling", c)) if v is not None}
+           for m in models for c in coolings]
+    return [w or None for w in out]
 
 
 def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_index=None,
@@ -216,9 +231,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
     owner = chart_owner(ds)
     ds = _short_attrs(ds)
     out_dir = Path(out_dir)
-    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else [None]
-    jobs = [(name, m) for name in names
-            for m in (models if name not in ALL_MODELS else [None])]
+    jobs = [(name, where) for name in names for where in _slices(ds, name)]
     owned = OwnedFiles(out_dir, owner)
     targets = [out_dir / _chart_file(n, m, fmt) for n, m in jobs]
     blocked = {} if overwrite else {p: why for p in targets if (why := owned.foreign(p))}
@@ -276,15 +289,20 @@ def warm_up():
     xr.DataArray(np.zeros(2), dims="x").isel(x=0)
 
 
-def _draw_one(ds, name, model, path, fmt, kwargs) -> Path:
-    """Draw chart ``name`` (of ``model``'s slice of a cube of several) into ``path``."""
+def _draw_one(ds, name, where, path, fmt, kwargs) -> Path:
+    """Draw chart ``name`` (of the slice ``where``, {dimension: name}, of a cube of several
+    models or cooling sets) into ``path``."""
     with rc_context():
-        # a cube of several models: each figure once a model, its name in title and file
-        one = ds if model is None else ds.sel(model=model, drop=True)
+        # a cube of several models (cooling sets): each figure once a model (cooling set),
+        # its name in title and file
+        one = ds if where is None else ds.sel(where, drop=True)
         fig = CHARTS[name](one, **kwargs)
-        if model is not None:
-            fig.text(0.99, 0.995, f"model: {model}", ha="right", va="top",
-                     fontsize="small", weight="bold")
+        if where is not None:
+            shown = ", ".join(f"{k}: {v}" for k, v in where.items())
+            title = fig.get_suptitle()
+            # a line of the figure's own title (the layout keeps it clear of the axes)
+            fig.suptitle(f"{shown}\n{title}" if title else shown,
+                         **({} if title else {"fontsize": "medium", "weight": "bold"}))
         # fixed metadata so that the same cube gives byte-stable PDF/SVG files; PNG at
         # zlib level 1: 12 % larger files, a third of the encoding time. The figure's
         # constrained layout keeps everything inside it, so the file is the figure as laid

@@ -29,6 +29,9 @@ def add_arguments(p):
                    help="mark the designs that meet EXPR (as query --where, e.g. "
                         "\"tip_force_max >= 0.5 N\"; repeat to AND) and list them in a "
                         "sortable table")
+    p.add_argument("--cooling", metavar="NAME",
+                   help="the cooling set the page shows, for a cube of several (its "
+                        "'cooling' coordinate; nylonflex info lists them)")
 
 
 _NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explore]'"
@@ -79,6 +82,7 @@ def run(args) -> int:
 
     where = parse_where(args.where)  # the query's own parser: bad input before any work
     ds = open_cube_for("explore", args.cube)
+    ds, source = _one_cooling(ds, args.cooling, str(args.cube))
     if not _has("bokeh"):
         print(_NEEDS_EXTRA.format(what="the explorer needs Bokeh"), file=sys.stderr)
         return 1
@@ -88,7 +92,7 @@ def run(args) -> int:
     if args.html:
         from ..storage.files import write_atomic
 
-        text = build_html(ds, source=str(args.cube), where=where, fidelity=fidelity)
+        text = build_html(ds, source=source, where=where, fidelity=fidelity)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0
@@ -99,11 +103,29 @@ def run(args) -> int:
         print(f"nylonflex explore: serving {args.cube} at {url} (Ctrl-C to stop)", flush=True)
 
     try:
-        serve(ds, port=args.port, source=str(args.cube), where=where,
+        serve(ds, port=args.port, source=source, where=where,
               show=not args.no_browser, ready=ready, fidelity=fidelity)
     except KeyboardInterrupt:
         pass
     return 0
+
+
+def _one_cooling(ds, name, source):
+    """The cube at the cooling set ``name`` (a cube of several: the page shows one), and the
+    page's source line naming it."""
+    from ..units import InputError
+
+    have = [str(c) for c in ds["cooling"].values] if "cooling" in ds.dims else []
+    if name is None and not have:
+        return ds, source
+    if not have:
+        raise InputError(f"--cooling {name}: this cube has one cooling set; leave --cooling "
+                         "out")
+    if name not in have:
+        given = "not given" if name is None else f"got {name!r}"
+        raise InputError(f"--cooling: this cube holds {len(have)} cooling sets "
+                         f"({', '.join(have)}) and the page shows one; {given}")
+    return ds.sel(cooling=name, drop=True), f"{source} (cooling: {name})"
 
 
 def _fidelity(cube):

@@ -12,6 +12,7 @@ dotted path) and what it accepts.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -136,7 +137,7 @@ class SweepConfig(_Strict):
     model: Union[str, list[str]] = "paper"
     supply: Supply | None = None
     tracking: Tracking | None = None
-    cooling: Union[str, dict[str, Any], None] = None
+    cooling: Union[str, dict[str, Any], list[Union[str, dict[str, Any]]], None] = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -165,6 +166,17 @@ class ResolvedConfig:
     supply_voltage: float | None = None
     tracking: "TrackingSpec | None" = None
     cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
+    # several cooling sets: the cube's string ``cooling`` dimension (then ``cooling`` is None)
+    coolings: tuple[Cooling, ...] = ()
+
+    @property
+    def cooling_names(self) -> tuple[str, ...]:
+        """The labels of the cube's ``cooling`` coordinate; () for one cooling set or none."""
+        return tuple(c.label for c in self.coolings)
+
+    def with_cooling(self, cooling: Cooling | None) -> "ResolvedConfig":
+        """This config under one cooling set (a slice of a cube of several)."""
+        return dataclasses.replace(self, cooling=cooling, coolings=())
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -209,6 +221,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["tracking"] = cfg.tracking.to_dict()
     if cfg.cooling is not None:
         doc["cooling"] = cfg.cooling.to_dict()
+    if cfg.coolings:
+        doc["cooling"] = [c.to_dict() for c in cfg.coolings]
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -308,13 +322,43 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     if tracking is not None and cfg.cooling is not None:
         raise InputError("cooling: not with tracking: yet (the closed loop, like nylonflex "
                          "simulate, uses the muscle set's own heat loss); leave one out")
+    coolings = _coolings(cfg.cooling, nylon)
+    if len(coolings) > 1 and (uncertainty is not None or requirements or
+                              tracking is not None):
+        raise InputError("cooling: a sweep with uncertainty, requirements or tracking takes "
+                         "one cooling set; sweep each set on its own")
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
                           requirements=requirements, models=models,
                           supply_voltage=voltage, tracking=tracking,
-                          cooling=_cooling(cfg.cooling, nylon))
+                          cooling=coolings[0] if len(coolings) == 1 else None,
+                          coolings=coolings if len(coolings) > 1 else ())
+
+
+def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
+    """The cooling sets of a config's ``cooling``: () without one, one set, or a list of
+    sets (a sweep axis), each named by a label of its own."""
+    if not isinstance(cooling, list):
+        env = _cooling(cooling, nylon)
+        return () if env is None else (env,)
+    if not cooling:
+        raise InputError("cooling: needs at least one cooling set, got []")
+    out = []
+    for i, item in enumerate(cooling):
+        try:
+            env = _cooling(item, nylon)
+        except InputError as err:  # name the list entry
+            raise InputError(str(err).replace("cooling", f"cooling[{i}]", 1)) from None
+        if env is None:
+            raise InputError(f"cooling[{i}]: must be a cooling set, got null")
+        labels = [c.label for c in out]
+        if env.label in labels:
+            raise InputError(f"cooling[{i}]: the same set as cooling[{labels.index(env.label)}] "
+                             f"({env.label}); give each set once")
+        out.append(env)
+    return tuple(out)
 
 
 def _cooling(cooling, nylon: Nylon) -> Cooling | None:

@@ -102,6 +102,10 @@ def _materials(ds, spec):
         raise InputError(f"cube: holds {len(model)} model variants ({', '.join(model)}); "
                          "design answers one: sweep the grid with one model, or give a "
                          "grid: spec with model: NAME")
+    if isinstance(cooling, list):
+        raise InputError(f"cube: holds {len(cooling)} cooling sets ("
+                         f"{', '.join(c.label for c in cooling)}); design answers one: sweep "
+                         "the grid with one cooling set")
     return Model(silicone, nylon, base, model, memo, supply_voltage=supply,
                  cooling=cooling)
 

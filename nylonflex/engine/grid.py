@@ -27,15 +27,17 @@ FLOAT_DESIGN = tuple(n for n, v in DESIGN.items() if v.dtype == "float64")
 def cube_variables(cfg: ResolvedConfig) -> dict:
     """``{name: (Variable, dims)}`` of every variable ``cfg``'s cube holds, in order.
 
-    With several models, the variables that depend on the model gain a last ``model``
-    dimension; ``heating_time`` is there only with a supply (docs/model.md s. 15-16); the
+    With several models, the variables that depend on the model gain a ``model``
+    dimension, and with several cooling sets those that depend on the heat loss a last
+    ``cooling`` one (:meth:`~nylonflex.variables.Variable.by_cooling`); ``heating_time`` is there only with a supply (docs/model.md s. 15-16); the
     quantiles and feasibility only with ``uncertainty``/``requirements``.
     """
     from .sampled import uncertain_variables
     from .tracking import tracking_variables
 
-    out = {n: (v, v.dims_for(cfg.models)) for n, v in {**DESIGN, **CURVES}.items()
-           if cfg.supply_voltage is not None or n not in SUPPLY_ONLY}
+    supply = cfg.supply_voltage is not None
+    out = {n: (v, v.dims_for(cfg.models, cfg.cooling_names, supply))
+           for n, v in {**DESIGN, **CURVES}.items() if supply or n not in SUPPLY_ONLY}
     # a sampled sweep's quantiles and feasibility (docs/uncertainty.md)
     out.update({n: (v, v.dims) for n, v in uncertain_variables(cfg).items()})
     # the closed loop of every design (docs/model.md s. 19)
@@ -62,6 +64,7 @@ def bytes_per_radius(cfg: ResolvedConfig) -> int:
     runs along ``radius``, over the other dimensions (the size of a slab per radius)."""
     sizes = {k: len(v) for k, v in coords(cfg).items()}
     sizes["model"] = len(cfg.models)
+    sizes["cooling"] = len(cfg.coolings)
     return sum(int(np.prod([sizes[d] for d in dims[1:]])) * np.dtype(v.dtype).itemsize
                for v, dims in cube_variables(cfg).values() if dims[0] == "radius")
 
@@ -99,6 +102,10 @@ def check_physics(cfg: ResolvedConfig):
     ny = cfg.nylon
     check_stroke_shape(ny.t_max, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
     if cfg.supply_voltage is None:
+        return
+    for cooling in cfg.coolings:  # a cube of several cooling sets: each must heat
+        check_physics(cfg.with_cooling(cooling))
+    if cfg.coolings:
         return
     ax = cfg.axes
     p_max = float(outer_perimeter(ax["radius"][-1], ax["wall_thickness"][-1],
@@ -203,23 +210,27 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
     """Every radius-dependent variable of the radii [i0, i1), as a dict of arrays.
 
     ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers. With
-    several models the kernel runs once a model and the model-dependent variables are
-    stacked along a last axis (docs/model.md s. 16). ``pool``: the kernel's output arrays
+    several models (cooling sets) the kernel runs once a model (and cooling set) and the
+    variables that depend on them are stacked along last axes, model then cooling
+    (docs/model.md s. 9, 16). ``pool``: the kernel's output arrays
     come from it (and go back to it when the caller is done with the slab).
     """
     from ..physics.limits import MODELS
 
-    slabs = [_compute_model_slab(cfg, i0, i1, parallel, MODELS.index(m), pool)
-             for m in cfg.models]
-    variables = cube_variables(cfg)
+    coolings = [cfg.with_cooling(c) for c in cfg.coolings] or [cfg]
+    slabs = {(m, k): _compute_model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
+             for m in cfg.models for k, one in enumerate(coolings)}
     arrays = {}
-    for name, (v, dims) in variables.items():
+    for name, (v, dims) in cube_variables(cfg).items():
         if dims[0] != "radius":
             continue
-        if dims[-1] == "model":
-            arrays[name] = np.stack([slab[name] for slab in slabs], axis=-1)
-        else:
-            arrays[name] = slabs[0][name]
+        by_model, by_cooling = "model" in dims, "cooling" in dims
+        ks = range(len(coolings))
+        per_model = [np.stack([slabs[m, k][name] for k in ks], axis=-1) if by_cooling
+                     else slabs[m, 0][name]
+                     for m in (cfg.models if by_model else cfg.models[:1])]
+        arrays[name] = np.stack(per_model, axis=-2 if by_cooling else -1) if by_model \
+            else per_model[0]
     return arrays
 
 

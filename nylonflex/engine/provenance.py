@@ -193,11 +193,32 @@ def evaluate_settings(attrs) -> dict:
         out["supply_voltage"] = float(supply)
     cooling = doc.get("cooling")  # only in cubes swept with a cooling set (docs/model.md s. 9)
     if isinstance(cooling, dict) and cooling.get("fluid") is not None:
-        from ..materials import Cooling
-
-        out["cooling"] = Cooling(str(cooling["fluid"]), float(cooling.get("speed", 0.0)),
-                                 name=str(cooling.get("name", "custom")))
+        out["cooling"] = _cooling_set(cooling)
+    elif isinstance(cooling, list):  # several cooling sets: the caller picks one
+        out["cooling"] = [_cooling_set(c) for c in cooling if isinstance(c, dict)]
     return out
+
+
+def _cooling_set(resolved: dict):
+    """The :class:`~nylonflex.materials.Cooling` of a resolved config's cooling entry."""
+    from ..materials import Cooling
+
+    return Cooling(str(resolved["fluid"]), float(resolved.get("speed", 0.0)),
+                   name=str(resolved.get("name", "custom")))
+
+
+def _cooling_spec(resolved):
+    """A config's ``cooling`` entry (a set name, or the set with its speed) of a resolved
+    one (one set or a list)."""
+    from ..materials import COOLING_PARAMETERS
+
+    def one(c):
+        own = COOLING_PARAMETERS.get(c.get("name"), {}).get("speed")
+        if own is not None and float(own) == float(c["speed"]):
+            return str(c["name"])
+        return {"set": str(c["name"]), "speed": float(c["speed"])}
+
+    return [one(c) for c in resolved] if isinstance(resolved, list) else one(resolved)
 
 
 def _sampling(cfg: ResolvedConfig) -> dict:
@@ -267,6 +288,8 @@ def runnable_config(attrs) -> str:
         out["model"] = list(doc["model"]) if len(doc["model"]) > 1 else doc["model"][0]
     if doc.get("supply_voltage") is not None:
         out["supply"] = {"voltage": float(doc["supply_voltage"]), "units": "V"}
+    if doc.get("cooling") is not None:  # docs/model.md s. 9
+        out["cooling"] = _cooling_spec(doc["cooling"])
     if "uncertainty" in doc:
         out["uncertainty"] = _uncertainty_spec(doc["uncertainty"])
     if doc.get("requirements"):

@@ -226,6 +226,7 @@ class MemorySink:
         self.coords = coords(cfg)
         sizes = {k: len(v) for k, v in self.coords.items()}
         sizes["model"] = len(cfg.models)
+        sizes["cooling"] = len(cfg.coolings)
         self.variables = cube_variables(cfg)
         self.data = {name: np.empty([sizes[d] for d in dims], dtype=v.dtype)
                      for name, (v, dims) in self.variables.items()}
@@ -241,13 +242,16 @@ class MemorySink:
         """The cube as an :class:`xarray.Dataset` (every variable with its registry attrs)."""
         import xarray as xr
 
-        from ..variables import COORDS, MODEL, slab_done_attrs
+        from ..variables import COOLING, COORDS, MODEL, slab_done_attrs
 
         coords = {name: (name, values, COORDS[name].attrs())
                   for name, values in self.coords.items()}
         if len(self.cfg.models) > 1:
             coords["model"] = ("model", np.array(self.cfg.models, dtype=object),
                                MODEL.attrs())
+        if self.cfg.coolings:
+            coords["cooling"] = ("cooling", np.array(self.cfg.cooling_names, dtype=object),
+                                 COOLING.attrs())
         ds = xr.Dataset(
             {name: (dims, self.data[name], v.attrs())
              for name, (v, dims) in self.variables.items()},

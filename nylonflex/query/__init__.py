@@ -31,7 +31,7 @@ from ..variables import AXES, DESIGN, VARIABLES  # noqa: F401  (names the tests 
 from .format import (_describe_at, _records, _sig3, _unit, cell_text, flag_names,  # noqa: F401
                      format_csv, format_json, format_table, held_back, rows_note,
                      shown_columns)
-from .parse import (_FIELDS, _LIMIT_WORDS, _MODEL_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
+from .parse import (_FIELDS, _LIMIT_WORDS, _CATEGORY_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
                     HEADLINE, INTERPOLATED, OPS, OPTIONAL, Condition, _parse_sort,
                     _quantity, default_columns, parse_at, parse_columns, parse_condition,
                     parse_constraint, parse_requirements, parse_where)

@@ -13,12 +13,12 @@ import math
 
 import numpy as np
 
-from ..variables import AXES, DESIGN, MODEL, VARIABLES, to_display
+from ..variables import AXES, CATEGORIES, COOLING, DESIGN, MODEL, VARIABLES, to_display
 from .parse import EXACT, OPTIONAL, default_columns
 
 
 def _var(name):
-    return MODEL if name == "model" else VARIABLES[name]
+    return {"model": MODEL, "cooling": COOLING}.get(name) or VARIABLES[name]
 
 
 def _unit(name):
@@ -71,7 +71,7 @@ def cell_text(name, x) -> str:
     """The table text of value ``x`` [SI] of column ``name``: the model's name, the validity
     flags by name, the limit by word, an axis in its display unit to 6 digits, any other
     variable in its display unit to 3 significant digits."""
-    if name == "model":
+    if name in CATEGORIES:
         return str(x)
     if name == "validity":
         return flag_names(x)
@@ -105,7 +105,7 @@ def _describe_at(res) -> str:
 
 def _all_nan(res, name) -> bool:
     x = res.data[name]
-    return name != "model" and len(x) > 0 and not np.isfinite(np.asarray(x, float)).any()
+    return name not in CATEGORIES and len(x) > 0 and not np.isfinite(np.asarray(x, float)).any()
 
 
 def shown_columns(res, fmt="table") -> tuple:
@@ -114,7 +114,7 @@ def shown_columns(res, fmt="table") -> tuple:
     JSON and CSV every column. A table leaves out a column no row has a value in
     (``heating_time`` without a supply) unless ``--columns`` named it."""
     if res.chosen is not None:
-        return (("model",) if "model" in res.columns else ()) + res.chosen
+        return tuple(c for c in CATEGORIES if c in res.columns) + res.chosen
     if fmt != "table":
         return res.columns
     names = res.columns if getattr(res, "every", False) else \
@@ -184,8 +184,8 @@ def _columns_text(heads, cells, width=WIDTH) -> list[str]:
 
     def render(cols, names):
         widths = [max(body[j], *(len(x) for x in names[j])) for j in cols]
-        # names to the left (the model column), numbers to the right
-        just = [str.ljust if heads[j] == "model" else str.rjust for j in cols]
+        # names to the left (the model and cooling columns), numbers to the right
+        just = [str.ljust if heads[j] in CATEGORIES else str.rjust for j in cols]
         depth = max(len(names[j]) for j in cols)
         head = [[""] * (depth - len(names[j])) + names[j] for j in cols]
         lines = ["  ".join(jf(h[k], w) for h, w, jf in zip(head, widths, just)).rstrip()
@@ -243,7 +243,7 @@ def rows_note(res) -> str:
 
 
 def _json_value(name, x):
-    if name == "model":
+    if name in CATEGORIES:
         return str(x)
     if name in INTEGERS:
         return _integer(x)
@@ -291,7 +291,7 @@ def format_csv(res) -> str:
     w = csv.writer(out, lineterminator="\n")
     columns = shown_columns(res, "csv")
     head = ([] if not res.point else ["point"]) + \
-        [n if n == "model" else f"{n} [{VARIABLES[n].units}]" for n in columns]
+        [n if n in CATEGORIES else f"{n} [{VARIABLES[n].units}]" for n in columns]
     w.writerow(head)
     for i in range(len(res)):
         row = [] if not res.point else [res.point]

@@ -24,8 +24,10 @@ _LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limit
                 "supply": 2, "supply_limited": 2, "load": 3, "load_limited": 3}
 
 
-#: ``--where "model == NAME"``: picks a model's slice of a cube (not a Condition).
-_MODEL_WHERE = re.compile(r"^\s*model\s*(==|=)\s*([A-Za-z0-9_]+)\s*$")
+#: ``--where "model == NAME"`` or ``"cooling == NAME"``: picks a model's (a cooling set's)
+#: slice of a cube (not a Condition); a cooling set's name may carry its speed
+#: (``forced_air 5 m/s``).
+_CATEGORY_WHERE = re.compile(r"^\s*(model|cooling)\s*(==|=)\s*([A-Za-z0-9_][A-Za-z0-9_ ./]*?)\s*$")
 
 
 def _quantity(name, text, field):
@@ -165,9 +167,10 @@ def parse_condition(text, field: str = "--where", names=None, ops=OPS,
 def parse_where(texts) -> list[Condition]:
     """Parse ``--where`` strings (ANDed) into :class:`Condition` objects.
 
-    ``model == NAME`` stays a string: :func:`query_cube` selects that model's slice.
+    ``model == NAME`` and ``cooling == NAME`` stay strings: :func:`query_cube` selects that
+    model's (cooling set's) slice.
     """
-    return [t if _MODEL_WHERE.match(str(t)) else parse_condition(t) for t in texts or ()]
+    return [t if _CATEGORY_WHERE.match(str(t)) else parse_condition(t) for t in texts or ()]
 
 
 def parse_requirements(texts, field: str = "requirements") -> tuple[Condition, ...]:
@@ -247,9 +250,10 @@ def parse_columns(text):
 
 def default_columns(available, asked=()) -> tuple:
     """A table's columns: the axes, the ``asked`` names (tested by ``--where`` or sorted
-    by), then :data:`HEADLINE`; only the ``available`` ones, each once, ``model`` first."""
+    by), then :data:`HEADLINE`; only the ``available`` ones, each once, ``model`` and
+    ``cooling`` first."""
     out = []
-    for name in ("model", *AXES, *asked, *HEADLINE):
+    for name in ("model", "cooling", *AXES, *asked, *HEADLINE):
         if name in available and name not in out:
             out.append(name)
     return tuple(out)

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import InputError, from_si
-from ..variables import AXES, DESIGN, VARIABLES
-from .parse import (_MODEL_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
+from ..variables import CATEGORIES, AXES, DESIGN, VARIABLES
+from .parse import (_CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
                     _parse_sort, parse_at, parse_columns, parse_condition)
 
 # Values this close (relative to the axis span) to a grid value are that grid value.
@@ -123,11 +123,13 @@ def slab_rows(ds, at_loc, r0, r1):
         sub["limit"] = a["limit"].where(~mixed)
         if "validity" in sub:
             sub["validity"] = a["validity"].where(a["validity"] == b["validity"])
-    # a cube of several models: the model is the last (fastest) axis of the rows
-    dims = [d for d in (*AXES, "model") if d in sub.dims]
+    # a cube of several models (cooling sets): the model, then the cooling set, are the
+    # last (fastest) axes of the rows
+    cats = [d for d in CATEGORIES if d in sub.dims]
+    dims = [d for d in AXES if d in sub.dims] + cats
     shape = [sub.sizes[d] for d in dims]
-    if "model" in sub.dims:  # model-free variables: the same value for every model
-        sub = sub.map(lambda v: v if "model" in v.dims else v.expand_dims(model=sub["model"]))
+    for cat in cats:  # variables free of it: the same value for each model (cooling set)
+        sub = sub.map(lambda v, c=cat: v if c in v.dims else v.expand_dims({c: sub[c]}))
     rows = {}
     for name in AXES:
         if name in sub.dims:
@@ -136,10 +138,10 @@ def slab_rows(ds, at_loc, r0, r1):
             rows[name] = np.broadcast_to(coord, shape).reshape(-1)
         else:
             rows[name] = np.full(int(np.prod(shape)), at_value(at_loc, name, ds))
-    if "model" in sub.dims:
-        names = sub["model"].values.astype(str).astype(object)
-        rows["model"] = np.broadcast_to(names.reshape([1] * (len(dims) - 1) + [-1]),
-                                        shape).reshape(-1)
+    for cat in cats:
+        names = sub[cat].values.astype(str).astype(object)
+        axis_shape = [-1 if d == cat else 1 for d in dims]
+        rows[cat] = np.broadcast_to(names.reshape(axis_shape), shape).reshape(-1)
     for name in DESIGN:
         rows[name] = sub[name].transpose(*dims).values.reshape(-1) if name in sub else \
             np.full(int(np.prod(shape)), np.nan)  # heating_time: only with a supply
@@ -281,6 +283,11 @@ def _exact_settings(ds):
         raise InputError("--at: this cube holds several models "
                          f"({', '.join(settings['model'])}); the exact model between grid "
                          "points needs one: use --interpolate, or query a one-model cube")
+    if isinstance(settings.get("cooling"), list):
+        raise InputError("--at: this cube holds several cooling sets "
+                         f"({', '.join(c.label for c in settings['cooling'])}); the exact "
+                         "model between grid points needs one: use --interpolate, or query "
+                         "a cube of one cooling set")
     return settings
 
 
@@ -293,7 +300,8 @@ def radius_slabs(ds, at_loc) -> list[tuple[int, int]]:
     other = 1
     for name in AXES[1:]:
         other *= 2 if name in at_loc else ds.sizes[name]
-    other *= ds.sizes.get("model", 1)
+    for cat in CATEGORIES:
+        other *= ds.sizes.get(cat, 1)
     step = max(1, _SLAB_VALUES // max(other, 1))
     return [(r, min(r + step, ds.sizes["radius"])) for r in range(0, ds.sizes["radius"], step)]
 
@@ -348,8 +356,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     conditions = [c if isinstance(c, Condition) else parse_condition(c) for c in where]
     sort_name, descending = _parse_sort(sort)
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
-    if "model" in ds.dims:  # every model at once: the model names each row
-        columns = ("model", *columns)
+    # every model (cooling set) at once: the model (cooling set) names each row
+    columns = (*(c for c in CATEGORIES if c in ds.dims), *columns)
     for name in [c.name for c in conditions] + [sort_name]:
         if name in OPTIONAL and name not in ds:
             raise InputError(f"{name}: the cube has no {name}; sweep a config with "
@@ -382,7 +390,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                        if exact else None)
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
-    kept = {name: np.empty(0, dtype=object if name == "model" else float)
+    kept = {name: np.empty(0, dtype=object if name in CATEGORIES else float)
             for name in columns}
     matched = 0
     for k, (r0, r1) in enumerate(slabs):
@@ -395,8 +403,9 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         n_where = None
         if exact:
             rows = _exact_rows(ds, at, at_loc, r0, r1, settings)
-        elif conditions and not off_grid and "model" not in ds.dims:
-            # variable by variable (a cube of several models is read whole, per slab)
+        elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
+            # variable by variable (a cube of several models or cooling sets is read
+            # whole, per slab)
             rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
         else:
             rows = slab_rows(ds, at_loc, r0, r1)
@@ -445,25 +454,38 @@ def _exact_flags(rows, settings):
 
 
 def _select_model(ds, where):
-    """The cube at the model a ``--where "model == NAME"`` names, and the other conditions.
+    """The cube at the model (cooling set) a ``--where "model == NAME"`` (``"cooling ==
+    NAME"``) names, and the other conditions.
 
-    A cube of several models (docs/model.md s. 16) without such a condition is queried
-    across every model at once (a ``model`` column names each row's).
+    A cube of several models (docs/model.md s. 16) or cooling sets (s. 9) without such a
+    condition is queried across all of them at once (a ``model`` and a ``cooling`` column
+    name each row's).
     """
     where = list(where or ())
-    names = [m.group(2) for m in (_MODEL_WHERE.match(str(w)) for w in where) if m]
-    rest = [w for w in where if not _MODEL_WHERE.match(str(w))]
-    models = [str(m) for m in ds["model"].values] if "model" in ds.dims else \
-        str(ds.attrs.get("models", "paper")).split()
-    for name in names:
-        if name not in models:
-            raise InputError(f"--where model: this cube has {', '.join(models)}, got {name!r}")
-    if "model" not in ds.dims or not names:
-        return ds, rest
-    if len(set(names)) != 1:
-        raise InputError(f"--where: one model at a time ({', '.join(models)}), or none for "
-                         f"every model; got {', '.join(sorted(set(names)))}")
-    return ds.sel(model=names[0], drop=True), rest
+    picks = [m for m in (_CATEGORY_WHERE.match(str(w)) for w in where) if m]
+    rest = [w for w in where if not _CATEGORY_WHERE.match(str(w))]
+    for cat in CATEGORIES:
+        names = [m.group(3) for m in picks if m.group(1) == cat]
+        if cat in ds.dims:
+            have = [str(m) for m in ds[cat].values]
+        elif cat == "model":
+            have = str(ds.attrs.get("models", "paper")).split()
+        else:
+            have = []
+        for name in names:
+            if name not in have:
+                if not have:
+                    raise InputError(f"--where {cat}: this cube has no {cat} dimension "
+                                     "(one cooling set)")
+                raise InputError(f"--where {cat}: this cube has {', '.join(have)}, got "
+                                 f"{name!r}")
+        if cat not in ds.dims or not names:
+            continue
+        if len(set(names)) != 1:
+            raise InputError(f"--where: one {cat} at a time ({', '.join(have)}), or none "
+                             f"for every {cat}; got {', '.join(sorted(set(names)))}")
+        ds = ds.sel({cat: names[0]}, drop=True)
+    return ds, rest
 
 
 def _sorted(rows, name, descending, limit):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..variables import COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
+from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .netcdf4 import NetCDF4File
 
 __all__ = ["CODECS", "DEFAULT_CODEC", "Codec", "CubeFile", "MissingPlugin",
@@ -172,7 +172,7 @@ class CubeFile:
 
     def __init__(self, path, coords: dict, attrs: dict, radius_chunk: int,
                  codec: str = DEFAULT_CODEC, variables: dict | None = None,
-                 models=("paper",)):
+                 models=("paper",), coolings=()):
         import h5py
 
         self.codec = CODECS[codec]
@@ -188,6 +188,10 @@ class CubeFile:
         if len(models) > 1:  # the string dimension of a cube of several model variants
             sizes["model"] = len(models)
             self.f.coordinate("model", np.array(models, dtype=object), MODEL.attrs(),
+                              dtype=h5py.string_dtype())
+        if len(coolings) > 1:  # the string dimension of a cube of several cooling sets
+            sizes["cooling"] = len(coolings)
+            self.f.coordinate("cooling", np.array(coolings, dtype=object), COOLING.attrs(),
                               dtype=h5py.string_dtype())
         # the variables the config asks for, {name: (registry entry, dims)}; a plain
         # sweep's by default

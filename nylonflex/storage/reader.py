@@ -152,7 +152,9 @@ def _validity_lines(f, h5, done) -> list[str]:
     parts = [f"{name} {int(counts[(values & bit) > 0].sum()):,}"
              for bit, name in zip(bits, meanings)]
     flagged = int(counts[values > 0].sum())
-    per = " (counted over every model)" if "model" in f.dimensions else ""
+    over = [w for d, w in (("model", "model"), ("cooling", "cooling set"))
+            if d in var.dimensions]
+    per = f" (counted over every {' and '.join(over)})" if over else ""
     return [f"flagged   {flagged:,} of {n_values:,} design values ({100 * flagged / n:.1f} %)"
             f"{per}: " + ", ".join(parts)]
 
@@ -346,6 +348,9 @@ def cube_summary(path) -> list[str]:
         if "model" in sizes:
             out.append("models    " + ", ".join(
                 _text(m) for m in np.asarray(h5["model"][...]).reshape(-1)))
+        if "cooling" in sizes:
+            out.append("cooling   " + ", ".join(
+                _text(m) for m in np.asarray(h5["cooling"][...]).reshape(-1)))
         if a.get("supply_voltage", "none") != "none":
             out.append(f"supply    {a['supply_voltage']}")
         try:

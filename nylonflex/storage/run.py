@@ -277,7 +277,7 @@ def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, pro
            replaces=False):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
-                    cfg.models)
+                    cfg.models, cfg.cooling_names)
     try:
         check_building(building)  # HDF5 opened it by name: still the file this run locked
         _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
