@@ -113,6 +113,11 @@ def test_a_perturbed_sample_is_a_sweep_of_its_materials():
     for n in NAMES:
         np.testing.assert_allclose(got[n], ds[n].values[i, 0, 0, j, 0], rtol=1e-9,
                                    err_msg=n)
+    # the samples' threads change nothing: the same values as one thread
+    z3 = np.vstack([z, -z, 0.5 * z])
+    threaded, serial = (sampled_tracking(cfg, AT, z3, NAMES, parallel=p) for p in (True, False))
+    for n in NAMES:
+        np.testing.assert_array_equal(threaded[n], serial[n])
 
 
 def test_tracking_outputs_are_accepted_only_with_a_tracking_block():
