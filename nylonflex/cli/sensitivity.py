@@ -10,7 +10,14 @@ DESCRIPTION = """Sobol' first-order and total indices (SALib, Saltelli sampling,
 bootstrap intervals) of the chosen outputs with respect to every parameter of the config's
 uncertainty: section. --at with all five axes analyses one design; fewer (or none) fixes
 those axes and averages the per-design indices over grid designs (at most --designs of
-them, drawn with the seed). See docs/uncertainty.md."""
+them, drawn with the seed). With a tracking: block the closed-loop variables
+(tracking_rms_error, tracking_max_temperature, tracking_energy, tracking_bandwidth) are
+outputs too: every sample runs the sweep's closed loop, about 8 ms of CPU each for
+fig12_tracking.yaml's 125 s loop (512 x (4 factors + 2) = 3,072 runs of one design: about
+25 s of CPU), at most 16,384 runs an analysis. A config without an
+uncertainty: section takes one from --set, e.g. --set 'uncertainty={parameters:
+{silicone.mu: {rel_sd: 0.1}, nylon.heat_loss_per_length: {rel_sd: 0.1}}}'. See
+docs/uncertainty.md."""
 
 
 def add_arguments(p):
@@ -18,7 +25,9 @@ def add_arguments(p):
     p.add_argument("--at", metavar="NAME=VALUE,...",
                    help="design axes, e.g. radius=7.5mm,wall_thickness=2mm,...")
     p.add_argument("--output", nargs="+", default=["tip_force_max"], metavar="NAME",
-                   help="design variables to analyse (default tip_force_max)")
+                   help="design variables to analyse (default tip_force_max); with a "
+                   "tracking: block also tracking_rms_error, tracking_max_temperature, "
+                   "tracking_energy (and tracking_bandwidth with tracking.bandwidth)")
     p.add_argument("--samples", type=int, default=512, metavar="N",
                    help="Saltelli base sample N, a power of 2 (default 512)")
     p.add_argument("--designs", type=int, default=16, metavar="N",

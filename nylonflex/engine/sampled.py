@@ -22,8 +22,8 @@ from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
 from .pointwise import evaluate
 
-__all__ = ["FLOAT_NAMES", "perturbed_inputs", "sample_statistics", "slab_statistics",
-           "standard_from_unit", "standard_samples", "uncertain_variables"]
+__all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_statistics",
+           "slab_statistics", "standard_from_unit", "standard_samples", "uncertain_variables"]
 
 #: The design variables that get quantiles (``limit`` is a flag: no quantiles).
 FLOAT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
@@ -158,6 +158,54 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
     out["model"] = cfg.models[0]  # a sampled sweep has one model (nylonflex.config refuses more)
     out["supply_voltage"] = cfg.supply_voltage
     out["cooling"] = cfg.cooling
+    return out
+
+
+def perturbed_configs(cfg: ResolvedConfig, design: dict, z: np.ndarray) -> list:
+    """One design under each sample ``z``: ``(design, config)`` pairs, config being ``cfg``
+    with that sample's silicone and nylon (what :func:`perturbed_inputs` gives the
+    evaluator, the same truncations), for code that takes a config (the closed loop).
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        Materials and the uncertainty spec.
+    design : dict of str to float
+        The five axes [SI].
+    z : ndarray
+        Standard variables, shape (S, dims).
+
+    Returns
+    -------
+    list of (dict, ResolvedConfig)
+        S pairs: the sample's design axes [SI] (moved where an axis is uncertain) and its
+        config (``cfg`` itself where no material is uncertain).
+    """
+    from dataclasses import fields, replace
+
+    S = z.shape[0]
+    args = perturbed_inputs({k: np.asarray(design[k], float) for k in AXES}, cfg, z)
+    axes = {k: np.broadcast_to(np.asarray(args[k], float).reshape(-1), (S,)) for k in AXES}
+    silicone, nylon = args["silicone"], args["nylon"]
+    out = []
+    for s in range(S):
+        c = cfg
+        if silicone is not cfg.silicone:
+            c = replace(c, silicone=replace(cfg.silicone, **{
+                k: tuple(float(x) for x in silicone[k][s]) for k in ("mu", "alpha")}))
+        if nylon is not cfg.nylon:
+            changes = {}
+            for f in fields(cfg.nylon):
+                own = getattr(cfg.nylon, f.name)
+                if f.name not in nylon or not isinstance(own, (int, float, tuple)):
+                    continue
+                v = np.asarray(nylon[f.name], float)
+                if v.ndim > np.ndim(own):  # this field is sampled: the sample's row
+                    v = v[s]
+                changes[f.name] = tuple(float(x) for x in v) if isinstance(own, tuple) \
+                    else float(v)
+            c = replace(c, nylon=replace(cfg.nylon, **changes))
+        out.append(({k: float(axes[k][s]) for k in AXES}, c))
     return out
 
 

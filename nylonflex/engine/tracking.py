@@ -23,7 +23,8 @@ from ..physics.thermal import coil_resistance_per_length, steady_temperature
 from ..physics.wrap import muscle_length
 from ..variables import TRACKING
 
-__all__ = ["PLANT_POINTS", "slab_tracking", "tracking_variables"]
+__all__ = ["PLANT_POINTS", "design_tracking", "sampled_tracking", "slab_tracking",
+           "tracking_variables"]
 
 #: Points of each (radius, wall)'s curvature table: four times the density of
 #: ``nylonflex simulate``'s 513 over a design's own range.
@@ -76,12 +77,15 @@ def top_pressure(cfg: ResolvedConfig, lm, coil_index) -> np.ndarray:
 
 
 def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
-                  parallel: bool = True) -> dict:
+                  parallel: bool = True, table_top=None) -> dict:
     """The tracking variables of the radii [i0, i1), shape (radius, wall, length, coil,
     wrap) each.
 
     ``nominal`` is the slab's grid-kernel result (``bend_angle_max`` scales a reference
     relative to it). ``parallel=False`` (Dask workers) runs the serial kernels.
+    ``table_top`` [Pa], shape (radius, wall), is the top of each (radius, wall)'s plant
+    table; by default the highest pressure of the slab's designs (see
+    :func:`design_tracking`, which runs one design as a whole grid would).
     """
     from ..kernels import tracking as kt
 
@@ -95,9 +99,13 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
         muscle_length(grid[0], grid[1], grid[2], grid[4], grid[3], base, ny),
         (len(a), len(t), len(L), len(C), len(psi))), dtype=float)
     p_top = np.ascontiguousarray(top_pressure(cfg, lm, grid[3]))
-    with np.errstate(all="ignore"):
-        p_group = np.ascontiguousarray(np.nanmax(p_top.reshape(len(a), len(t), -1), axis=2)
-                                       if p_top.size else np.zeros((len(a), len(t))))
+    if table_top is not None:
+        p_group = np.ascontiguousarray(np.reshape(table_top, (len(a), len(t))), dtype=float)
+    else:
+        with np.errstate(all="ignore"):
+            p_group = np.ascontiguousarray(
+                np.nanmax(p_top.reshape(len(a), len(t), -1), axis=2)
+                if p_top.size else np.zeros((len(a), len(t))))
     scale = np.array([float(stroke_scale(c, np.asarray(ny.coil_index_table),
                                          np.asarray(ny.stroke_max_table), ny.t_amb,
                                          ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g))
@@ -136,3 +144,122 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
              "tracking_bandwidth")
     return {name: out[k].reshape(lm.shape) for k, name in enumerate(names)
             if name in tracking_variables(cfg)}
+
+
+def design_tracking(cfg: ResolvedConfig, design: dict, bend_angle_max: float | None = None,
+                    parallel: bool = True) -> dict:
+    """The tracking variables of one design, as a sweep of ``cfg``'s grid gives them.
+
+    The design need not be a grid point (a perturbed wall, an ``--at`` value): its plant
+    table spans the highest pressure of the grid designs of its radius and wall (the
+    config's length, coil and wrap axes) and its own, as its slab's would; on a grid design
+    the values are the cube's, bit for bit.
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        Materials, supply and ``tracking:`` (needed); its axes give the plant table's group.
+    design : dict of str to float
+        The five axes [SI].
+    bend_angle_max : float, optional
+        theta* [rad] of the design under ``cfg``'s materials, for a reference relative to
+        it (``tracking.reference.relative_to: bend_angle_max``); unused otherwise.
+    parallel : bool
+        False: the serial kernels (one thread; callers that run designs in threads).
+
+    Returns
+    -------
+    dict of str to float
+        :func:`tracking_variables`' names.
+    """
+    from dataclasses import replace
+
+    from ..variables import AXES
+
+    one = {k: np.array([float(design[k])]) for k in AXES}
+    ny, ax = cfg.nylon, cfg.axes
+    base = None if cfg.base_thickness is None else float(cfg.base_thickness)
+    group = [np.concatenate([ax[k], one[k]]) for k in ("length", "coil_index", "wrap_angle")]
+    L, C, psi = np.meshgrid(*group, indexing="ij", sparse=True)
+    lm = muscle_length(one["radius"][0], one["wall_thickness"][0], L, psi, C, base, ny)
+    with np.errstate(all="ignore"):
+        top = np.nanmax(top_pressure(cfg, np.broadcast_to(lm, np.broadcast(L, C, psi).shape),
+                                     C))
+    if cfg.tracking.relative_to == "bend_angle_max" and bend_angle_max is None:
+        raise ValueError("bend_angle_max: needed for a reference relative to it")
+    nominal = {"bend_angle_max": np.full((1,) * 5, np.nan if bend_angle_max is None
+                                         else float(bend_angle_max))}
+    out = slab_tracking(replace(cfg, axes=one), 0, 1, nominal, parallel=parallel,
+                        table_top=np.full((1, 1), top))
+    return {k: float(v.reshape(-1)[0]) for k, v in out.items()}
+
+
+
+def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=None,
+                     bend_angle_max=None, parallel: bool = True) -> dict:
+    """The tracking variables of one design under each sample of the uncertain parameters.
+
+    Each sample is :func:`design_tracking` of the design under that sample's materials
+    (and moved axes, :func:`~.sampled.perturbed_configs`): the value a sweep of a config
+    with those materials would hold. A run takes about 8 ms (a plant table and the loop;
+    ``tracking.bandwidth``'s search several runs more); the samples run in threads, one a
+    Numba thread (the kernels release the GIL).
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        Materials, ``tracking:`` and ``uncertainty:``.
+    design : dict of str to float
+        The five axes [SI].
+    z : ndarray
+        Standard variables, shape (S, dims).
+    names : sequence of str, optional
+        The tracking variables wanted (default all of :func:`tracking_variables`); the
+        bandwidth search runs only when ``tracking_bandwidth`` is among them.
+    bend_angle_max : ndarray, optional
+        theta* [rad] of each sample (S,), for a reference relative to it; computed by the
+        evaluator when not given.
+    parallel : bool
+        False: one thread.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``names``, shape (S,) each.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+    from dataclasses import replace
+
+    import numba
+
+    from .sampled import perturbed_configs
+
+    names = tuple(tracking_variables(cfg) if names is None else names)
+    pairs = perturbed_configs(cfg, design, z)
+    if "tracking_bandwidth" not in names and cfg.tracking.bandwidth is not None:
+        # the search is several runs a design: only when asked for (the main run's noise
+        # is the same: the sequence of the seed, only shorter)
+        quick = replace(cfg.tracking, bandwidth=None)
+        pairs = [(d, replace(c, tracking=quick)) for d, c in pairs]
+    if cfg.tracking.relative_to == "bend_angle_max" and bend_angle_max is None:
+        from .pointwise import evaluate
+        from .sampled import perturbed_inputs
+
+        one = {k: np.asarray(design[k], float) for k in design}
+        bend_angle_max = np.asarray(evaluate(**perturbed_inputs(one, cfg, z))
+                                    ["bend_angle_max"], float).reshape(-1)
+    theta = [None] * len(pairs) if bend_angle_max is None else \
+        np.broadcast_to(np.asarray(bend_angle_max, float).reshape(-1), (len(pairs),))
+
+    def run(s):
+        d, c = pairs[s]
+        return design_tracking(c, d, None if theta[s] is None else float(theta[s]),
+                               parallel=False)
+
+    workers = numba.get_num_threads() if parallel else 1
+    if workers > 1 and len(pairs) > 1:
+        with ThreadPoolExecutor(workers, thread_name_prefix="nylonflex-track") as pool:
+            rows = list(pool.map(run, range(len(pairs))))
+    else:
+        rows = [run(s) for s in range(len(pairs))]
+    return {n: np.array([r[n] for r in rows]) for n in names}

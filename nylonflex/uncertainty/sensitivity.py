@@ -10,6 +10,12 @@ At one design the indices are those of its outputs. Over the design space (desig
 grid, at most ``max_designs`` of them drawn with the seed) they are the mean of the
 per-design indices, with the mean of their confidence half-widths: "which parameter decides
 the typical design". Designs where an output does not vary are left out of its mean.
+
+With a ``tracking:`` block the closed-loop variables (``tracking_rms_error``, ...) are
+outputs too: each sample of each design runs the sweep's closed loop under that sample's
+materials (:func:`nylonflex.engine.tracking.sampled_tracking`, about 8 ms a run), so the
+nominal materials give the cube's value. Their run count is bounded by
+:data:`MAX_LOOP_RUNS`.
 """
 
 from __future__ import annotations
@@ -21,8 +27,9 @@ import numpy as np
 from ..config import ResolvedConfig
 from ..engine.pointwise import evaluate
 from ..engine.sampled import FLOAT_NAMES, perturbed_inputs, standard_from_unit
+from ..engine.tracking import sampled_tracking, tracking_variables
 from ..units import InputError
-from ..variables import AXES
+from ..variables import AXES, TRACKING
 
 __all__ = ["SensitivityResult", "sobol_indices"]
 
@@ -35,6 +42,9 @@ MAX_DESIGNS = 10_000
 #: The most model runs of one analysis, N (factors + 2) x designs [-]: about 0.4 GB of
 #: memory (2^24 base samples of one factor, 5 x 10^7 runs, held 1.2 GB).
 MAX_RUNS = 2**24
+#: The most closed-loop runs of one analysis with tracking outputs, N (factors + 2) x
+#: designs (x the bandwidth search's runs) [-]: about 8 ms each, some 2 minutes of one core.
+MAX_LOOP_RUNS = 2**14
 
 
 @dataclass
@@ -81,7 +91,9 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     cfg : ResolvedConfig
         A config whose ``uncertainty.parameters`` name the factors (at least one).
     outputs : sequence of str
-        Float design variables (``tip_force_max``, ``range_fraction``, ...).
+        Float design variables (``tip_force_max``, ``range_fraction``, ...) and, with
+        ``cfg.tracking``, its tracking variables (``tracking_rms_error``, ...: the closed
+        loop of each sample, see module).
     at : dict, optional
         Axis values [SI]; all five: one design; some or none: grid designs (see module).
     base_samples : int
@@ -100,7 +112,8 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     Raises
     ------
     InputError
-        No uncertain parameter, an unknown output, or a bad ``base_samples``.
+        No uncertain parameter, an unknown output (a tracking one without ``tracking:``),
+        a bad ``base_samples``, or too many model or closed-loop runs.
     """
     from SALib.analyze import sobol as analyze
     from SALib.sample import sobol as sample
@@ -109,10 +122,17 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     if spec is None or not spec.parameters:
         raise InputError("uncertainty.parameters: sensitivity needs at least one uncertain "
                          "parameter in the config")
-    bad = [o for o in outputs if o not in FLOAT_NAMES]
+    tracked = tracking_variables(cfg)
+    for o in outputs:
+        if o in TRACKING and o not in tracked:
+            raise InputError(f"--output: {o} needs " + (
+                "a tracking: block in the config (the closed loop of every design, "
+                "docs/model.md s. 19)" if cfg.tracking is None else
+                "tracking.bandwidth in the config's tracking: block"))
+    bad = [o for o in outputs if o not in FLOAT_NAMES and o not in tracked]
     if bad or not outputs:
         raise InputError(f"--output: unknown {', '.join(bad) or 'none given'}; accepted: "
-                         f"{', '.join(FLOAT_NAMES)}")
+                         f"{', '.join((*FLOAT_NAMES, *tracked))}")
     if base_samples < 8 or base_samples & (base_samples - 1) or \
             base_samples > MAX_BASE_SAMPLES:
         raise InputError(f"--samples: must be a power of 2 in [8, {MAX_BASE_SAMPLES:,}], got "
@@ -132,6 +152,18 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
                          f"{n_designs:,} design{'s' if n_designs != 1 else ''} = {runs:,} "
                          f"model runs, over the {MAX_RUNS:,} one analysis may make; lower "
                          "--samples or --designs (or fix more axes with --at)")
+    loop = [o for o in outputs if o in tracked]
+    if loop:
+        b = cfg.tracking.bandwidth
+        per = 1 + b["iterations"] + 2 if "tracking_bandwidth" in loop else 1
+        loop_runs = runs * per
+        if loop_runs > MAX_LOOP_RUNS:
+            times = f" x {per} (the loop and tracking.bandwidth's search)" if per > 1 else ""
+            raise InputError(
+                f"--samples: {base_samples:,} x {groups_n + 2} (factors + 2) x {n_designs:,} "
+                f"design{'s' if n_designs != 1 else ''}{times} = {loop_runs:,} closed-loop "
+                f"runs, over the {MAX_LOOP_RUNS:,} one analysis may make (about 8 ms each); "
+                "lower --samples or --designs (or fix more axes with --at)")
     d = len(groups)
     problem = {"num_vars": d, "names": [f"{g}[{i}]" for i, g in enumerate(groups)],
                "bounds": [[0.0, 1.0]] * d}
@@ -140,7 +172,15 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     u = sample.sample(problem, base_samples, calc_second_order=False, seed=seed)
     z = standard_from_unit(spec, u)
     designs = _grid_designs(cfg, dict(at or {}), max_designs, seed)
-    out = evaluate(**perturbed_inputs(designs, cfg, z))  # (designs, samples)
+    relative = bool(loop) and cfg.tracking.relative_to == "bend_angle_max"
+    out = {}
+    if relative or any(o not in tracked for o in outputs):
+        out = evaluate(**perturbed_inputs(designs, cfg, z))  # (designs, samples)
+    if loop:  # the closed loop of each sample of each design
+        rows = [sampled_tracking(cfg, {a: designs[a][i] for a in AXES}, z, loop,
+                                 bend_angle_max=out["bend_angle_max"][i] if relative
+                                 else None) for i in range(len(designs["radius"]))]
+        out = {**out, **{o: np.array([r[o] for r in rows]) for o in loop}}
     acc = {o: {k: {p: [] for p in names} for k in _KEYS} for o in outputs}
     for o in outputs:
         for row in np.asarray(out[o]):
