@@ -23,8 +23,7 @@ import numpy as np
 import yaml
 from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
 
-from ..materials import Cooling, Nylon, Silicone, cooling_parameters, nylon_parameters, \
-    silicone_parameters
+from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
@@ -39,6 +38,7 @@ from .base import (
     check_range,
     check_run_name,
     range_error,
+    resolve_cooling,
 )
 from .tracking import Tracking, TrackingSpec, resolve_tracking
 from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
@@ -305,31 +305,13 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     models, voltage = _models(cfg.model), _supply(cfg.supply)
     tracking = None if cfg.tracking is None else \
         resolve_tracking(cfg.tracking, voltage, models, nylon.t_amb, nylon.t_max)
-    if tracking is not None and cfg.cooling is not None:
-        raise InputError("cooling: not with tracking: yet (the closed loop, like nylonflex "
-                         "simulate, uses the muscle set's own heat loss); leave one out")
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
                           raw=copy.deepcopy(raw), uncertainty=uncertainty,
                           requirements=requirements, models=models,
                           supply_voltage=voltage, tracking=tracking,
-                          cooling=_cooling(cfg.cooling, nylon))
-
-
-def _cooling(cooling, nylon: Nylon) -> Cooling | None:
-    """The cooling set of a config's ``cooling`` (docs/model.md s. 9), or None; refused
-    beside a nylon set whose heat loss is fitted (a ``fit thermal`` file's value wins)."""
-    if cooling is None:
-        return None
-    try:
-        env = cooling_parameters(cooling)
-    except ValueError as err:
-        raise InputError(str(err)) from None
-    if "nylonflex fit" in str(nylon.sources.get("heat_loss_per_length", "")):
-        raise InputError("cooling: the nylon set's heat_loss_per_length is fitted (a fit "
-                         "thermal file); leave out cooling: or the fitted value")
-    return env
+                          cooling=resolve_cooling(cfg.cooling, nylon))
 
 
 def _models(model) -> tuple[str, ...]:
