@@ -115,8 +115,10 @@ def test_each_coil_index_tracks_under_a_cooling_set_as_simulate_does(cooling, vo
     # a cooling set gives lambda'(C), different at every coil index (docs/model.md s. 9):
     # the sweep's loop of each C cools with that C's, as simulate of that design with the
     # same cooling: does. The supplies bring the cooled muscles near the paper's operating
-    # temperatures (12 V barely warms them in water, docs/model.md s. 19).
-    sim_raw = _control(cooling=cooling, supply__voltage=voltage)
+    # temperatures (12 V barely warms them in water, docs/model.md s. 19); 50 s, two
+    # periods, keep it short with the JIT off (.ci/run)
+    changes = {"cooling": cooling, "supply__voltage": voltage, "time__duration": "50 s"}
+    sim_raw = _control(**changes)
     coils = [1.1, 1.7]
     cfg = parse_config(_sweep_of(sim_raw, {"coil_index": {"values": coils}}))
     assert cfg.cooling.name == cooling and cfg.tracking is not None
@@ -124,8 +126,7 @@ def test_each_coil_index_tracks_under_a_cooling_set_as_simulate_does(cooling, vo
     assert lam[0] != lam[1] and min(lam) > 10 * cfg.nylon.heat_loss_per_length
     ds = nf.run_sweep(cfg)
     for i, c in enumerate(coils):
-        sim = run_simulation(parse_sim_config(_control(cooling=cooling, supply__voltage=voltage,
-                                                       design__coil_index=c)))
+        sim = run_simulation(parse_sim_config(_control(**changes, design__coil_index=c)))
         assert sim.attrs["temperature_max"] > 350.0  # the loop heats: a real comparison
         for name, metric in PAIRS.items():
             got = float(ds[name].values.reshape(-1)[i])
