@@ -219,6 +219,17 @@ def test_info_config_gives_back_the_tracking_block():
     assert back.tracking == cfg.tracking and back.sha256 == cfg.sha256
 
 
+def test_info_config_gives_back_the_cooling_set():
+    # a cube swept with tracking: and cooling: rebuilds with the same cooling set (its
+    # speed too), so the rebuilt config hashes as the cube's
+    from nylonflex.engine.provenance import provenance, runnable_config
+
+    cfg = parse_config(_sweep_of(_control(cooling={"set": "forced_air", "speed": 5})))
+    back = parse_config(yaml.safe_load(runnable_config(provenance(cfg))))
+    assert back.cooling == cfg.cooling and back.cooling.speed == 5.0
+    assert back.tracking == cfg.tracking and back.sha256 == cfg.sha256
+
+
 @pytest.mark.parametrize("edit, match", [
     (lambda r: r.pop("supply"), r"^tracking: needs a supply"),
     (lambda r: r.update(model=["paper", "paper_eq10"]), r"^tracking: the closed loop is the "
