@@ -122,7 +122,7 @@ def test_sweep_and_simulate_word_a_range_alike():
                                                  "times": [0]}}]},
      "actuators[0].reference.times: unknown key; accepted: at, final, initial, kind"),
     ({"actuators": [{"name": "a", "supply": {}}]},
-     "actuators[0].supply: unknown key; accepted: controller, design, estimator, "
+     "actuators[0].supply: unknown key; accepted: controller, cooling, design, estimator, "
      "initial_temperature, metrics, name, nylon, reference, sensor, silicone"),
     ({"actuators": []}, "actuators: must be a list of 1 to 64 actuators, got 0"),
     ({"actuators": [{"name": "a"}, {"name": "a"}]},
@@ -192,6 +192,39 @@ def test_actuator_inherits_the_top_level_reference_and_materials():
     assert a.reference.params == pytest.approx({"initial": 0.0, "final": 120 * DEG, "at": 1.0})
     assert a.silicone != b.silicone
     assert (a.seed, b.seed) == (0, 8)
+
+
+def test_cooling_at_the_top_and_per_actuator_sets_each_muscles_heat_loss():
+    # docs/model.md s. 9: a cooling set's lambda'(C) at the actuator's own coil index takes
+    # the place of the set's heat_loss_per_length; the actuator's own cooling: wins, and
+    # the resolved config records each set
+    from nylonflex.materials import nylon_parameters
+    from nylonflex.physics.thermal import coil_heat_loss_per_length
+
+    own = nylon_parameters("silver_nylon66")
+    raw = _base(cooling="still_water",
+                actuators=[{"name": "a", "design": {"coil_index": 1.2}},
+                           {"name": "b", "cooling": {"set": "forced_air", "speed": 5}},
+                           {"name": "c", "cooling": None}])
+    cfg = parse_sim_config(raw)
+    a, b, c = cfg.actuators
+    assert (a.cooling.name, b.cooling.name, c.cooling) == ("still_water", "forced_air", None)
+    assert a.nylon.heat_loss_per_length == coil_heat_loss_per_length(1.2, own, "still_water")
+    assert b.nylon.heat_loss_per_length == coil_heat_loss_per_length(
+        1.7, own, {"set": "forced_air", "speed": 5})
+    assert c.nylon == own  # no cooling: the set as it is
+    assert "still_water" in a.nylon.sources["heat_loss_per_length"]
+    # only lambda' changes
+    assert a.nylon.heat_capacity_per_length == own.heat_capacity_per_length
+    assert a.nylon.name == own.name
+    doc = yaml.safe_load(cfg.text)["actuators"]
+    assert doc[0]["cooling"] == {"name": "still_water", "fluid": "water", "speed": 0.0}
+    assert doc[1]["cooling"] == {"name": "forced_air", "fluid": "air", "speed": 5.0}
+    assert "cooling" not in doc[2]
+    assert doc[0]["nylon"]["heat_loss_per_length"] == a.nylon.heat_loss_per_length
+    plain = parse_sim_config(_base())
+    assert plain.actuators[0].cooling is None and plain.actuators[0].nylon == own
+    assert "cooling" not in yaml.safe_load(plain.text)["actuators"][0]
 
 
 def test_sine_rms_from_defaults_to_the_first_period():

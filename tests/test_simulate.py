@@ -387,6 +387,9 @@ def test_cli_gripper_draws_pressures(tmp_path, capsys):
     ({"initial_temperature": "10 degC"}, "initial_temperature"),
     ({"actuators": [{"name": "x", "desing": {}}]}, "actuators[0].desing"),
     ({"speed": 3}, "speed"),
+    ({"cooling": "breeze"}, "cooling"),
+    ({"actuators": [{"name": "x", "cooling": {"set": "forced_air", "speed": -1}}]},
+     "actuators[0].cooling.speed"),
 ])
 def test_bad_config_is_refused_naming_the_field(tmp_path, capsys, patch, field):
     raw = copy.deepcopy(_base())
@@ -399,3 +402,48 @@ def test_bad_config_is_refused_naming_the_field(tmp_path, capsys, patch, field):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and field in err
 
+
+
+def test_water_cools_the_muscle_faster_than_the_sets_own_heat_loss():
+    # the same 12 V loop and reference: in still water lambda' is hundreds of times the
+    # set's own (docs/model.md s. 9), so the muscle stays near ambient, the controller
+    # holds the supply on and spends more energy, and the angle falls behind
+    raw = _yaml("control.yaml")
+    dry = run_simulation(parse_sim_config(copy.deepcopy(raw))).attrs
+    wet = run_simulation(parse_sim_config({**copy.deepcopy(raw),
+                                           "cooling": "still_water"})).attrs
+    assert wet["temperature_max"] < dry["temperature_max"] - 50.0
+    assert wet["energy"] > dry["energy"]
+    assert wet["rms_error"] > dry["rms_error"]
+
+
+def test_cooling_beside_a_fitted_heat_loss_is_refused(tmp_path, capsys):
+    # a fit thermal file's lambda' is the measured muscle's in its own environment: a
+    # cooling set beside it is refused, as in a sweep config (one line naming cooling)
+    from nylonflex.calibration import fit_thermal
+    from nylonflex.config.material_files import write_material_file
+    from nylonflex.materials import nylon_parameters
+
+    ny = nylon_parameters()
+    lm, v, r_meas, lam, cap = 0.3, 5.0, 40.0, 0.05, 0.45
+    t = np.linspace(0.0, 60.0, 40)
+    t_ss = ny.t_amb + v ** 2 / (r_meas * lam * lm)
+    temp = t_ss + (ny.t_amb - t_ss) * np.exp(-t * lam / cap)
+    csv = tmp_path / "t.csv"
+    csv.write_text("time [s],temperature [K]\n" + "\n".join(f"{float(a)!r},{float(b)!r}"
+                                                            for a, b in zip(t, temp)))
+    fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
+    write_material_file(fit, tmp_path / "n.yaml")
+    raw = _base(nylon={"file": str(tmp_path / "n.yaml")})
+    parse_sim_config(raw)  # the fitted set alone runs
+    for over, field in (({"cooling": "still_air"}, "cooling"),
+                        ({"actuators": [{"cooling": "still_water"}]}, "actuators[0].cooling")):
+        bad = {**raw, **over}
+        with pytest.raises(InputError, match=r"^" + re.escape(field) + ": the nylon set's "
+                           "heat_loss_per_length is fitted"):
+            parse_sim_config(bad)
+        path = tmp_path / "bad.yaml"
+        path.write_text(yaml.safe_dump(bad))
+        assert main(["simulate", str(path), "--out", str(tmp_path / "x.h5")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"{field}: " in err

@@ -17,6 +17,7 @@ from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.engine.grid import cube_variables, plan_slabs
 from nylonflex.config.safe_yaml import read_yaml
+from nylonflex.physics.thermal import coil_heat_loss_per_length
 from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.units import InputError
 
@@ -41,13 +42,16 @@ def _sweep_of(sim: dict, designs=None) -> dict:
                 "rms_from": sim["metrics"]["rms_from"]}
     if "initial_temperature" in sim:
         tracking["initial_temperature"] = sim["initial_temperature"]
-    return {"name": "tracking_test", "silicone": sim["silicone"], "nylon": sim["nylon"],
-            "grid": grid, "base_thickness": "wall",
-            "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
-                       "pressure": {"start": 0, "stop": 25, "num": 3, "units": "kPa"}},
-            "supply": {"voltage": float(str(sim["supply"]["voltage"]).split()[0]),
-                       "units": "V"},
-            "tracking": tracking}
+    out = {"name": "tracking_test", "silicone": sim["silicone"], "nylon": sim["nylon"],
+           "grid": grid, "base_thickness": "wall",
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                      "pressure": {"start": 0, "stop": 25, "num": 3, "units": "kPa"}},
+           "supply": {"voltage": float(str(sim["supply"]["voltage"]).split()[0]),
+                      "units": "V"},
+           "tracking": tracking}
+    if "cooling" in sim:
+        out["cooling"] = sim["cooling"]
+    return out
 
 
 def _control(**changes) -> dict:
@@ -104,6 +108,29 @@ def test_each_coil_index_is_its_own_simulation():
         for var, key in (("tracking_rms_error", "rms_error"), ("tracking_energy", "energy")):
             got = float(ds[var].values.reshape(-1)[i])
             assert got == pytest.approx(sim.attrs[key], rel=1e-9)
+
+
+@pytest.mark.parametrize("cooling, voltage", [("still_water", "200 V"), ("forced_air", "40 V")])
+def test_each_coil_index_tracks_under_a_cooling_set_as_simulate_does(cooling, voltage):
+    # a cooling set gives lambda'(C), different at every coil index (docs/model.md s. 9):
+    # the sweep's loop of each C cools with that C's, as simulate of that design with the
+    # same cooling: does. The supplies bring the cooled muscles near the paper's operating
+    # temperatures (12 V barely warms them in water, docs/model.md s. 19); 50 s, two
+    # periods, keep it short with the JIT off (.ci/run)
+    changes = {"cooling": cooling, "supply__voltage": voltage, "time__duration": "50 s"}
+    sim_raw = _control(**changes)
+    coils = [1.1, 1.7]
+    cfg = parse_config(_sweep_of(sim_raw, {"coil_index": {"values": coils}}))
+    assert cfg.cooling.name == cooling and cfg.tracking is not None
+    lam = coil_heat_loss_per_length(np.array(coils), cfg.nylon, cooling)
+    assert lam[0] != lam[1] and min(lam) > 10 * cfg.nylon.heat_loss_per_length
+    ds = nf.run_sweep(cfg)
+    for i, c in enumerate(coils):
+        sim = run_simulation(parse_sim_config(_control(**changes, design__coil_index=c)))
+        assert sim.attrs["temperature_max"] > 350.0  # the loop heats: a real comparison
+        for name, metric in PAIRS.items():
+            got = float(ds[name].values.reshape(-1)[i])
+            assert got == pytest.approx(sim.attrs[metric], rel=1e-9, abs=1e-12), (name, c)
 
 
 def test_reference_relative_to_the_designs_range():
@@ -189,6 +216,17 @@ def test_info_config_gives_back_the_tracking_block():
     raw["tracking"]["bandwidth"] = {"error": "2 deg"}
     cfg = parse_config(raw)
     back = parse_config(yaml.safe_load(runnable_config(provenance(cfg))))
+    assert back.tracking == cfg.tracking and back.sha256 == cfg.sha256
+
+
+def test_info_config_gives_back_the_cooling_set():
+    # a cube swept with tracking: and cooling: rebuilds with the same cooling set (its
+    # speed too), so the rebuilt config hashes as the cube's
+    from nylonflex.engine.provenance import provenance, runnable_config
+
+    cfg = parse_config(_sweep_of(_control(cooling={"set": "forced_air", "speed": 5})))
+    back = parse_config(yaml.safe_load(runnable_config(provenance(cfg))))
+    assert back.cooling == cfg.cooling and back.cooling.speed == 5.0
     assert back.tracking == cfg.tracking and back.sha256 == cfg.sha256
 
 

@@ -12,9 +12,11 @@ from typing import Annotated, Literal, Union, get_args, get_origin
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Tag, ValidationError
 
+from ..materials import Cooling, Nylon, cooling_parameters
 from ..units import InputError, from_si, parse_quantity, short
 
-__all__ = ["Count", "Number", "check_range", "check_run_name", "range_error", "valid_name"]
+__all__ = ["Count", "Number", "check_range", "check_run_name", "range_error", "resolve_cooling",
+           "valid_name"]
 
 
 def _no_bool(value):
@@ -45,6 +47,28 @@ def check_run_name(name):
     if not valid_name(name):
         raise ValueError("letters, digits, '-', '_' and '.' only")
     return name
+
+
+def resolve_cooling(cooling, nylon: Nylon, field: str = "cooling") -> Cooling | None:
+    """The cooling set of a config's ``cooling`` (docs/model.md s. 9), or None.
+
+    Refused (one line naming ``field``) beside a nylon set whose heat loss is fitted: a
+    ``fit thermal`` file's value is the measured muscle's own in its own environment, so a
+    cooling set would silently replace a measurement. Sweep and simulate configs both ask
+    here.
+    """
+    if cooling is None:
+        return None
+    try:
+        env = cooling_parameters(cooling)
+    except ValueError as err:
+        msg = str(err)
+        raise InputError(field + msg[len("cooling"):] if msg.startswith("cooling") else
+                         f"{field}: {msg}") from None
+    if "nylonflex fit" in str(nylon.sources.get("heat_loss_per_length", "")):
+        raise InputError(f"{field}: the nylon set's heat_loss_per_length is fitted (a fit "
+                         "thermal file); leave out cooling: or the fitted value")
+    return env
 
 
 def range_error(field: str, lo, hi, display_unit: str, got, lo_open: bool = False,

@@ -34,12 +34,13 @@ from pydantic import (
     field_validator,
 )
 
-from ..materials import Nylon, Silicone, nylon_parameters, silicone_parameters
+from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..physics.nylon import stroke
-from ..physics.thermal import muscle_resistance, steady_temperature
+from ..physics.thermal import cooled_nylon, muscle_resistance, steady_temperature
 from ..physics.wrap import muscle_length
 from ..units import InputError, from_si
-from .base import _no_bool, _pydantic_message, _Strict, check_range, check_run_name, range_error
+from .base import _no_bool, _pydantic_message, _Strict, check_range, check_run_name, \
+    range_error, resolve_cooling
 from .material_files import anchor_material_files
 from .safe_yaml import read_yaml
 from .sweep import DESIGN_RANGES
@@ -182,6 +183,7 @@ class _Loop(_Strict):
 
     silicone: Material = None
     nylon: Material = None
+    cooling: Material | None = None  # a cooling set (docs/model.md s. 9); None: the set's own
     design: Design | None = None
     initial_temperature: Quantity | None = None
     sensor: Sensor | None = None
@@ -250,7 +252,12 @@ class Reference:
 
 @dataclass(frozen=True)
 class ActuatorSpec:
-    """One actuator of a simulation, SI: design, materials, loop settings and reference."""
+    """One actuator of a simulation, SI: design, materials, loop settings and reference.
+
+    With a ``cooling`` set, ``nylon`` is the muscle set with that environment's lambda'(C)
+    at this actuator's coil index as its ``heat_loss_per_length``
+    (:func:`~nylonflex.physics.thermal.cooled_nylon`): the whole loop uses it.
+    """
 
     name: str
     radius: float
@@ -272,6 +279,7 @@ class ActuatorSpec:
     controller: str = "bang_bang"  # or "pi" (docs/model.md s. 19)
     proportional_band: float = math.inf  # PI [rad]
     integral_time: float = math.inf  # PI [s]
+    cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
 
 
 @dataclass(frozen=True)
@@ -310,6 +318,7 @@ def _resolved_doc(cfg: SimConfig) -> dict:
                                                   "base_thickness")},
             "silicone": a.silicone.to_dict(),
             "nylon": a.nylon.to_dict(),
+            **({} if a.cooling is None else {"cooling": a.cooling.to_dict()}),
             "initial_temperature": a.initial_temperature,
             "sensor": {"noise": a.noise, "seed": a.seed},
             "estimator": {"table_points": a.table_points,
@@ -430,6 +439,7 @@ def _actuator(top: SimConfigModel, own: _Loop, path: str, duration: float, index
         ny = nylon_parameters(_own_or_top(own, top, "nylon", DEFAULTS["nylon"]))
     except ValueError as exc:  # the material sets name their own field
         raise InputError(f"{pre}{exc}") from None
+    cooling = resolve_cooling(_own_or_top(own, top, "cooling"), ny, f"{pre}cooling")
     d = _section("design", top, own)
     vals = {}
     for key in ("radius", "wall_thickness", "length", "wrap_angle"):
@@ -444,6 +454,11 @@ def _actuator(top: SimConfigModel, own: _Loop, path: str, duration: float, index
         kind, unit, lo, hi, shown = DESIGN_RANGES["base_thickness"]
         vals["base_thickness"] = check_range(d["base_thickness"], f"{pre}design.base_thickness",
                                              kind, unit, lo, hi, shown)
+    if cooling is not None:  # lambda'(C) of this muscle in place of the set's own
+        try:
+            ny = cooled_nylon(ny, cooling, vals["coil_index"])
+        except ValueError as exc:  # the fluid's property table does not reach the muscle
+            raise InputError(f"{pre}cooling: {exc}") from None
     t0_raw = _own_or_top(own, top, "initial_temperature")
     t0 = ny.t_amb if t0_raw is None else check_range(
         t0_raw, f"{pre}initial_temperature", "temperature", "degC", ny.t_amb, ny.t_max)
@@ -470,7 +485,8 @@ def _actuator(top: SimConfigModel, own: _Loop, path: str, duration: float, index
         raise InputError(f"{pre}controller: proportional_band and integral_time are for "
                          "kind: pi")
     return ActuatorSpec(
-        name=name, **pi, silicone=sil, nylon=ny, initial_temperature=t0, reference=ref,
+        name=name, **pi, silicone=sil, nylon=ny, cooling=cooling, initial_temperature=t0,
+        reference=ref,
         noise=check_range(sensor["noise"], f"{pre}sensor.noise", "pressure", "kPa", 0.0,
                           100e3),
         seed=_integer(sensor["seed"], f"{pre}sensor.seed", 0, 2**32 - 1) + index,

@@ -24,8 +24,7 @@ import numpy as np
 import yaml
 from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
 
-from ..materials import Cooling, Nylon, Silicone, cooling_parameters, nylon_parameters, \
-    silicone_parameters
+from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
@@ -40,6 +39,7 @@ from .base import (
     check_range,
     check_run_name,
     range_error,
+    resolve_cooling,
 )
 from .tracking import Tracking, TrackingSpec, resolve_tracking
 from .uncertainty import Uncertainty, UncertaintySpec, resolve_uncertainty
@@ -319,9 +319,6 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
     models, voltage = _models(cfg.model), _supply(cfg.supply)
     tracking = None if cfg.tracking is None else \
         resolve_tracking(cfg.tracking, voltage, models, nylon.t_amb, nylon.t_max)
-    if tracking is not None and cfg.cooling is not None:
-        raise InputError("cooling: not with tracking: yet (the closed loop, like nylonflex "
-                         "simulate, uses the muscle set's own heat loss); leave one out")
     coolings = _coolings(cfg.cooling, nylon)
     if len(coolings) > 1 and (uncertainty is not None or requirements or
                               tracking is not None):
@@ -341,16 +338,13 @@ def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
     """The cooling sets of a config's ``cooling``: () without one, one set, or a list of
     sets (a sweep axis), each named by a label of its own."""
     if not isinstance(cooling, list):
-        env = _cooling(cooling, nylon)
+        env = resolve_cooling(cooling, nylon)
         return () if env is None else (env,)
     if not cooling:
         raise InputError("cooling: needs at least one cooling set, got []")
     out = []
     for i, item in enumerate(cooling):
-        try:
-            env = _cooling(item, nylon)
-        except InputError as err:  # name the list entry
-            raise InputError(str(err).replace("cooling", f"cooling[{i}]", 1)) from None
+        env = resolve_cooling(item, nylon, f"cooling[{i}]")
         if env is None:
             raise InputError(f"cooling[{i}]: must be a cooling set, got null")
         labels = [c.label for c in out]
@@ -359,21 +353,6 @@ def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
                              f"({env.label}); give each set once")
         out.append(env)
     return tuple(out)
-
-
-def _cooling(cooling, nylon: Nylon) -> Cooling | None:
-    """The cooling set of a config's ``cooling`` (docs/model.md s. 9), or None; refused
-    beside a nylon set whose heat loss is fitted (a ``fit thermal`` file's value wins)."""
-    if cooling is None:
-        return None
-    try:
-        env = cooling_parameters(cooling)
-    except ValueError as err:
-        raise InputError(str(err)) from None
-    if "nylonflex fit" in str(nylon.sources.get("heat_loss_per_length", "")):
-        raise InputError("cooling: the nylon set's heat_loss_per_length is fitted (a fit "
-                         "thermal file); leave out cooling: or the fitted value")
-    return env
 
 
 def _models(model) -> tuple[str, ...]:

@@ -246,8 +246,8 @@ def runnable_config(attrs) -> str:
     each grid axis as ``start/stop/num`` or ``values`` in its display unit (mm, deg, kPa)
     where those decimals resolve to exactly the cube's coordinates, else as SI values;
     materials by set name (with the fields that differ), or by their fitted file where it
-    is still there and unchanged, else every field; the model, supply, uncertainty and
-    requirements as the cube has them, and its codec. Sweeping it gives a cube whose
+    is still there and unchanged, else every field; the model, supply, cooling, uncertainty,
+    requirements and tracking as the cube has them, and its codec. Sweeping it gives a cube whose
     data equal this one's bit for bit (the slab size aside, which does not change them).
 
     Parameters

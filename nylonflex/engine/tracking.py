@@ -2,8 +2,9 @@
 (docs/model.md s. 19), through :mod:`nylonflex.kernels.tracking`.
 
 Each design's loop is ``nylonflex simulate``'s for that design alone (one actuator, the
-sweep's supply, no internal resistance): the same top pressure and estimator table, the
-same sensor noise sequence (the seed's), controller and thermal step. Only the plant's
+sweep's supply and ``cooling:``, no internal resistance): the same top pressure and
+estimator table, the same sensor noise sequence (the seed's), controller and thermal step,
+with r'(C) and lambda'(C) of the design's coil index (docs/model.md s. 9). Only the plant's
 angle table differs in its grid: one curvature table per (radius, wall) of the slab, on
 :data:`PLANT_POINTS` points up to the highest pressure of its designs, instead of 513
 points up to each design's own (both within 1e-9 of the curvature solve).
@@ -19,7 +20,8 @@ from ..config import ResolvedConfig
 from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import stroke, stroke_scale
-from ..physics.thermal import coil_resistance_per_length, steady_temperature
+from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length, \
+    steady_temperature
 from ..physics.wrap import muscle_length
 from ..variables import TRACKING
 
@@ -64,13 +66,15 @@ def _longest_run(spec) -> int:
 
 def top_pressure(cfg: ResolvedConfig, lm, coil_index) -> np.ndarray:
     """The highest gauge pressure each design reaches [Pa], the top of its estimator table:
-    ``nylonflex simulate``'s, at T = max(T(0), T_ss(supply)); NaN where that stroke is at
+    ``nylonflex simulate``'s, at T = max(T(0), T_ss(supply)) with lambda'(C) of the
+    config's cooling set (the nylon set's own without one); NaN where that stroke is at
     least 0.5 (simulate refuses those). ``lm`` [m] and ``coil_index`` broadcast."""
     ny, spec = cfg.nylon, cfg.tracking
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
     r = coil_resistance_per_length(coil_index, ny) * lm
     v = cfg.supply_voltage * r / (r + 0.0)  # simulate's terminal voltage, no source resistance
-    top = np.maximum(t0, steady_temperature(v, lm, ny, coil_index=coil_index))
+    top = np.maximum(t0, steady_temperature(v, lm, ny, coil_index=coil_index,
+                                            cooling=cfg.cooling))
     s_top = np.asarray(stroke(top, coil_index, ny), float)
     p = np.asarray(chamber_pressure(np.minimum(s_top, _STROKE_CAP)), float) * (1.0 + 1e-9)
     return np.where(s_top < _STROKE_CAP, np.maximum(p, 1.0), np.nan)
@@ -124,7 +128,9 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
     muscle = (np.ascontiguousarray(np.atleast_1d(coil_resistance_per_length(C, ny)), float),
               ny.heat_capacity_per_length,
-              ny.heat_loss_per_length, ny.t_amb, t0, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+              np.ascontiguousarray(np.atleast_1d(coil_heat_loss_per_length(C, ny, cfg.cooling)),
+                                   float),
+              ny.t_amb, t0, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
     keep = math.exp(-spec.step / spec.filter_time_constant) \
         if spec.filter_time_constant > 0 else 0.0
     settings = (spec.step, spec.n_steps, float(cfg.supply_voltage), P_ATM,

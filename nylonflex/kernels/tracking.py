@@ -199,7 +199,9 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         :func:`kappa_tables` on the spacing p_group / (points - 1).
     muscle : tuple
         r'(C) [ohm/m] (an array over the coil indices, docs/model.md s. 9), c' [J/(K m)],
-        lambda' [W/(K m)], T_amb, T(0) [K], gamma [1/K], beta [-], T_g, sigma_g [K].
+        lambda'(C) [W/(K m)] (an array over the coil indices: the cooling set's, or the
+        nylon set's own at every C), T_amb, T(0) [K], gamma [1/K], beta [-], T_g,
+        sigma_g [K].
     silicone, nodes : tuple
         Ogden (mu [Pa], alpha [-]); the quadrature nodes and weights.
     rtol : float
@@ -238,8 +240,9 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         g = ref_scale[i, j, li, ci, wi]
         # one call, no branch in the prange body (writes after a branch were lost)
         res = _one_design(dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len[ci], c_per_len,
-                          loss_per_len, t_amb, t_start, scale[ci], gamma, beta, t_g, sigma_g,
-                          radius[i], wall[j], b, length[li], p_top[i, j, li, ci, wi], points,
+                          loss_per_len[ci], t_amb, t_start, scale[ci], gamma, beta, t_g,
+                          sigma_g, radius[i], wall[j], b, length[li], p_top[i, j, li, ci, wi],
+                          points,
                           mu, alpha, x_base, w_base, phi_trig, w_phi, rtol,
                           p_group[i, j] / (plant_points - 1), kappa[i, j], kappa_slope[i, j],
                           kind, half_band, gain, integral_step, filter_keep, noise, ref_kind,

@@ -6,11 +6,12 @@ length l_m, so the time constant tau = c'/lambda' does not depend on the length.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
-from ..materials import cooling_parameters, nylon_parameters
+from ..materials import Nylon, cooling_parameters, nylon_parameters
 from ._formula import check, formula, scalar_or_array
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "coil_resistance",
     "coil_resistance_per_length",
     "convection_loss_per_length",
+    "cooled_nylon",
     "MIN_SUPPLY_RISE",
     "check_supply_rise",
     "coiled_resistance_per_length",
@@ -192,6 +194,43 @@ def coil_heat_loss_per_length(coil_index, nylon="silver_nylon66", cooling=None):
         ny.fibre_diameter * (ci + 1.0), ny.t_max, ny.t_amb, env.fluid, env.speed),
         otypes=[float])(c)
     return scalar_or_array(out)
+
+
+def cooled_nylon(nylon, cooling, coil_index) -> Nylon:
+    """The muscle set with the cooling set's lambda'(C) as its ``heat_loss_per_length``.
+
+    One muscle of coil index C in a cooling environment loses
+    :func:`coil_heat_loss_per_length` (C, nylon, cooling) [W/(K m)]; the returned set holds
+    that value, so everything that takes the set's lambda' (the thermal step of eq. 3, the
+    steady temperature, the time constant) uses it (docs/model.md s. 9). Its ``sources``
+    entry for ``heat_loss_per_length`` names the cooling set; every other field is the
+    set's own.
+
+    Parameters
+    ----------
+    nylon : str, dict or Nylon
+        Muscle set.
+    cooling : str, dict, Cooling or None
+        Cooling environment (``materials.COOLING_PARAMETERS``); None: the set as it is.
+    coil_index : float
+        The muscle's coil index C [-], > 0.
+
+    Returns
+    -------
+    Nylon
+    """
+    ny = nylon_parameters(nylon)
+    if cooling is None:
+        return ny
+    env = cooling_parameters(cooling)
+    c = float(check("coil_index", coil_index, 0.0, lo_open=True))
+    loss = float(coil_heat_loss_per_length(c, ny, env))
+    how = "free convection" if env.speed == 0.0 else f"cross flow at {env.speed:g} m/s"
+    return dataclasses.replace(ny, heat_loss_per_length=loss, sources={
+        **ny.sources,
+        "heat_loss_per_length": f"D: cooling set {env.name} ({env.fluid}, {how}): "
+                                f"lambda'(C = {c:g}) of coil_heat_loss_per_length, in place "
+                                "of the set's own (docs/model.md s. 9)"})
 
 
 @formula
@@ -398,7 +437,8 @@ def temperature_rate(temperature, voltage, muscle_length, nylon="silver_nylon66"
     return scalar_or_array((heat - loss) / (ny.heat_capacity_per_length * lm))
 
 
-def steady_temperature(voltage, muscle_length, nylon="silver_nylon66", coil_index=None):
+def steady_temperature(voltage, muscle_length, nylon="silver_nylon66", coil_index=None,
+                       cooling=None):
     """Steady state of eq. (3), T_ss = T_amb + V^2 / (R Lambda) [K].
 
     Parameters
@@ -411,12 +451,20 @@ def steady_temperature(voltage, muscle_length, nylon="silver_nylon66", coil_inde
         Muscle set.
     coil_index : float or array, optional
         C [-] for r'(C); None: the set's own r'.
+    cooling : str, dict, Cooling or None
+        Cooling environment: lambda'(C) of :func:`coil_heat_loss_per_length` (needs
+        ``coil_index``); None: the set's own lambda'.
     """
     ny = nylon_parameters(nylon)
     v = check("voltage", voltage, unit="V")
     lm = _lengths(muscle_length)
-    return scalar_or_array(ny.t_amb + v * v / (_r_per_len(ny, coil_index)
-                                               * ny.heat_loss_per_length * lm * lm))
+    if cooling is None:
+        loss = ny.heat_loss_per_length
+    elif coil_index is None:
+        raise ValueError("coil_index: needed with a cooling set (lambda' depends on C)")
+    else:
+        loss = np.asarray(coil_heat_loss_per_length(coil_index, ny, cooling), float)
+    return scalar_or_array(ny.t_amb + v * v / (_r_per_len(ny, coil_index) * loss * lm * lm))
 
 
 def temperature_step(temperature, voltage, dt, muscle_length, nylon="silver_nylon66",
