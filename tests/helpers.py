@@ -30,3 +30,24 @@ def stable(ds):
     ds = ds.copy()
     ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS}
     return ds
+
+
+def fitted_thermal_file(folder, lam=0.05, cap=0.45, lm=0.3, v=5.0, r_meas=40.0):
+    """A ``fit thermal`` material file fitted to a synthetic step response (lambda' [W/(K m)],
+    c' [J/(K m)] of a muscle of length ``lm`` [m] at ``v`` [V] and ``r_meas`` [ohm]);
+    return its path."""
+    import numpy as np
+
+    from nylonflex.calibration import fit_thermal
+    from nylonflex.config.material_files import write_material_file
+    from nylonflex.materials import nylon_parameters
+
+    t_amb = nylon_parameters().t_amb
+    t = np.linspace(0.0, 60.0, 40)
+    t_ss = t_amb + v ** 2 / (r_meas * lam * lm)
+    temp = t_ss + (t_amb - t_ss) * np.exp(-t * lam / cap)
+    csv = Path(folder) / "t.csv"
+    csv.write_text("time [s],temperature [K]\n" + "\n".join(f"{float(a)!r},{float(b)!r}"
+                                                            for a, b in zip(t, temp)))
+    fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
+    return write_material_file(fit, Path(folder) / "n.yaml")

@@ -239,19 +239,12 @@ def test_dynamic_charts_draw_into_a_given_axes_or_their_own_figure():
 def test_a_fit_thermal_file_replaces_both_constants_and_refuses_a_cooling_set(tmp_path):
     # docs/model.md s. 9: a fitted lambda' and a measured r' replace the set's, r' then the
     # same at every coil index (resistance_coil_index 0); cooling: beside it is refused
-    from nylonflex.calibration import fit_thermal
+    from helpers import fitted_thermal_file
     from nylonflex.config import parse_config
-    from nylonflex.config.material_files import write_material_file
 
-    lm, v, r_meas, lam, cap = 0.3, 5.0, 40.0, 0.05, 0.45
-    t = np.linspace(0.0, 60.0, 40)
-    t_ss = NY.t_amb + v ** 2 / (r_meas * lam * lm)
-    temp = t_ss + (NY.t_amb - t_ss) * np.exp(-t * lam / cap)
-    csv = tmp_path / "t.csv"
-    csv.write_text("time [s],temperature [K]\n" + "\n".join(f"{float(a)!r},{float(b)!r}"
-                                                            for a, b in zip(t, temp)))
-    fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
-    ny = nylon_parameters({"file": str(write_material_file(fit, tmp_path / "n.yaml"))})
+    lam, lm, r_meas = 0.05, 0.3, 40.0
+    ny = nylon_parameters({"file": str(fitted_thermal_file(tmp_path, lam=lam, lm=lm,
+                                                            r_meas=r_meas))})
     assert ny.heat_loss_per_length == pytest.approx(lam, rel=1e-6)
     assert ny.resistance_coil_index == 0.0
     for c in (1.1, 1.7):

@@ -420,20 +420,9 @@ def test_water_cools_the_muscle_faster_than_the_sets_own_heat_loss():
 def test_cooling_beside_a_fitted_heat_loss_is_refused(tmp_path, capsys):
     # a fit thermal file's lambda' is the measured muscle's in its own environment: a
     # cooling set beside it is refused, as in a sweep config (one line naming cooling)
-    from nylonflex.calibration import fit_thermal
-    from nylonflex.config.material_files import write_material_file
-    from nylonflex.materials import nylon_parameters
+    from helpers import fitted_thermal_file
 
-    ny = nylon_parameters()
-    lm, v, r_meas, lam, cap = 0.3, 5.0, 40.0, 0.05, 0.45
-    t = np.linspace(0.0, 60.0, 40)
-    t_ss = ny.t_amb + v ** 2 / (r_meas * lam * lm)
-    temp = t_ss + (ny.t_amb - t_ss) * np.exp(-t * lam / cap)
-    csv = tmp_path / "t.csv"
-    csv.write_text("time [s],temperature [K]\n" + "\n".join(f"{float(a)!r},{float(b)!r}"
-                                                            for a, b in zip(t, temp)))
-    fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
-    write_material_file(fit, tmp_path / "n.yaml")
+    fitted_thermal_file(tmp_path)
     raw = _base(nylon={"file": str(tmp_path / "n.yaml")})
     parse_sim_config(raw)  # the fitted set alone runs
     for over, field in (({"cooling": "still_air"}, "cooling"),
