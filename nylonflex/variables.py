@@ -3,9 +3,10 @@
 Everything that needs to know about a quantity reads it here (after sgkit's
 ``variables.py``): the physics' input checks and the pointwise evaluator (accepted ranges),
 config validation (ranges and the unit a bare number means), the engine (the order of the
-design variables, written once: :data:`DESIGN`), cube attributes, chart labels and query
-units. ``display`` is the unit a designer reads on charts and types in configs and on the
-command line; the code and the cube stay SI.
+design variables, written once: :data:`DESIGN`), cube attributes, the labels of every chart
+and of the explorer (:func:`label`, from a variable's attributes) and query units.
+``display`` is the unit a designer reads on charts and types in configs and on the command
+line; the code and the cube stay SI.
 
 This module is the bottom layer with :mod:`nylonflex.units` and :mod:`nylonflex.materials`:
 it imports nothing else of nylonflex at module level.
@@ -19,7 +20,7 @@ import numpy as np
 
 __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
            "THERMAL", "TRACKING", "UNCERTAIN",
-           "VARIABLES", "Variable", "display_label", "quantile_name", "range_text",
+           "VARIABLES", "Variable", "label", "name_label", "quantile_name", "range_text",
            "slab_done_attrs", "to_display"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
@@ -353,8 +354,64 @@ def to_display(name: str, si):
     return from_si(np.asarray(si, dtype=float), VARIABLES[name].display)
 
 
-def display_label(name: str) -> str:
-    """Axis label ``"long name [display unit]"`` of a registered name."""
-    v = VARIABLES[name]
-    unit = "" if v.display == "1" else f" [{v.display}]"
-    return f"{v.long_name}{unit}"
+class _Named:
+    """A stand-in for a DataArray of a name and no attrs (:func:`name_label`)."""
+
+    __slots__ = ("name", "attrs")
+
+    def __init__(self, name):
+        self.name, self.attrs = name, {}
+
+
+def label(da, unit_note: str = "") -> str:
+    """``"chamber radius [mm]"``: the label of a quantity, read from its attributes (after
+    xarray's ``label_from_attrs``); every chart and the explorer label with it.
+
+    The long name is ``da.attrs["long_name"]`` (so a name a user edited in the cube
+    shows), else the registry's, else ``da.name``. The unit is the registry's display unit
+    for a registered name (the cube stores SI; charts show mm, deg, kPa), else
+    ``da.attrs["units"]``; a dimensionless quantity (``"1"``) shows no brackets.
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        A cube variable or coordinate (anything with ``name`` and ``attrs``).
+    unit_note : str, optional
+        Text appended as it is, e.g. ``" [-]"`` for a fraction shown without a unit.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> radius = xr.DataArray([5e-3], dims="radius", name="radius",
+    ...                       attrs={"units": "m", "long_name": "chamber radius"})
+    >>> label(radius)
+    'chamber radius [mm]'
+    >>> label(radius.assign_attrs(long_name="inner radius"))
+    'inner radius [mm]'
+    >>> label(xr.DataArray(0.3, name="muscle_share", attrs={"units": "1"}))
+    'muscle_share'
+    >>> label(xr.DataArray(0.0, name="stroke"), " [-]")
+    'muscle stroke [-]'
+    """
+    name = getattr(da, "name", None)
+    attrs = getattr(da, "attrs", None) or {}
+    v = VARIABLES.get(name) if isinstance(name, str) else None
+    long_name = attrs.get("long_name") or (v.long_name if v is not None else
+                                          "" if name is None else name)
+    unit = v.display if v is not None else attrs.get("units", "1")
+    shown = "" if str(unit) in ("1", "") else f" [{unit}]"
+    return f"{long_name}{shown}{unit_note}"
+
+
+def name_label(name: str, unit_note: str = "") -> str:
+    """:func:`label` of a name with no DataArray in scope (a sensitivity output, a design
+    objective): the registry's long name and display unit; an unknown name is itself.
+
+    >>> name_label("tip_force_max")
+    'maximum tip force [N]'
+    """
+    return label(_Named(name), unit_note)

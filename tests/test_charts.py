@@ -95,6 +95,49 @@ def test_labels_carry_units_and_title_names_the_slice(ds, name):
         plt.close(fig)
 
 
+def test_label_reads_the_attrs_and_shows_display_units():
+    # issue 28: one label(da), after xarray's label_from_attrs
+    import xarray as xr
+
+    from nylonflex.variables import label, name_label
+
+    radius = xr.DataArray([5e-3], dims="radius", name="radius",
+                          attrs={"units": "m", "long_name": "chamber radius"})
+    assert label(radius) == "chamber radius [mm]"  # the display unit, not the SI attrs
+    assert label(radius.assign_attrs(long_name="inner radius")) == "inner radius [mm]"
+    assert label(xr.DataArray(0.5, name="bend_angle_max")) == "maximum bend angle [deg]"
+    assert label(xr.DataArray(0.3, name="usable_stroke",
+                              attrs={"units": "1", "long_name": "usable stroke"})) \
+        == "usable stroke"  # dimensionless: no brackets
+    grip = xr.DataArray(1.0, name="grip", attrs={"units": "N m", "long_name": "grip torque"})
+    assert label(grip) == "grip torque [N m]"  # not registered: its own units
+    assert label(xr.DataArray(1.0, name="grip")) == "grip" == name_label("grip")
+    assert label(xr.DataArray(0.0, name="stroke"), " [-]") == "muscle stroke [-]"
+    assert name_label("tip_force_max") == "maximum tip force [N]"
+    assert name_label("stroke", " [-]") == "muscle stroke [-]"
+
+
+def test_a_long_name_edited_in_the_cube_shows_on_its_charts(ds):
+    import matplotlib.pyplot as plt
+
+    edited = ds.copy()
+    edited["radius"].attrs["long_name"] = "inner radius"
+    edited["tip_force_max"].attrs["long_name"] = "blocked force"
+    edited["stroke"].attrs["long_name"] = "contraction"
+    assert ds["radius"].attrs["long_name"] == "chamber radius"  # the fixture's cube as it was
+    for name, want in (("design_map", ["inner radius [mm]", "blocked force [N]"]),
+                       ("compare", ["inner radius [mm]", "blocked force [N]"]),
+                       ("fig12b", ["inner radius [mm]"]), ("fig4", ["contraction [-]"])):
+        fig = charts.CHARTS[name](edited)
+        try:
+            texts = [t for ax in fig.axes for t in (ax.get_xlabel(), ax.get_ylabel())]
+            for text in want:
+                assert text in texts, (name, text, texts)
+            assert not any("chamber radius" in t for t in texts), (name, texts)
+        finally:
+            plt.close(fig)
+
+
 def test_every_chart_is_written_as_png(ds, tmp_path):
     paths = charts.draw_charts(ds, None, tmp_path, "png")
     assert [p.name for p in paths] == [f"{n}.png" for n in PLAIN_CHARTS]

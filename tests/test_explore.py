@@ -166,6 +166,26 @@ def test_one_document_for_the_served_page_and_the_file(ds):
     assert "Served page" in served and "Exported page" in saved
 
 
+def test_a_long_name_edited_in_the_cube_shows_on_the_page(ds):
+    # the page's labels are read from the variables' attrs (issue 28)
+    pytest.importorskip("bokeh")
+    from bokeh.models import Select
+
+    from nylonflex.explore.page import build_document
+
+    edited = ds.copy()
+    edited["radius"].attrs["long_name"] = "inner radius"
+    edited["tip_force_max"].attrs["long_name"] = "blocked force"
+    doc = build_document(edited)
+    fig = doc.select_one({"name": "nf-map-figure"})
+    assert fig.xaxis[0].axis_label == "inner radius [mm]"
+    assert ("radius", "inner radius [mm]") in doc.select_one({"name": "nf-map-x"}).options
+    variable = doc.select_one({"type": Select, "name": "nf-variable"})
+    assert any(text == "blocked force [N]" for _, text in variable.options)
+    assert doc.select_one({"name": "nf-slider-radius"}).title == "inner radius"
+    assert ds["radius"].attrs["long_name"] == "chamber radius"
+
+
 def test_html_is_offline_and_holds_the_cube(ds, tmp_path):
     pytest.importorskip("bokeh")
     from nylonflex.explore.page import build_html

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..variables import VARIABLES, display_label, to_display
+from ..variables import VARIABLES, to_display
 
 #: Image formats a chart can be written in.
 FORMATS = ("png", "pdf", "svg")
@@ -176,10 +176,6 @@ def _pick_few(ds, name, n):
     """Up to ``n`` grid values of ``name`` spread over its whole range."""
     values = ds[name].values
     return _spread(ds, name, float(values.min()), float(values.max()), n)
-
-
-def _label(name, unit_note=""):
-    return display_label(name) + unit_note
 
 
 def _footer(fig, ds):

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..units import InputError
-from ..variables import DESIGN, VARIABLES, display_label, to_display
+from ..variables import DESIGN, VARIABLES, label, to_display
 from ._common import _COLOURS, _eq, _figure, _flag_text, _footer, _nearest, _suptitle
 
 # the paper's first worked example's slice (docs/model.md s. 8), SI
@@ -82,8 +82,8 @@ def compare(ds, *, variable="tip_force_max", wall_thickness=None, length=None,
     if bits:
         ax.plot([], [], "x", color="0.3", ms=6, mew=1.5,
                 label=f"flagged: {_flag_text(ds, bits)}")
-    ax.set_xlabel(display_label("radius"))
-    ax.set_ylabel(display_label(variable))
+    ax.set_xlabel(label(ds["radius"]))
+    ax.set_ylabel(label(ds[variable]))
     ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
     ax.legend(fontsize="small", title="model")
     sub = ", ".join(_eq(n, v) for n, v in at.items())

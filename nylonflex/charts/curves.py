@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..variables import VARIABLES, to_display
-from ._common import (_COLOURS, _LENGTH_DEFAULT, _coils, _eq, _figure, _footer, _label,
+from ..variables import VARIABLES, label, to_display
+from ._common import (_COLOURS, _LENGTH_DEFAULT, _coils, _eq, _figure, _footer,
                       _nearest, _pick_few, _range_text, _spread, _stroke_max, _suptitle)
 
 
@@ -42,8 +42,8 @@ def fig4(ds, *, coil_index=None):
                                f"p = {p_k:.3g} {VARIABLES['pressure'].display}")
     ax.set_xlim(stroke[0], stroke[-1])
     ax.set_ylim(bottom=0)
-    ax.set_xlabel(_label("stroke", " [-]"))
-    ax.set_ylabel(_label("chamber_pressure"))
+    ax.set_xlabel(label(ds["stroke"], " [-]"))
+    ax.set_ylabel(label(ds["chamber_pressure"]))
     ax.legend(loc="upper left")
     _suptitle(fig, "Figure 4: chamber pressure against muscle stroke",
               "sealed air chamber, same for every design")
@@ -59,8 +59,8 @@ def _curve_panel(ax, ds, var, name, values, fixed):
                 label=_eq(name, v))
     ax.set_xlim(pressure[0], pressure[-1])
     ax.set_ylim(bottom=0)
-    ax.set_xlabel(_label("pressure"))
-    ax.set_ylabel(_label(var))
+    ax.set_xlabel(label(ds["pressure"]))
+    ax.set_ylabel(label(ds[var]))
     ax.set_title(", ".join(_eq(k, v) for k, v in fixed.items()))
     ax.legend(loc="upper left", title=VARIABLES[name].long_name)
 

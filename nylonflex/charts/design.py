@@ -14,7 +14,7 @@ import numpy as np
 
 from ..storage.files import save_figure
 from ._common import new_figure, rc_context
-from ..variables import AXES, display_label, to_display
+from ..variables import AXES, name_label, to_display
 
 __all__ = ["draw_front", "front_figure"]
 
@@ -77,9 +77,9 @@ def front_figure(res):
                 ax.plot(to_display(xname, d[xname]), to_display(yname, d[yname]), ls="none",
                         label=f"{'refined design' if d['source'] == 'refined' else 'best grid point'}",
                         **style)
-        ax.set_xlabel(display_label(xname) + f"  ({'min' if objs[-1].sense == 'min' else 'max'})"
-                      if len(objs) >= 2 else display_label(xname))
-        ax.set_ylabel(display_label(yname) + f"  ({objs[0].sense})")
+        ax.set_xlabel(name_label(xname) + f"  ({'min' if objs[-1].sense == 'min' else 'max'})"
+                      if len(objs) >= 2 else name_label(xname))
+        ax.set_ylabel(name_label(yname) + f"  ({objs[0].sense})")
         title = "Pareto front" if len(objs) >= 2 else "best design"
         ax.set_title(f"{title}: {res.spec.name}")
         if res.spec.constraints:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import InputError
-from ..variables import AXES, to_display
+from ..variables import AXES, label, to_display
 from ._common import (_COLOURS, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _footer,
-                      _label, _nearest, new_figure)
+                      _nearest, new_figure)
 
 __all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate", "tracking_map"]
 
@@ -141,9 +141,9 @@ def _map(ds, name, title, cmap, *, ax, x, y, **given):
     else:  # a line of designs, a flat field or gaps: cells, gaps left blank
         filled = ax.pcolormesh(xs, ys, np.ma.masked_invalid(values), cmap=cmap,
                                shading="nearest")
-    fig.colorbar(filled, ax=ax, label=_label(name))
-    ax.set_xlabel(_label(x))
-    ax.set_ylabel(_label(y))
+    fig.colorbar(filled, ax=ax, label=label(ds[name]))
+    ax.set_xlabel(label(ds[x]))
+    ax.set_ylabel(label(ds[y]))
     _title(ax, title, fixed)
     _footer(fig, ds)
     return fig
@@ -196,8 +196,8 @@ def cycle_rate_lines(ds, *, ax=None, wall_thickness=None, length=None, wrap_angl
                        label="strength-limited"),
                 Line2D([], [], ls="", marker="x", color="0.3", label="supply-limited")]
     ax.legend(handles=handles, fontsize=8)
-    ax.set_xlabel(_label("radius"))
-    ax.set_ylabel(_label("cycle_rate"))
+    ax.set_xlabel(label(ds["radius"]))
+    ax.set_ylabel(label(ds["cycle_rate"]))
     ax.set_ylim(bottom=0)
     _title(ax, "Cycle rate against radius per coil index", fixed)
     _footer(fig, ds)
@@ -247,8 +247,8 @@ def force_rate(ds, *, ax=None, coil_index=None, length=None, wrap_angle=None):
         front = np.maximum.accumulate(force[order])
         ax.step(rate[order], front, where="post", color="k", lw=1.2,
                 label="largest force at this rate or faster")
-    ax.set_xlabel(_label("cycle_rate"))
-    ax.set_ylabel(_label("tip_force_max"))
+    ax.set_xlabel(label(ds["cycle_rate"]))
+    ax.set_ylabel(label(ds["tip_force_max"]))
     ax.legend(fontsize=8, markerscale=3)
     where = ", ".join(_eq(k, v) for k, v in sel.items()) or "every design of the cube"
     ax.set_title(f"Tip force against cycle rate\n{where}", fontsize=9)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..variables import display_label, to_display
+from ..variables import label, to_display
 from ._common import _figure
 
 __all__ = ["fidelity_map"]
@@ -70,8 +70,8 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
         med = np.median(r[ok]) if ok.any() else float("nan")
         ax.set_title(f"{model}\nmedian {med:.2f}, {within:.0f} % within 10 %")
         ax.margins(0.06)
-        ax.set_xlabel(display_label(x))
-        ax.set_ylabel(display_label(y))
+        ax.set_xlabel(label(fid[x]))
+        ax.set_ylabel(label(fid[y]))
         ax.grid(alpha=0.3)
     cbar = fig.colorbar(mappable, ax=axes[0].tolist(), shrink=0.9)
     cbar.set_label("model / FE bend angle [1]")

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..variables import VARIABLES, quantile_name, to_display
+from ..variables import VARIABLES, label, quantile_name, to_display
 from ._common import (_COLOURS, _DASHES, _EXAMPLES, _FLAG_GREY, _LENGTH_DEFAULT,
                       _WRAP_DEFAULT, _flag_text, _models, _one_model,
-                      _coils, _eq, _example_point, _figure, _footer, _label,
+                      _coils, _eq, _example_point, _figure, _footer,
                       _labelled_psis, _nearest, _pick_few, _psi_colour, _stroke_max,
                       _suptitle, _text)
 
@@ -88,8 +88,8 @@ def fig12a(ds, *, radii=None, walls=None, wrap_angle=None, wrap_angles=None,
                               "alpha": 0.8})
         ax.set_xlim(stroke[0], stroke[-1])
         ax.set_ylim(0, top)
-        ax.set_xlabel(_label("stroke", " [-]"))
-    left.set_ylabel(_label("nylon_force"))
+        ax.set_xlabel(label(ds["stroke"], " [-]"))
+    left.set_ylabel(label(ds["nylon_force"]))
     handles = [Line2D([], [], color=_COLOURS[i % len(_COLOURS)], label=_eq("radius", a))
                for i, a in enumerate(radii)]
     handles += [Line2D([], [], color="0.3", ls=styles[j % len(styles)],
@@ -200,7 +200,7 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
                         ha="left", va="top", zorder=6,
                         bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none",
                               "alpha": 0.8})
-    ax.set_xlabel(_label("radius"))
+    ax.set_xlabel(label(ds["radius"]))
     return load_drawn, bits
 
 
@@ -367,7 +367,7 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
                          f"{model}\n{_eq('wall_thickness', t)}",
                          weight="bold" if many else None)
-            ax.set_ylabel(_label("torque_max") if m == 0 else "")
+            ax.set_ylabel(label(one["torque_max"]) if m == 0 else "")
             if many and w < len(walls) - 1:
                 ax.set_xlabel("")
             if not many:
@@ -443,7 +443,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                           f"{model}\n{_eq('wall_thickness', t)}",
                           weight="bold" if many else None)
             top.set_xlabel("")
-            top.set_ylabel(_label("bend_angle_max") if m == 0 else "")
+            top.set_ylabel(label(one["bend_angle_max"]) if m == 0 else "")
             if not many:
                 top.set_ylim(bottom=0)
             names = ["range_fraction", *(["validity"] if "validity" in one else [])]
@@ -461,7 +461,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                                     solid_capstyle="round", zorder=1.5)
             bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)}" +
                              ("" if many else " (100 % = full range)"))
-            bottom.set_xlabel(_label("radius") if w == len(walls) - 1 or not many else "")
+            bottom.set_xlabel(label(ds["radius"]) if w == len(walls) - 1 or not many else "")
             bottom.set_ylabel("range of motion [%]" if m == 0 else "")
             bottom.set_ylim(0, 105)
     if many:

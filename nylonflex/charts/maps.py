@@ -8,9 +8,9 @@ import math
 import numpy as np
 
 from ..units import InputError
-from ..variables import to_display
+from ..variables import label, to_display
 from ._common import (_EXAMPLES, _FLAG_FILL, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq,
-                      _figure, _flag_text, _footer, _grid_value, _label, _nearest,
+                      _figure, _flag_text, _footer, _grid_value, _nearest,
                       _pick_few, _suptitle)
 
 
@@ -84,10 +84,10 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
         ax.set_title(_eq("coil_index", c))
         ax.grid(False)
         if i % ncols == 0:
-            ax.set_ylabel(_label("wall_thickness"))
+            ax.set_ylabel(label(ds["wall_thickness"]))
         if i >= len(coils) - ncols:
-            ax.set_xlabel(_label("radius"))
-    fig.colorbar(mappable, ax=axes, label=_label("tip_force_max"), shrink=0.9)
+            ax.set_xlabel(label(ds["radius"]))
+    fig.colorbar(mappable, ax=axes, label=label(ds["tip_force_max"]), shrink=0.9)
     handles = [Patch(fc="#2a788e", ec="white", hatch="///",
                      label="strength-limited: nylon breaks first, range of motion cut short"),
                Patch(fc="#2a788e", ec="none", label="stroke-limited: full range of motion")]
@@ -188,10 +188,10 @@ def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
         ax.set_title(_eq("coil_index", c))
         ax.grid(False)
         if i % ncols == 0:
-            ax.set_ylabel(_label("wall_thickness"))
+            ax.set_ylabel(label(ds["wall_thickness"]))
         if i >= len(coils) - ncols:
-            ax.set_xlabel(_label("radius"))
-    fig.colorbar(mappable, ax=axes, label=_label("feasibility"), shrink=0.9,
+            ax.set_xlabel(label(ds["radius"]))
+    fig.colorbar(mappable, ax=axes, label=label(ds["feasibility"]), shrink=0.9,
                  ticks=np.linspace(0, 1, 6))
     reqs = ds.attrs.get("requirements", "?")
     samples = ds.attrs.get("uncertainty_samples")

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..storage.files import save_figure
 from ._common import RC, new_figure, rc_context
-from ..variables import display_label
+from ..variables import name_label
 
 __all__ = ["sensitivity_chart", "sensitivity_figure"]
 
@@ -55,7 +55,7 @@ def sensitivity_figure(result):
                 ax.text(0.5, 0.5, "does not vary over the samples:\nno indices",
                         transform=ax.transAxes, ha="center", va="center", color="0.3")
             ax.set_xticks(x, params, rotation=20, ha="right")
-            ax.set_title(display_label(o))
+            ax.set_title(name_label(o))
             ax.axhline(0, color="0.3", lw=0.8)
             ax.set_ylim(-0.05, 1.1)
         axes[0][0].set_ylabel("Sobol' index [1]")

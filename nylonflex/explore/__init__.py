@@ -1,6 +1,6 @@
 """``nylonflex explore``: one page over a cube, served locally or saved as one offline file.
 
-* :mod:`.data`: the parts of a cube the page shows (labels, display units, flag names, the
+* :mod:`.data`: the parts of a cube the page shows (display units, flag names, the
   stand-in note, "copy as config"), read lazily, never interpolated;
 * :mod:`.page`: the page itself, one Bokeh document whose views are all drawn in the
   browser by ``update.js`` from one state; :func:`~.page.build_html` saves it,

@@ -1,10 +1,11 @@
 """The explorer's data: what ``nylonflex explore`` says about a cube besides its numbers.
 
-Labels and display units (from the variable registry; a variable the registry does not know
-keeps the units the cube gives it), the design variables, ``validity`` by flag name, the
-note on stand-in materials, the grid point nearest a value (:func:`snap`; the explorer never
-interpolates) and "copy as config". The views themselves are drawn in the browser by
-``update.js`` from the numbers :func:`nylonflex.explore.page.build_payload` puts in a page.
+Display units (from the variable registry; a variable the registry does not know keeps the
+units the cube gives it; the labels are :func:`nylonflex.variables.label`'s), the design
+variables, ``validity`` by flag name, the note on stand-in materials, the grid point
+nearest a value (:func:`snap`; the explorer never interpolates) and "copy as config". The
+views themselves are drawn in the browser by ``update.js`` from the numbers
+:func:`nylonflex.explore.page.build_payload` puts in a page.
 
 The page itself is built by :func:`nylonflex.explore.page.build_document`.
 """
@@ -19,11 +20,11 @@ from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
 
 __all__ = ["Snapped", "axis_text", "design_config", "design_variables", "display_unit",
-           "flag_meanings", "label", "snap", "stand_in_note", "to_display_any",
+           "flag_meanings", "snap", "stand_in_note", "to_display_any",
            "validity_names"]
 
 
-# ---------------------------------------------------------------------------- units, labels
+# ---------------------------------------------------------------------------- units
 def display_unit(ds, name: str) -> str:
     """The unit ``name`` is shown in: the registry's display unit, else the cube's units."""
     if name in VARIABLES:
@@ -36,16 +37,6 @@ def to_display_any(ds, name: str, si):
     if name in VARIABLES:
         return to_display(name, si)
     return np.asarray(si, dtype=float)
-
-
-def label(ds, name: str) -> str:
-    """``"maximum tip force [N]"``: long name and display unit of ``name``."""
-    if name in VARIABLES:
-        long_name = VARIABLES[name].long_name
-    else:
-        long_name = str(ds[name].attrs.get("long_name", name))
-    unit = display_unit(ds, name)
-    return long_name if unit == "1" else f"{long_name} [{unit}]"
 
 
 def axis_text(ds, name: str, si) -> str:

@@ -12,7 +12,8 @@ import html
 
 import numpy as np
 
-from .data import display_unit, label, to_display_any
+from ..variables import label
+from .data import display_unit, to_display_any
 
 __all__ = ["fidelity_rows", "fidelity_summary_html", "fidelity_widgets"]
 
@@ -63,7 +64,7 @@ def fidelity_widgets(ds, fid, source: str = "") -> list:
         elif name == "pressure":
             title, fmt = f"pressure [{display_unit(ds, 'pressure')}]", "0.00"
         else:
-            title, fmt = label(ds, name), "0.[00]"
+            title, fmt = label(ds[name]), "0.[00]"
         columns.append(TableColumn(field=name, title=title,
                                    formatter=NumberFormatter(format=fmt, nan_format="-")))
     table = DataTable(source=ColumnDataSource(rows, name="nf-fidelity-rows"), columns=columns,

@@ -32,9 +32,9 @@ from importlib.resources import files
 import numpy as np
 
 from ..units import InputError
-from ..variables import AXES, VARIABLES
-from .data import (design_config, design_variables, display_unit, flag_meanings, label,
-                   snap, stand_in_note, to_display_any, validity_names)
+from ..variables import AXES, label, name_label
+from .data import (design_config, design_variables, display_unit, flag_meanings, snap,
+                   stand_in_note, to_display_any, validity_names)
 
 #: The most designs a page carries (the rest of a larger cube is left out, and it says so).
 MAX_DESIGNS = 120_000
@@ -289,10 +289,10 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     # ---- widgets: the page's whole state
     default_var = variables.index("tip_force_max") if "tip_force_max" in variables else 0
     variable = Select(title="variable (map, lines and read-out)", width=300,
-                      options=[(str(i), label(ds, n)) for i, n in enumerate(variables)],
+                      options=[(str(i), label(ds[n])) for i, n in enumerate(variables)],
                       value=str(default_var), name="nf-variable")
     model = RadioButtonGroup(labels=models, active=0, name="nf-model") if models else None
-    axis_options = [(a, label(ds, a)) for a in AXES]
+    axis_options = [(a, label(ds[a])) for a in AXES]
     map_x = Select(title="map across", options=axis_options, value="radius", width=145,
                    name="nf-map-x")
     map_y = Select(title="map up", options=axis_options, value="wall_thickness", width=145,
@@ -303,7 +303,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         fmt = CustomJSTickFormatter(args={"labels": p["labels"][a]},
                                     code="return labels[Math.round(tick)] || '';")
         sliders[a] = Slider(start=0, end=max(1, sizes[j] - 1), step=1, value=start,
-                            title=label(ds, a).split(" [")[0], format=fmt, width=300,
+                            title=label(ds[a]).split(" [")[0], format=fmt, width=300,
                             disabled=sizes[j] < 2, name=f"nf-slider-{a}",
                             css_classes=[f"nf-slider-{a}"])
     # ---- the map (its cells are laid out by update.js for the chosen axes)
@@ -312,7 +312,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                                name="nf-map")
     mapper = LinearColorMapper(palette="Viridis256", low=0, high=1)
     map_fig = figure(width=540, height=400, tools="tap,reset,save", name="nf-map-figure",
-                     x_axis_label=label(ds, "radius"), y_axis_label=label(ds, "wall_thickness"),
+                     x_axis_label=label(ds["radius"]), y_axis_label=label(ds["wall_thickness"]),
                      x_range=(p["edges"]["radius"][0], p["edges"]["radius"][-1]),
                      y_range=(p["edges"]["wall_thickness"][0],
                               p["edges"]["wall_thickness"][-1]))
@@ -321,10 +321,10 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                          fill_alpha="fa", line_color="lc", line_width=2, hatch_pattern="h",
                          hatch_color="white", hatch_alpha=0.8, hatch_scale=8,
                          nonselection_fill_alpha="fa", selection_fill_alpha="fa")
-    hover = HoverTool(renderers=[cells], tooltips=[(label(ds, variables[default_var]),
+    hover = HoverTool(renderers=[cells], tooltips=[(label(ds[variables[default_var]]),
                                                     "@z{0.000}")])
     map_fig.add_tools(hover)
-    colorbar = ColorBar(color_mapper=mapper, width=12, title=label(ds, variables[default_var]))
+    colorbar = ColorBar(color_mapper=mapper, width=12, title=label(ds[variables[default_var]]))
     map_fig.add_layout(colorbar, "right")
     match_src = ColumnDataSource({"x": [], "y": []}, name="nf-match")
     if p["match"] is not None:
@@ -337,7 +337,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                     line_color="black")
     map_fig.select_one(TapTool).mode = "replace"
     # ---- figure 12 style lines
-    lines_fig = figure(width=520, height=400, x_axis_label=label(ds, "radius"),
+    lines_fig = figure(width=520, height=400, x_axis_label=label(ds["radius"]),
                        tools="pan,box_zoom,reset,save")
     line_srcs, solid_srcs = [], []
     for k, c in enumerate(p["gx"]["coil_index"]):
@@ -358,8 +358,8 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     for k, (name, (axis, _)) in enumerate(_CURVES.items()):
         if name not in p["curves"]:
             continue
-        f = figure(width=400, height=280, title=titles[name], x_axis_label=label(ds, axis),
-                   y_axis_label=label(ds, name), tools="pan,box_zoom,reset,save")
+        f = figure(width=400, height=280, title=titles[name], x_axis_label=label(ds[axis]),
+                   y_axis_label=label(ds[name]), tools="pan,box_zoom,reset,save")
         src = ColumnDataSource({"x": [], "y": [], "design": []}, name=f"nf-curve-{name}")
         f.line("x", "y", source=src, color=_COLOURS[k], line_width=2)
         curve_figs.append(f)
@@ -383,13 +383,13 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                 colorbar=colorbar, hover=hover, sizes=sizes, AXES=list(AXES),
                 map_src=map_src, match_src=match_src, mapper=mapper, star=star, gx=p["gx"],
                 edges=p["edges"], names=_SYMBOL, labels=p["labels"],
-                alabels={a: label(ds, a) for a in AXES}, map_fig=map_fig,
+                alabels={a: label(ds[a]) for a in AXES}, map_fig=map_fig,
                 map_xaxis=map_fig.xaxis[0], map_yaxis=map_fig.yaxis[0], lines_fig=lines_fig,
                 lines_yaxis=lines_fig.yaxis[0], line_srcs=line_srcs, solid_srcs=solid_srcs,
                 curves=p["curves"], curve_srcs=curve_srcs, flim=p["flim"],
                 flim_span=flim_span, readout=readout, table=table, note=note, hold=hold,
-                vnames=variables, vlabels=[label(ds, n) for n in variables],
-                vshort=[label(ds, n).split(" [")[0] for n in variables],
+                vnames=variables, vlabels=[label(ds[n]) for n in variables],
+                vshort=[label(ds[n]).split(" [")[0] for n in variables],
                 vunits=[display_unit(ds, n) for n in variables])
     update = CustomJS(args=args, code=_script("update.js"))
     for w in (variable, map_x, map_y):
@@ -410,7 +410,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         rows_src = ColumnDataSource(rows["data"], name="nf-where-rows")
         columns = []
         for n in rows["columns"]:
-            title = label(ds, n) if n in VARIABLES or n in ds.variables else n
+            title = label(ds[n]) if n in ds.variables else name_label(n)
             fmt = {} if n in ("model", "validity") else \
                 {"formatter": NumberFormatter(format="0.[000]")}
             columns.append(TableColumn(field=n, title=title, **fmt))
