@@ -220,3 +220,21 @@ def test_a_missing_or_unreadable_settings_attribute_is_named(tmp_path):
         cube_settings(cube_attrs(old))
     with pytest.raises(ValueError, match="no nylonflex_cube attribute"):
         cube_settings({})
+
+
+def test_the_explorers_config_of_a_design_sweeps_under_the_cubes_settings(tmp_path):
+    # "copy as config" (explore.data.design_config) carries the cube's supply and cooling
+    # set from cube_settings: its one-design sweep gives that design's values of the cube
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+    from nylonflex.explore.data import design_config
+    from nylonflex.variables import AXES
+
+    _, ds = _swept(tmp_path, "cooling")
+    at = {a: float(ds[a].values[1]) for a in AXES}
+    doc = yaml.safe_load(design_config(ds, at))
+    assert doc["supply"] == {"voltage": 12.0, "units": "V"}
+    assert doc["cooling"] == {"set": "forced_air", "speed": 3.5}
+    one = nf.run_sweep(parse_config(doc))
+    for name in ("tip_force_max", "limit", "validity", "cycle_time", "cooling_time"):
+        assert float(one[name].squeeze()) == float(ds[name].sel(at)), name
