@@ -248,11 +248,11 @@ def test_bad_model_or_supply_is_refused(raw, match):
 def test_a_supply_cube_is_asked_with_its_supply(tmp_path):
     # query --at between grid points and design re-evaluate with the cube's own settings,
     # the supply included (the resolved config stores it as supply_voltage)
-    from nylonflex.engine.provenance import evaluate_settings
+    from nylonflex.engine.provenance import cube_settings
     from nylonflex.query import query_cube
 
     ds = run_sweep(parse_config({**SMALL, "supply": {"voltage": 12}}), tmp_path / "cube.h5")
-    assert evaluate_settings(ds.attrs)["supply_voltage"] == 12.0
+    assert cube_settings(ds).supply_voltage == 12.0
     at = dict(EXAMPLE_1, radius=19.9e-3)  # between grid radii: the exact model
     res = query_cube(ds, at=at)
     exact = nf.evaluate(**at, supply_voltage=12.0)

@@ -96,27 +96,28 @@ def _materials(ds, spec):
     ``model: fe_calibrated`` is answered under it, whatever the spec's default); a cube of
     several variants is refused, since its rows would mix them.
     """
-    silicone, nylon, base, supply, cooling, model, memo = _cube_materials(
-        ds.attrs["config_yaml"])
-    if not isinstance(model, str):
-        raise InputError(f"cube: holds {len(model)} model variants ({', '.join(model)}); "
+    from ..engine.provenance import cube_settings
+
+    try:
+        s = cube_settings(ds)
+    except ValueError as err:
+        raise InputError(str(err)) from None
+    if len(s.models) != 1:
+        raise InputError(f"cube: holds {len(s.models)} model variants ({', '.join(s.models)}); "
                          "design answers one: sweep the grid with one model, or give a "
                          "grid: spec with model: NAME")
-    if isinstance(cooling, list):
-        raise InputError(f"cube: holds {len(cooling)} cooling sets ("
-                         f"{', '.join(c.label for c in cooling)}); design answers one: sweep "
+    if s.coolings:
+        raise InputError(f"cube: holds {len(s.coolings)} cooling sets ("
+                         f"{', '.join(c.label for c in s.coolings)}); design answers one: sweep "
                          "the grid with one cooling set")
-    return Model(silicone, nylon, base, model, memo, supply_voltage=supply,
-                 cooling=cooling)
+    return Model(s.silicone, s.nylon, s.base_thickness, s.models[0], _memo(s),
+                 supply_voltage=s.supply_voltage, cooling=s.cooling)
 
 
 @functools.lru_cache(maxsize=8)
-def _cube_materials(config_yaml):
-    from ..engine.provenance import evaluate_settings
-
-    s = evaluate_settings({"config_yaml": config_yaml})
-    return (s["silicone"], s["nylon"], s["base_thickness"], s.get("supply_voltage"),
-            s.get("cooling"), s["model"], {})
+def _memo(settings) -> dict:
+    """The designs evaluated under one cube's settings (shared between runs on it)."""
+    return {}
 
 
 def _open(spec, cube):

@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..config import ResolvedConfig
+from ..materials import Cooling, Nylon, Silicone
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
 from ..variables import is_complete  # noqa: F401 - re-exported
 
-__all__ = ["CUBE_FORMAT", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "evaluate_settings", "is_complete",
-           "provenance", "run_attrs", "runnable_config", "typed_info"]
+__all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "cube_settings",
+           "is_complete", "provenance", "run_attrs", "runnable_config", "settings_attrs",
+           "typed_info"]
 
-#: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format.
-CUBE_FORMAT = "1"
+#: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format:
+#: "2" stores the settings as typed attributes (:func:`settings_attrs`), "1" (before issue
+#: 28) only as YAML text, which :func:`cube_settings` still reads.
+CUBE_FORMAT = "2"
 #: Attributes that differ between two runs of the same config (timing, host, when).
 VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "workers",
                   "resumed_slabs", "python_version", "hostname", "history")
@@ -113,98 +119,275 @@ def provenance(cfg: ResolvedConfig) -> dict:
         "silicone_parameters": material(cfg.silicone),
         "nylon": cfg.nylon.name,
         "nylon_parameters": material(cfg.nylon),
-        "base_thickness": "wall" if cfg.base_thickness is None else
-        f"{cfg.base_thickness} m",
+        **settings_attrs(cfg),
         "quadrature": (f"Gauss-Legendre phi={QUADRATURE_ORDERS['phi']} "
                        f"base={QUADRATURE_ORDERS['base']}; Newton rtol curvature "
                        f"{NEWTON_RTOL:g}, stroke {STROKE_RTOL:g}"),
         "model": "docs/model.md (nylonflex), after the paper 'Soft fluidic actuator based on "
                  "nylon artificial muscles' and Polygerinos et al. 2015",
-        "models": " ".join(cfg.models),
-        "supply_voltage": "none" if cfg.supply_voltage is None else f"{cfg.supply_voltage:g} V",
         "complete": np.int8(0),
         **_sampling(cfg),
     }
 
 
-def evaluate_settings(attrs) -> dict:
-    """Keyword arguments of :func:`nylonflex.evaluate` that reproduce a cube's designs.
+#: The numeric fields of :class:`~nylonflex.materials.Silicone` and
+#: :class:`~nylonflex.materials.Nylon`, each stored as the attribute ``<kind>_<field>``
+#: (float64; a tuple as a float64 array) in the units of ``materials.FIELD_UNITS``.
+SILICONE_FIELDS = ("mu", "alpha", "stretch_range")
+NYLON_FIELDS = tuple(f.name for f in dataclasses.fields(Nylon)
+                     if f.name not in ("name", "description", "sources"))
 
-    Rebuilds the silicone and nylon sets, the base thickness and the model (and the supply,
-    when the cube's config names one) from the cube's ``config_yaml`` attribute, the
-    resolved config in SI that :func:`provenance` stores.
+
+def settings_attrs(cfg: ResolvedConfig) -> dict:
+    """The settings a cube was computed with, as typed global attributes (cube format 2).
+
+    ``silicone`` and ``nylon`` (the sets' names) with ``<kind>_description`` (text) and
+    ``<kind>_<field>`` for every numeric field (:data:`SILICONE_FIELDS`,
+    :data:`NYLON_FIELDS`; float64, tuples as float64 arrays, SI); ``models`` (the model
+    variants' names, space-separated); ``base_thickness`` [m] float64, only where b is not
+    t; ``supply_voltage`` [V] float64, only with a supply; and, only with cooling,
+    ``cooling`` and ``cooling_fluid`` (the sets' names and fluids, space-separated) with
+    ``cooling_speed`` [m/s] (a float64 array, one speed a set). :func:`cube_settings` reads
+    them back.
+    """
+    def numbers(material, names, kind):
+        out = {}
+        for name in names:
+            value = getattr(material, name)
+            out[f"{kind}_{name}"] = np.asarray(value, np.float64) if isinstance(value, tuple) \
+                else np.float64(value)
+        return out
+
+    out = {"silicone": cfg.silicone.name, "silicone_description": cfg.silicone.description,
+           **numbers(cfg.silicone, SILICONE_FIELDS, "silicone"),
+           "nylon": cfg.nylon.name, "nylon_description": cfg.nylon.description,
+           **numbers(cfg.nylon, NYLON_FIELDS, "nylon"),
+           "models": " ".join(cfg.models)}
+    if cfg.base_thickness is not None:
+        out["base_thickness"] = np.float64(cfg.base_thickness)
+    if cfg.supply_voltage is not None:
+        out["supply_voltage"] = np.float64(cfg.supply_voltage)
+    coolings = cfg.coolings or ((cfg.cooling,) if cfg.cooling is not None else ())
+    if coolings:
+        out["cooling"] = " ".join(c.name for c in coolings)
+        out["cooling_fluid"] = " ".join(c.fluid for c in coolings)
+        out["cooling_speed"] = np.array([c.speed for c in coolings], np.float64)
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class CubeSettings:
+    """The settings a cube was computed with (:func:`cube_settings`): evaluating a design
+    under them (:meth:`evaluate_kwargs`) gives the cube's values at its grid designs.
+
+    Attributes
+    ----------
+    silicone : Silicone
+    nylon : Nylon
+        The material sets, equal to the sweep's (their ``sources`` aside, which stay in the
+        ``<kind>_parameters`` provenance text).
+    base_thickness : float or None
+        b [m]; None for b = t.
+    models : tuple of str
+        The model variants; several: the cube's ``model`` dimension.
+    supply_voltage : float or None
+        The supply [V]; None: no supply limit.
+    cooling : Cooling or None
+        The cube's one cooling set; None without one, or with several.
+    coolings : tuple of Cooling
+        Several cooling sets: the cube's ``cooling`` dimension; () otherwise.
+    """
+
+    silicone: Silicone
+    nylon: Nylon
+    base_thickness: float | None = None
+    models: tuple[str, ...] = ("paper",)
+    supply_voltage: float | None = None
+    cooling: Cooling | None = None
+    coolings: tuple[Cooling, ...] = ()
+
+    def evaluate_kwargs(self, model: str | None = None, cooling: Cooling | None = None) -> dict:
+        """Keyword arguments of :func:`nylonflex.evaluate` under one model variant and
+        cooling set of the cube (by default its only ones).
+
+        Raises
+        ------
+        ValueError
+            The cube holds several models (or cooling sets) and none is named.
+        """
+        if model is None:
+            if len(self.models) != 1:
+                raise ValueError(f"cube: holds {len(self.models)} model variants "
+                                 f"({', '.join(self.models)}); name one")
+            model = self.models[0]
+        if cooling is None and self.coolings:
+            raise ValueError(f"cube: holds {len(self.coolings)} cooling sets "
+                             f"({', '.join(c.label for c in self.coolings)}); name one")
+        out = {"silicone": self.silicone, "nylon": self.nylon,
+               "base_thickness": self.base_thickness, "model": model}
+        if self.supply_voltage is not None:
+            out["supply_voltage"] = self.supply_voltage
+        cooling = self.cooling if cooling is None else cooling
+        if cooling is not None:
+            out["cooling"] = cooling
+        return out
+
+
+def cube_settings(ds_or_attrs) -> CubeSettings:
+    """The settings a cube was computed with, from its typed attributes
+    (:func:`settings_attrs`), or, in a cube of format 1 (before them), from its YAML text.
 
     Parameters
     ----------
-    attrs : mapping
-        Global attributes of a cube (``ds.attrs`` or
+    ds_or_attrs : xarray.Dataset, h5py.File or mapping
+        A cube (``nf.open_cube``) or its global attributes (``ds.attrs``,
         :func:`nylonflex.storage.cube_attrs`).
 
     Returns
     -------
-    dict
-        ``silicone`` (:class:`~nylonflex.materials.Silicone`), ``nylon``
-        (:class:`~nylonflex.materials.Nylon`), ``base_thickness`` [m] or None, and
-        ``model`` (and ``supply_voltage`` [V] when the cube has a supply).
+    CubeSettings
 
     Raises
     ------
     ValueError
-        The attributes hold no readable ``config_yaml`` (not a nylonflex cube).
+        An attribute it needs is missing or unreadable (one line naming it).
     """
-    import dataclasses
+    attrs = getattr(ds_or_attrs, "attrs", ds_or_attrs)
+    if attrs is None or "nylonflex_cube" not in attrs:
+        raise ValueError("cube: no nylonflex_cube attribute; cannot rebuild its settings "
+                         "(was it written by 'nylonflex sweep'?)")
+    if _text(attrs, "nylonflex_cube") == "1":
+        return _yaml_settings(attrs)
 
+    def material(cls, kind, names, plain):
+        kw = {}
+        for name in names:
+            key = f"{kind}_{name}"
+            kw[name] = _numbers(attrs, key) if name not in plain else _number(attrs, key)
+        return cls(**kw, name=_text(attrs, kind),
+                   description=_text(attrs, f"{kind}_description"))
+
+    silicone = material(Silicone, "silicone", SILICONE_FIELDS, ())
+    nylon = material(Nylon, "nylon", NYLON_FIELDS,
+                     {n for n in NYLON_FIELDS if not n.endswith("_table")})
+    coolings = ()
+    if "cooling" in attrs:
+        names = _text(attrs, "cooling").split()
+        fluids = _text(attrs, "cooling_fluid").split()
+        speeds = _numbers(attrs, "cooling_speed")
+        if not len(names) == len(fluids) == len(speeds):
+            raise ValueError(f"cube: attributes cooling, cooling_fluid and cooling_speed "
+                             f"differ in length ({len(names)}, {len(fluids)}, {len(speeds)})")
+        coolings = tuple(_cooling(n, f, s) for n, f, s in zip(names, fluids, speeds))
+    return CubeSettings(
+        silicone, nylon,
+        base_thickness=_number(attrs, "base_thickness") if "base_thickness" in attrs else None,
+        models=tuple(_text(attrs, "models").split()),
+        supply_voltage=_number(attrs, "supply_voltage") if "supply_voltage" in attrs else None,
+        cooling=coolings[0] if len(coolings) == 1 else None,
+        coolings=coolings if len(coolings) > 1 else ())
+
+
+def _value(attrs, key):
+    if key not in attrs:
+        raise ValueError(f"cube: no {key} attribute; cannot rebuild its settings (was it "
+                         "written by 'nylonflex sweep'?)")
+    return attrs[key]
+
+
+def _text(attrs, key) -> str:
+    """A text attribute (h5py may give it as bytes, or as a one-element array)."""
+    value = _value(attrs, key)
+    if isinstance(value, np.ndarray) and value.size == 1:
+        value = value.reshape(-1)[0]
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", "replace")
+    if not isinstance(value, str):
+        raise ValueError(f"cube: attribute {key}: must be text, got {type(value).__name__}")
+    return str(value)
+
+
+def _numbers(attrs, key) -> tuple[float, ...]:
+    """A float attribute as a tuple of floats (a one-element array reads as a scalar)."""
+    value = np.atleast_1d(np.asarray(_value(attrs, key)))
+    if value.dtype.kind not in "fiu" or value.ndim != 1 or value.size == 0:
+        raise ValueError(f"cube: attribute {key}: must be numbers, got "
+                         f"{value.dtype} of shape {value.shape}")
+    return tuple(float(x) for x in value)
+
+
+def _number(attrs, key) -> float:
+    value = _numbers(attrs, key)
+    if len(value) != 1:
+        raise ValueError(f"cube: attribute {key}: must be one number, got {len(value)}")
+    return value[0]
+
+
+def _cooling(name: str, fluid: str, speed: float) -> Cooling:
+    """A cube's cooling set: the named set at its speed, as the config resolved it (its
+    description and sources from the set's table), or, for a set this version does not
+    name, the fluid and speed alone."""
+    from ..materials import COOLING_PARAMETERS, cooling_parameters
+
+    own = COOLING_PARAMETERS.get(name)
+    if own is not None and own.get("fluid") == fluid:
+        return cooling_parameters({"set": name, "speed": speed})
+    return Cooling(fluid, speed, name=name)
+
+
+def _yaml_settings(attrs) -> CubeSettings:
+    """The settings of a cube of format 1, from ``config_yaml`` (the resolved config, SI)
+    and the sets' ``<kind>_parameters`` (their descriptions and stretch range)."""
     import yaml
 
-    from ..materials import Nylon, Silicone
+    def load(key):
+        try:
+            doc = yaml.safe_load(_text(attrs, key))
+        except yaml.YAMLError:
+            doc = None
+        if not isinstance(doc, dict):
+            raise ValueError(f"cube: attribute {key}: not a readable YAML mapping; cannot "
+                             "rebuild its settings")
+        return doc
 
-    text = attrs.get("config_yaml") if attrs is not None else None
-    try:
-        doc = yaml.safe_load(text) if text else None
-    except yaml.YAMLError:
-        doc = None
-    if not isinstance(doc, dict) or "silicone" not in doc or "nylon" not in doc:
-        raise ValueError("cube: no readable config_yaml attribute; cannot rebuild its "
-                         "materials (was it written by 'nylonflex sweep'?)")
+    doc = load("config_yaml")
+    for kind in ("silicone", "nylon"):
+        if not isinstance(doc.get(kind), dict):
+            raise ValueError(f"cube: attribute config_yaml: no {kind} set; cannot rebuild "
+                             "its settings")
 
-    def rebuild(cls, values):
-        known = {f.name for f in dataclasses.fields(cls)} - {"description", "sources"}
+    def rebuild(cls, kind):
+        known = {f.name for f in dataclasses.fields(cls)} - {"sources"}
+        extra = load(f"{kind}_parameters") if f"{kind}_parameters" in attrs else {}
+        values = {**{k: v for k, v in extra.items() if k in ("description", "stretch_range")},
+                  **doc[kind]}
         kw = {k: tuple(float(x) for x in v) if isinstance(v, list) else v
               for k, v in values.items() if k in known}
+        missing = [f.name for f in dataclasses.fields(cls)
+                   if f.name not in kw and f.default is dataclasses.MISSING and
+                   f.default_factory is dataclasses.MISSING]
+        if missing:
+            raise ValueError(f"cube: attribute config_yaml: the {kind} set has no "
+                             f"{missing[0]}; cannot rebuild its settings")
         return cls(**kw)
 
     base = doc.get("base_thickness", "wall")
-    out = {"silicone": rebuild(Silicone, doc["silicone"]),
-           "nylon": rebuild(Nylon, doc["nylon"]),
-           "base_thickness": None if base in (None, "wall") else float(base),
-           "model": "paper"}
-    model = doc.get("model")
-    if isinstance(model, str):
-        out["model"] = model
-    elif isinstance(model, list) and len(model) == 1:
-        out["model"] = str(model[0])
-    elif model is not None:  # several models: the caller picks one
-        out["model"] = [str(m) for m in model]
-    # the resolved config stores the supply as supply_voltage [V] (config.canonical_yaml)
-    supply = doc.get("supply_voltage", doc.get("supply"))
-    if isinstance(supply, dict) and supply.get("voltage") is not None:
-        out["supply_voltage"] = float(supply["voltage"])
-    elif isinstance(supply, (int, float)) and not isinstance(supply, bool):
-        out["supply_voltage"] = float(supply)
-    cooling = doc.get("cooling")  # only in cubes swept with a cooling set (docs/model.md s. 9)
-    if isinstance(cooling, dict) and cooling.get("fluid") is not None:
-        out["cooling"] = _cooling_set(cooling)
-    elif isinstance(cooling, list):  # several cooling sets: the caller picks one
-        out["cooling"] = [_cooling_set(c) for c in cooling if isinstance(c, dict)]
-    return out
-
-
-def _cooling_set(resolved: dict):
-    """The :class:`~nylonflex.materials.Cooling` of a resolved config's cooling entry."""
-    from ..materials import Cooling
-
-    return Cooling(str(resolved["fluid"]), float(resolved.get("speed", 0.0)),
-                   name=str(resolved.get("name", "custom")))
+    model = doc.get("model", ["paper"])
+    supply = doc.get("supply_voltage")
+    coolings = doc.get("cooling")
+    coolings = [coolings] if isinstance(coolings, dict) else list(coolings or [])
+    if not all(isinstance(c, dict) and "fluid" in c for c in coolings):
+        raise ValueError("cube: attribute config_yaml: a cooling entry has no fluid; cannot "
+                         "rebuild its settings")
+    coolings = tuple(_cooling(str(c.get("name", "custom")), str(c["fluid"]),
+                              float(c.get("speed", 0.0))) for c in coolings)
+    return CubeSettings(
+        rebuild(Silicone, "silicone"), rebuild(Nylon, "nylon"),
+        base_thickness=None if base in (None, "wall") else float(base),
+        models=(model,) if isinstance(model, str) else tuple(str(m) for m in model),
+        supply_voltage=None if supply is None else float(supply),
+        cooling=coolings[0] if len(coolings) == 1 else None,
+        coolings=coolings if len(coolings) > 1 else ())
 
 
 def _cooling_spec(resolved):

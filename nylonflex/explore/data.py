@@ -128,26 +128,30 @@ def design_config(ds, at: dict, placeholders: bool = False) -> str:
     value is ``'@AXIS@'``, for a page to fill in."""
     import yaml
 
+    from ..engine.provenance import cube_settings
     from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
 
-    cfg = yaml.safe_load(str(ds.attrs.get("config_yaml", ""))) or {}
-    out = {"name": f"{cfg.get('name', 'design')}_design"}
+    try:
+        settings = cube_settings(ds)
+    except ValueError as err:
+        raise InputError(str(err)) from None
+    name = str(ds.attrs.get("name", "design"))
+    out = {"name": f"{name}_design"}
     for kind, table, default in (("silicone", SILICONE_PARAMETERS, "tc5005"),
                                  ("nylon", NYLON_PARAMETERS, "silver_nylon66")):
-        m = cfg.get(kind)
-        if isinstance(m, dict):
-            base = str(m.get("name", default)).split("+")[0]
-            out[kind] = {"set": base if base in table else default,
-                         **{k: v for k, v in m.items() if k != "name"}}
-        elif m is not None:
-            out[kind] = m
-    if "base_thickness" in cfg:
-        b = cfg["base_thickness"]
-        out["base_thickness"] = b if b == "wall" or b is None else \
-            {"value": float(f"{float(to_display('wall_thickness', float(b))):.12g}"),
-             "units": "mm"}
-    if isinstance(cfg.get("model"), str):
-        out["model"] = cfg["model"]
+        m = getattr(settings, kind).to_dict()
+        base = str(m.get("name", default)).split("+")[0]
+        out[kind] = {"set": base if base in table else default,
+                     **{k: v for k, v in sorted(m.items()) if k != "name"}}
+    b = settings.base_thickness
+    out["base_thickness"] = "wall" if b is None else \
+        {"value": float(f"{float(to_display('wall_thickness', b)):.12g}"), "units": "mm"}
+    if len(settings.models) == 1 and settings.models[0] != "paper":
+        out["model"] = settings.models[0]
+    if settings.supply_voltage is not None:
+        out["supply"] = {"voltage": settings.supply_voltage, "units": "V"}
+    if settings.cooling is not None:
+        out["cooling"] = {"set": settings.cooling.name, "speed": settings.cooling.speed}
     grid = {}
     for axis in AXES:
         value = float(ds[axis].values[snap(ds, axis, float(at[axis])).index])
@@ -157,7 +161,7 @@ def design_config(ds, at: dict, placeholders: bool = False) -> str:
                       **({} if unit == "1" else {"units": unit})}
     out["grid"] = grid
     out["curves"] = {c: _curve_axis(c, ds[c].values) for c in ("stroke", "pressure")}
-    head = (f"# the design picked in the explorer of cube '{cfg.get('name', '?')}': "
+    head = (f"# the design picked in the explorer of cube '{name}': "
             "nylonflex sweep THIS.yaml\n")
     return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
 

@@ -81,12 +81,12 @@ def sample_designs(ds, n, seed=0) -> list[dict]:
 
 def _plan(ds, attrs, n, seed, mesh):
     from ..engine import evaluate
-    from ..engine.provenance import evaluate_settings
+    from ..engine.provenance import cube_settings
 
-    settings = evaluate_settings(attrs)
-    model = settings.get("model", "paper")
-    if isinstance(model, list):
-        settings["model"] = model[0]
+    s = cube_settings(attrs)
+    # a cube of several models (cooling sets): its first one's peak pressures
+    settings = s.evaluate_kwargs(model=s.models[0],
+                                 cooling=s.coolings[0] if s.coolings else None)
     designs = sample_designs(ds, n, seed)
     arr = {a: np.array([d[a] for d in designs]) for a in AXES}
     res = evaluate(arr["radius"], arr["wall_thickness"], arr["length"], arr["coil_index"],

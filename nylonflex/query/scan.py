@@ -272,23 +272,23 @@ def _exact_rows(ds, at, at_loc, r0, r1, settings):
 
 
 def _exact_settings(ds):
-    from ..engine.provenance import evaluate_settings
+    from ..engine.provenance import cube_settings
 
     try:
-        settings = evaluate_settings(ds.attrs)
+        settings = cube_settings(ds)
     except ValueError as err:
         raise InputError(f"--at: {err}; use --interpolate to interpolate between grid "
                          "points instead") from None
-    if isinstance(settings.get("model"), list):
+    if len(settings.models) != 1:
         raise InputError("--at: this cube holds several models "
-                         f"({', '.join(settings['model'])}); the exact model between grid "
+                         f"({', '.join(settings.models)}); the exact model between grid "
                          "points needs one: use --interpolate, or query a one-model cube")
-    if isinstance(settings.get("cooling"), list):
+    if settings.coolings:
         raise InputError("--at: this cube holds several cooling sets "
-                         f"({', '.join(c.label for c in settings['cooling'])}); the exact "
+                         f"({', '.join(c.label for c in settings.coolings)}); the exact "
                          "model between grid points needs one: use --interpolate, or query "
                          "a cube of one cooling set")
-    return settings
+    return settings.evaluate_kwargs()
 
 
 def radius_slabs(ds, at_loc) -> list[tuple[int, int]]:

@@ -351,8 +351,9 @@ def cube_summary(path) -> list[str]:
         if "cooling" in sizes:
             out.append("cooling   " + ", ".join(
                 _text(m) for m in np.asarray(h5["cooling"][...]).reshape(-1)))
-        if a.get("supply_voltage", "none") != "none":
-            out.append(f"supply    {a['supply_voltage']}")
+        supply = a.get("supply_voltage", "none")  # [V] float64; text before cube format 2
+        if supply != "none":
+            out.append(f"supply    {supply if isinstance(supply, str) else f'{supply:g} V'}")
         try:
             out.extend(_validity_lines(f, h5, done_flags if not complete else
                                        np.ones_like(done_flags)))
