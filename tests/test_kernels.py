@@ -230,3 +230,64 @@ def test_loading_the_kernels_skips_numbas_scipy_linalg_probe():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert _compile._scipy_blas_installed() is True  # scipy is a dependency
+
+
+def test_the_kernels_output_rows_are_the_registrys_order():
+    # issue 28: the row of every kernel output comes from one table (kernels/rows.py),
+    # derived from the registry: each float design variable, flag and tracking variable
+    # has exactly one ROW_ constant, each table's rows are 0..n-1 in the registry's order,
+    # and no ROW_ constant names anything else
+    from nylonflex.engine import grid
+    from nylonflex.kernels import rows
+    from nylonflex.variables import DESIGN, TRACKING
+
+    tables = [([n for n, v in DESIGN.items() if v.dtype == "float64"], rows.DESIGN_ROWS),
+              ([n for n, v in DESIGN.items() if v.dtype == "int8"], rows.FLAG_ROWS),
+              (list(TRACKING), rows.TRACKING_ROWS)]
+    assert sorted(tables[0][0] + tables[1][0]) == sorted(DESIGN)
+    expected = {}
+    for names, table in tables:
+        assert list(table) == names
+        assert list(table.values()) == list(range(len(names)))
+        expected.update({f"ROW_{n.upper()}": row for row, n in enumerate(names)})
+    assert len(expected) == sum(len(names) for names, _ in tables)  # no name in two tables
+    assert {n: getattr(rows, n) for n in dir(rows) if n.startswith("ROW_")} == expected
+    assert (rows.N_FLOAT_DESIGN, rows.N_FLAGS, rows.N_TRACKING) == \
+        tuple(len(names) for names, _ in tables)
+    assert list(rows.FLOAT_DESIGN) == tables[0][0] and grid.FLOAT_DESIGN is rows.FLOAT_DESIGN
+
+
+@pytest.mark.parametrize("module, function, arrays", [
+    ("design", "_design_slab", {"out_design": "DESIGN_ROWS", "out_flags": "FLAG_ROWS"}),
+    ("design", "_design_points", {"out_design": "DESIGN_ROWS", "out_flags": "FLAG_ROWS"}),
+    ("tracking", "_track_slab", {"out": "TRACKING_ROWS"})])
+def test_each_kernel_writes_every_row_once_by_its_constant(module, function, arrays):
+    # every write into a kernel's output array indexes it by a ROW_ constant, each row of
+    # the table is written exactly once, and (but for the validity bits, computed in the
+    # write) from the local named after its variable
+    import ast
+    from pathlib import Path
+
+    from nylonflex.kernels import rows
+
+    path = Path(rows.__file__).with_name(f"{module}.py")
+    body = next(node for node in ast.parse(path.read_text()).body
+                if isinstance(node, ast.FunctionDef) and node.name == function)
+    written = {name: [] for name in arrays}
+    for node in ast.walk(body):
+        if not isinstance(node, ast.Assign):
+            continue
+        for target in node.targets:
+            if isinstance(target, ast.Subscript) and isinstance(target.value, ast.Name) \
+                    and target.value.id in arrays:
+                first = target.slice.elts[0]
+                assert isinstance(first, ast.Name) and first.id.startswith("ROW_"), \
+                    f"{function}: {ast.unparse(target)} is not indexed by a ROW_ constant"
+                written[target.value.id].append(first.id)
+                if isinstance(node.value, ast.Name):
+                    assert f"ROW_{node.value.id.upper()}" == first.id, ast.unparse(node)
+                else:
+                    assert first.id == "ROW_VALIDITY", ast.unparse(node)
+    for array, table in arrays.items():
+        assert sorted(written[array]) == sorted(f"ROW_{n.upper()}"
+                                                for n in getattr(rows, table))

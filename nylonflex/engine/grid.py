@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import ResolvedConfig
+from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, FLOAT_DESIGN, N_FLAGS, N_FLOAT_DESIGN
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke_max
@@ -20,8 +21,8 @@ from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
 __all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
            "cube_variables", "global_arrays", "plan_slabs", "slab_variables"]
 
-#: The float design variables in the registry's order (the kernel's ``out.design`` rows).
-FLOAT_DESIGN = tuple(n for n, v in DESIGN.items() if v.dtype == "float64")
+# FLOAT_DESIGN (exported): the float design variables in the registry's order, the rows of
+# the kernel's ``out.design`` (nylonflex.kernels.rows, the table the kernels write by)
 
 
 def cube_variables(cfg: ResolvedConfig) -> dict:
@@ -261,8 +262,8 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
     shape = lambda name: [sizes[d] for d in CURVES[name].dims]  # noqa: E731
     design_shape = [sizes[d] for d in DESIGN["limit"].dims]
     empty = np.empty if pool is None else pool.empty
-    out = GridOut(design=empty((len(FLOAT_DESIGN), *design_shape)),
-                  flags=empty((2, *design_shape), dtype=np.int8),
+    out = GridOut(design=empty((N_FLOAT_DESIGN, *design_shape)),
+                  flags=empty((N_FLAGS, *design_shape), dtype=np.int8),
                   nylon_force=empty(shape("nylon_force")),
                   bend_angle=empty(shape("bend_angle")),
                   tip_force=empty(shape("tip_force")))
@@ -270,9 +271,11 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
     options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
     kernel(grid, coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
            _muscle(cfg), options, out)
-    arrays = {name: out.design[j] for j, name in enumerate(FLOAT_DESIGN)}
-    arrays.update(limit=out.flags[0], validity=out.flags[1], nylon_force=out.nylon_force,
-                  bend_angle=out.bend_angle, tip_force=out.tip_force)
+    # the kernel's rows by name (kernels.rows, the one table both sides read)
+    arrays = {name: out.design[row] for name, row in DESIGN_ROWS.items()}
+    arrays.update({name: out.flags[row] for name, row in FLAG_ROWS.items()})
+    arrays.update(nylon_force=out.nylon_force, bend_angle=out.bend_angle,
+                  tip_force=out.tip_force)
     if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
         from .sampled import slab_statistics
 

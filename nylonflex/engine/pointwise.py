@@ -19,6 +19,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
 from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
                          check_shear_modulus, nylon_parameters, silicone_kind,
                          silicone_parameters)
@@ -37,7 +38,6 @@ _PARALLEL_FROM = 64
 #: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls use the serial loop.
 _SERIAL = threading.local()
 
-_FLOAT_DESIGN = [n for n, v in DESIGN.items() if v.dtype == "float64"]
 _MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistance_per_length",
                   "heat_capacity_per_length", "heat_loss_per_length",
                   "thermal_force_coefficient")
@@ -250,14 +250,14 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
 
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
-    out = PointOut(np.empty((len(_FLOAT_DESIGN), n)), np.empty((2, n), dtype=np.int8))
+    out = PointOut(np.empty((N_FLOAT_DESIGN, n)), np.empty((N_FLAGS, n), dtype=np.int8))
     kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM and \
         not getattr(_SERIAL, "on", False) else kernels.design_points_serial
     kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
            Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
-    result = {name: out.design[j].reshape(shape) for j, name in enumerate(_FLOAT_DESIGN)}
-    result["limit"] = out.flags[0].reshape(shape)
-    result["validity"] = out.flags[1].reshape(shape)
+    # the kernel's rows by name (kernels.rows, the one table both sides read)
+    result = {name: out.design[row].reshape(shape) for name, row in DESIGN_ROWS.items()}
+    result.update({name: out.flags[row].reshape(shape) for name, row in FLAG_ROWS.items()})
     return {name: result[name] for name in DESIGN}
 
 

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from ..config import ResolvedConfig
+from ..kernels.rows import N_TRACKING, TRACKING_ROWS
 from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import stroke, stroke_scale
@@ -141,15 +142,14 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     b = spec.bandwidth
     bandwidth = (0, 0.0, 1.0, 1.0, 0, 1) if b is None else \
         (1, b["error"], b["low"], b["high"], b["iterations"], b["periods"])
-    out = np.empty((4, lm.size))
+    out = np.empty((N_TRACKING, lm.size))
     kernel = kt.track_slab_parallel if parallel else kt.track_slab_serial
     kernel((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
            kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
            bandwidth, sensor_noise(spec, _longest_run(spec)), out)
-    names = ("tracking_rms_error", "tracking_max_temperature", "tracking_energy",
-             "tracking_bandwidth")
-    return {name: out[k].reshape(lm.shape) for k, name in enumerate(names)
-            if name in tracking_variables(cfg)}
+    wanted = tracking_variables(cfg)
+    return {name: out[row].reshape(lm.shape) for name, row in TRACKING_ROWS.items()
+            if name in wanted}
 
 
 def design_tracking(cfg: ResolvedConfig, design: dict, bend_angle_max: float | None = None,

@@ -42,10 +42,12 @@ from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
 from ._compile import jit_kernel
-
-#: Number of float design variables in ``out.design``: the registry's float design
-#: variables (all but ``limit`` and ``validity``), in its order.
-N_FLOAT_DESIGN = 19
+from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYCLE_TIME,
+                   ROW_EFFICIENCY, ROW_HEATING_ENERGY, ROW_HEATING_POWER, ROW_HEATING_TIME,
+                   ROW_HEATING_VOLTAGE, ROW_LIMIT, ROW_MECHANICAL_WORK, ROW_MUSCLE_LENGTH,
+                   ROW_NYLON_FORCE_MAX, ROW_NYLON_USE, ROW_PRESSURE_MAX, ROW_RANGE_FRACTION,
+                   ROW_RESISTANCE, ROW_TIP_FORCE_MAX, ROW_TORQUE_MAX, ROW_USABLE_STROKE,
+                   ROW_VALIDITY)
 
 
 def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
@@ -56,8 +58,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     :class:`~.records.Ogden` of 1-D arrays, ``nodes`` the quadrature's
     :class:`~.records.Nodes`, ``muscle`` a :class:`~.records.Muscle` of one entry and
     ``options`` the :class:`~.records.Options` (model code, supply, fitted stretch).
-    ``out.design[v]`` holds the float variables in the registry's order; shapes (na, nt, nl,
-    nc, npsi), curves as the registry says.
+    ``out.design[ROW_<NAME>]`` holds each float variable, ``out.flags`` ``limit`` and
+    ``validity`` (the rows of :mod:`.rows`); shapes (na, nt, nl, nc, npsi), curves as the
+    registry says.
 
     The paper's model without a supply runs the loops it always ran (the stroke state once
     per (a, t, C, psi)); a variant or a supply runs :func:`_model_state_nodes`, per length
@@ -195,38 +198,42 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free
                     lf = _length_factor(model, a, length[il])
-                    v = _design_values(st[0], st[1], st[2], st[3], st[4] * lf, st[5],
-                                       st[6] * lf, f_lim, length[il])
-                    out_design[0, ia, it, il, ic, ip] = v[0]
-                    out_flags[0, ia, it, il, ic, ip] = v[1]
-                    out_design[1, ia, it, il, ic, ip] = v[2]
-                    out_design[2, ia, it, il, ic, ip] = v[3]
-                    out_design[3, ia, it, il, ic, ip] = v[4]
-                    out_design[4, ia, it, il, ic, ip] = v[5]
-                    out_design[5, ia, it, il, ic, ip] = v[6]
-                    out_design[6, ia, it, il, ic, ip] = v[7]
-                    out_design[7, ia, it, il, ic, ip] = v[8]
-                    th = _thermal_values_at(length[il], pitch, perimeter, cos_wrap, voltage,
-                                            temps[0], temps[2], t_amb, r_per_len,
-                                            loss_per_len, tau, cooling)
-                    out_design[8, ia, it, il, ic, ip] = th[0]
-                    out_design[9, ia, it, il, ic, ip] = th[1]
-                    out_design[10, ia, it, il, ic, ip] = th[2]
-                    out_design[11, ia, it, il, ic, ip] = th[3]
-                    out_design[12, ia, it, il, ic, ip] = th[4]
-                    out_design[13, ia, it, il, ic, ip] = th[5]
-                    dyn = _dynamic_values(model, v[0], a, t, lever, solid, mu, alpha, p_atm,
-                                          th[0], th[1], voltage, th[5], temps[2], temps[1],
-                                          t_amb, tau)
-                    out_design[14, ia, it, il, ic, ip] = dyn[0]
-                    out_design[15, ia, it, il, ic, ip] = dyn[1]
-                    out_design[16, ia, it, il, ic, ip] = dyn[2]
-                    out_design[17, ia, it, il, ic, ip] = dyn[3]
-                    out_design[18, ia, it, il, ic, ip] = dyn[4]
-                    out_flags[1, ia, it, il, ic, ip] = _validity(v[5], st[4] * lf, a, t, b,
-                                                              stretch_max,
-                                                              length[il] / pitch, closes,
-                                                              dyn[4])
+                    (usable_stroke, limit, pressure_max, torque_max, tip_force_max,
+                     bend_angle_max, range_fraction, nylon_force_max,
+                     nylon_use) = _design_values(st[0], st[1], st[2], st[3], st[4] * lf,
+                                                 st[5], st[6] * lf, f_lim, length[il])
+                    out_design[ROW_USABLE_STROKE, ia, it, il, ic, ip] = usable_stroke
+                    out_flags[ROW_LIMIT, ia, it, il, ic, ip] = limit
+                    out_design[ROW_PRESSURE_MAX, ia, it, il, ic, ip] = pressure_max
+                    out_design[ROW_TORQUE_MAX, ia, it, il, ic, ip] = torque_max
+                    out_design[ROW_TIP_FORCE_MAX, ia, it, il, ic, ip] = tip_force_max
+                    out_design[ROW_BEND_ANGLE_MAX, ia, it, il, ic, ip] = bend_angle_max
+                    out_design[ROW_RANGE_FRACTION, ia, it, il, ic, ip] = range_fraction
+                    out_design[ROW_NYLON_FORCE_MAX, ia, it, il, ic, ip] = nylon_force_max
+                    out_design[ROW_NYLON_USE, ia, it, il, ic, ip] = nylon_use
+                    (muscle_length, resistance, heating_power, heating_voltage, cooling_time,
+                     heating_time) = _thermal_values_at(length[il], pitch, perimeter, cos_wrap,
+                                                        voltage, temps[0], temps[2], t_amb,
+                                                        r_per_len, loss_per_len, tau, cooling)
+                    out_design[ROW_MUSCLE_LENGTH, ia, it, il, ic, ip] = muscle_length
+                    out_design[ROW_RESISTANCE, ia, it, il, ic, ip] = resistance
+                    out_design[ROW_HEATING_POWER, ia, it, il, ic, ip] = heating_power
+                    out_design[ROW_HEATING_VOLTAGE, ia, it, il, ic, ip] = heating_voltage
+                    out_design[ROW_COOLING_TIME, ia, it, il, ic, ip] = cooling_time
+                    out_design[ROW_HEATING_TIME, ia, it, il, ic, ip] = heating_time
+                    (cycle_time, cycle_rate, heating_energy, mechanical_work,
+                     efficiency) = _dynamic_values(model, usable_stroke, a, t, lever, solid, mu,
+                                                   alpha, p_atm, muscle_length, resistance,
+                                                   voltage, heating_time, temps[2], temps[1],
+                                                   t_amb, tau)
+                    out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
+                    out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
+                    out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
+                    out_design[ROW_MECHANICAL_WORK, ia, it, il, ic, ip] = mechanical_work
+                    out_design[ROW_EFFICIENCY, ia, it, il, ic, ip] = efficiency
+                    out_flags[ROW_VALIDITY, ia, it, il, ic, ip] = _validity(
+                        bend_angle_max, st[4] * lf, a, t, b, stretch_max, length[il] / pitch,
+                        closes, efficiency)
                 for js in range(ns):
                     if model == INCOMPRESSIBLE_WALL:
                         f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
@@ -278,37 +285,42 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
                            scale, t_amb, t_max, gamma_all[i], beta_all[i], t_g_all[i],
                            sigma_g_all[i], r_all[i], loss_all[i], coeff_all[i], mu, alpha,
                            x_base, w_base, phi_trig, w_phi, p_atm)
-        v = _design_values(st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
-        out_design[0, i] = v[0]
-        out_flags[0, i] = v[1]
-        out_design[1, i] = v[2]
-        out_design[2, i] = v[3]
-        out_design[3, i] = v[4]
-        out_design[4, i] = v[5]
-        out_design[5, i] = v[6]
-        out_design[6, i] = v[7]
-        out_design[7, i] = v[8]
-        temps = _working_temperatures(model, v[0], st[8], scale, t_amb, t_max, gamma_all[i],
-                                      beta_all[i], t_g_all[i], sigma_g_all[i])
-        th = _thermal_values(length[i], pitch, a, t, b, psi, voltage, temps[0], temps[1],
-                             temps[2], t_amb, r_all[i], c_all[i], loss_all[i])
-        out_design[8, i] = th[0]
-        out_design[9, i] = th[1]
-        out_design[10, i] = th[2]
-        out_design[11, i] = th[3]
-        out_design[12, i] = th[4]
-        out_design[13, i] = th[5]
+        (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
+         range_fraction, nylon_force_max, nylon_use) = _design_values(
+            st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
+        out_design[ROW_USABLE_STROKE, i] = usable_stroke
+        out_flags[ROW_LIMIT, i] = limit
+        out_design[ROW_PRESSURE_MAX, i] = pressure_max
+        out_design[ROW_TORQUE_MAX, i] = torque_max
+        out_design[ROW_TIP_FORCE_MAX, i] = tip_force_max
+        out_design[ROW_BEND_ANGLE_MAX, i] = bend_angle_max
+        out_design[ROW_RANGE_FRACTION, i] = range_fraction
+        out_design[ROW_NYLON_FORCE_MAX, i] = nylon_force_max
+        out_design[ROW_NYLON_USE, i] = nylon_use
+        temps = _working_temperatures(model, usable_stroke, st[8], scale, t_amb, t_max,
+                                      gamma_all[i], beta_all[i], t_g_all[i], sigma_g_all[i])
+        (muscle_length, resistance, heating_power, heating_voltage, cooling_time,
+         heating_time) = _thermal_values(length[i], pitch, a, t, b, psi, voltage, temps[0],
+                                         temps[1], temps[2], t_amb, r_all[i], c_all[i],
+                                         loss_all[i])
+        out_design[ROW_MUSCLE_LENGTH, i] = muscle_length
+        out_design[ROW_RESISTANCE, i] = resistance
+        out_design[ROW_HEATING_POWER, i] = heating_power
+        out_design[ROW_HEATING_VOLTAGE, i] = heating_voltage
+        out_design[ROW_COOLING_TIME, i] = cooling_time
+        out_design[ROW_HEATING_TIME, i] = heating_time
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
-        dyn = _dynamic_values(model, v[0], a, t, lever, solid, mu, alpha, p_atm, th[0], th[1],
-                              voltage, th[5], temps[2], temps[1], t_amb,
-                              c_all[i] / loss_all[i])
-        out_design[14, i] = dyn[0]
-        out_design[15, i] = dyn[1]
-        out_design[16, i] = dyn[2]
-        out_design[17, i] = dyn[3]
-        out_design[18, i] = dyn[4]
-        out_flags[1, i] = _validity(v[5], st[4], a, t, b, stretch_max, length[i] / pitch, st[7],
-                                    dyn[4])
+        (cycle_time, cycle_rate, heating_energy, mechanical_work,
+         efficiency) = _dynamic_values(model, usable_stroke, a, t, lever, solid, mu, alpha,
+                                       p_atm, muscle_length, resistance, voltage, heating_time,
+                                       temps[2], temps[1], t_amb, c_all[i] / loss_all[i])
+        out_design[ROW_CYCLE_TIME, i] = cycle_time
+        out_design[ROW_CYCLE_RATE, i] = cycle_rate
+        out_design[ROW_HEATING_ENERGY, i] = heating_energy
+        out_design[ROW_MECHANICAL_WORK, i] = mechanical_work
+        out_design[ROW_EFFICIENCY, i] = efficiency
+        out_flags[ROW_VALIDITY, i] = _validity(bend_angle_max, st[4], a, t, b, stretch_max,
+                                               length[i] / pitch, st[7], efficiency)
 
 
 #: Threaded (Numba prange) and serial compilations of the same loops. The serial ones are

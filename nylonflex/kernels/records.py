@@ -31,8 +31,8 @@ GridAxes = namedtuple("GridAxes", "radius wall length wrap base_thickness stroke
 #: a design.
 CoilTable = namedtuple("CoilTable", "s_max force_limit width r_per_len loss_per_len")
 
-#: Output arrays of the grid kernel: ``design`` (float design variables, the registry's
-#: order less ``limit``, then the slab's design shape), ``flags`` (int8, rows ``limit`` and
+#: Output arrays of the grid kernel: ``design`` (float design variables, the rows of
+#: :mod:`.rows`, then the slab's design shape), ``flags`` (int8, rows ``limit`` and
 #: ``validity``: one array, since Numba's parallel loops lost the writes to a second int8
 #: output of the same record), ``nylon_force``,
 #: ``bend_angle``, ``tip_force`` (the registry's dims).
@@ -54,8 +54,9 @@ Options = namedtuple("Options", "model voltage stretch_max")
 #: ``wrap`` [rad].
 PointDesigns = namedtuple("PointDesigns", "radius wall base length wrap")
 
-#: Output of the pointwise kernel: ``design`` (float variables, shape (19, n)) and ``flags``
-#: (int8, shape (2, n): ``limit`` and ``validity``).
+#: Output of the pointwise kernel: ``design`` (float variables, shape (N_FLOAT_DESIGN, n))
+#: and ``flags`` (int8, shape (N_FLAGS, n): ``limit`` and ``validity``), the rows of
+#: :mod:`.rows`.
 PointOut = namedtuple("PointOut", "design flags")
 
 # ----------------------------------------------------------------- the closed loop

@@ -25,6 +25,8 @@ from ..physics.nylon import _stroke_shape
 from ..physics.thermal import _temperature_step
 from ._compile import jit_kernel
 from .control import _duty, angle_table, estimate_angle, plant_angle
+from .rows import (ROW_TRACKING_BANDWIDTH, ROW_TRACKING_ENERGY, ROW_TRACKING_MAX_TEMPERATURE,
+                   ROW_TRACKING_RMS_ERROR)
 
 __all__ = ["kappa_tables", "kappa_tables_serial", "run_loop", "track_slab_parallel",
            "track_slab_serial"]
@@ -217,7 +219,9 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
     noise : ndarray
         Sensor noise at each sample [Pa], as long as the longest run.
     out : ndarray (4, n)
-        Written: rms error [rad], highest temperature [K], energy [J], bandwidth [Hz].
+        Written, in the rows of :mod:`.rows` (``ROW_TRACKING_*``, the registry's
+        ``TRACKING`` order): rms error [rad], highest temperature [K], energy [J],
+        bandwidth [Hz].
     """
     radius, wall, length, base = axes
     r_per_len, c_per_len, loss_per_len, t_amb, t_start, gamma, beta, t_g, sigma_g = muscle
@@ -239,20 +243,19 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         b = wall[j] if base <= 0.0 else base
         g = ref_scale[i, j, li, ci, wi]
         # one call, no branch in the prange body (writes after a branch were lost)
-        res = _one_design(dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len[ci], c_per_len,
-                          loss_per_len[ci], t_amb, t_start, scale[ci], gamma, beta, t_g,
-                          sigma_g, radius[i], wall[j], b, length[li], p_top[i, j, li, ci, wi],
-                          points,
-                          mu, alpha, x_base, w_base, phi_trig, w_phi, rtol,
-                          p_group[i, j] / (plant_points - 1), kappa[i, j], kappa_slope[i, j],
-                          kind, half_band, gain, integral_step, filter_keep, noise, ref_kind,
-                          g * mean, g * amplitude, frequency, phase, g * initial, g * final,
-                          at, rms_from, bw_on, bw_error, bw_low, bw_high, bw_iterations,
-                          bw_periods)
-        out[0, q] = res[0]
-        out[1, q] = res[1]
-        out[2, q] = res[2]
-        out[3, q] = res[3]
+        (tracking_rms_error, tracking_max_temperature, tracking_energy,
+         tracking_bandwidth) = _one_design(
+            dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len[ci], c_per_len,
+            loss_per_len[ci], t_amb, t_start, scale[ci], gamma, beta, t_g, sigma_g, radius[i],
+            wall[j], b, length[li], p_top[i, j, li, ci, wi], points, mu, alpha, x_base, w_base,
+            phi_trig, w_phi, rtol, p_group[i, j] / (plant_points - 1), kappa[i, j],
+            kappa_slope[i, j], kind, half_band, gain, integral_step, filter_keep, noise,
+            ref_kind, g * mean, g * amplitude, frequency, phase, g * initial, g * final, at,
+            rms_from, bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods)
+        out[ROW_TRACKING_RMS_ERROR, q] = tracking_rms_error
+        out[ROW_TRACKING_MAX_TEMPERATURE, q] = tracking_max_temperature
+        out[ROW_TRACKING_ENERGY, q] = tracking_energy
+        out[ROW_TRACKING_BANDWIDTH, q] = tracking_bandwidth
 
 
 #: Threaded (Numba prange) and serial (Dask workers) compilations of the same loop.
