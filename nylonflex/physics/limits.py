@@ -31,7 +31,7 @@ from .wrap import _muscle_length, _muscle_length_at, _nylon_force_and_slope, \
 __all__ = ["DESIGN_VARIABLES", "EFFICIENCY_BOUND", "MODELS", "VALIDITY_FLAGS", "design_limits",
            "model_bend_angle", "stroke_limit"]
 
-from ..variables import MODELS  # noqa: E402  (the registry holds the names)
+from ..variables import DESIGN, MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE, \
     FE_CALIBRATED = range(7)
 
@@ -60,30 +60,9 @@ COOLED_FRACTION = 0.05
 #: Relative shortfall below the free stroke that counts as load-limited [-].
 LOAD_RTOL = 1e-9
 
-#: The names :func:`design_limits` returns, in the cube's order (docs/interface.md).
-DESIGN_VARIABLES = (
-    "usable_stroke",
-    "limit",
-    "pressure_max",
-    "torque_max",
-    "tip_force_max",
-    "bend_angle_max",
-    "range_fraction",
-    "nylon_force_max",
-    "nylon_use",
-    "muscle_length",
-    "resistance",
-    "heating_power",
-    "heating_voltage",
-    "cooling_time",
-    "heating_time",
-    "cycle_time",
-    "cycle_rate",
-    "heating_energy",
-    "mechanical_work",
-    "efficiency",
-    "validity",
-)
+#: The names :func:`design_limits` returns, in the cube's order (docs/interface.md): the
+#: registry's, read from it (the kernels' output rows come from the same order).
+DESIGN_VARIABLES = tuple(DESIGN)
 
 #: Relative Newton step below which s_lim counts as converged [-].
 STROKE_RTOL = 1e-10
