@@ -31,23 +31,22 @@ __all__ = [
     "cooling_parameters",
     "SILICONE_PARAMETERS",
     "WALL_STRETCH_RANGE",
-    "WALL_STRETCH_RANGE",
     "Nylon",
     "FIELD_UNITS",
     "SHEAR_MODULUS_RANGE",
     "SILICONE_KINDS",
     "Silicone",
+    "NYLON_POSITIVE",
+    "NYLON_RANGES",
+    "NYLON_TABLES",
+    "SILICONE_RANGES",
+    "check_nylon",
     "check_shear_modulus",
+    "check_silicone",
     "silicone_kind",
     "nylon_parameters",
     "silicone_parameters",
 ]
-
-#: Stretch range [-] the actuators' walls reach, the window a silicone fit is made over by
-#: default (``nylonflex fit silicone``). D: the paper's two worked examples stretch the top
-#: fibre of the wall to about 1.2 (a = 20 mm) and 1.6 (a = 7.5 mm) at full stroke
-#: (docs/model.md s. 5); 2 leaves a margin above the stiffer of them.
-WALL_STRETCH_RANGE = (1.0, 2.0)
 
 #: Stretch range [-] the actuators' walls reach, the window a silicone fit is made over by
 #: default (``nylonflex fit silicone``). D: the paper's two worked examples stretch the top
@@ -601,19 +600,9 @@ def silicone_parameters(silicone="tc5005", **overrides) -> Silicone:
         return resolved
     name, p = resolved
     mu, alpha = _terms("mu", p["mu"]), _terms("alpha", p["alpha"])
-    if len(mu) != len(alpha):
-        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
-    if not all(np.isfinite(mu)) or any(abs(m) > SILICONE_RANGES["mu"] for m in mu):
-        raise ValueError(f"silicone.mu: each term must be finite and in "
-                         f"[-{SILICONE_RANGES['mu']:g}, {SILICONE_RANGES['mu']:g}] Pa")
-    if not all(np.isfinite(alpha)) or any(not 0 < abs(a) <= SILICONE_RANGES["alpha"]
-                                          for a in alpha):
-        raise ValueError(f"silicone.alpha: each term must be finite, non-zero and in "
-                         f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
-    mu0 = 0.5 * sum(m * a for m, a in zip(mu, alpha))
     base = silicone.get("set") if isinstance(silicone, Mapping) else silicone
-    check_shear_modulus(mu0, kind=_kind_name(p.get("kind", "any")),
-                        name=base if isinstance(base, str) else None)
+    check_silicone(mu, alpha, kind=_kind_name(p.get("kind", "any")),
+                   name=base if isinstance(base, str) else None)
     stretch_range = p.get("stretch_range", (0.0, float("inf")))
     try:
         lo, hi = (float(x) for x in stretch_range)
@@ -661,14 +650,76 @@ NYLON_RANGES = {
 SILICONE_RANGES = {"mu": 1e9, "alpha": 50.0, "mu0": SHEAR_MODULUS_RANGE}
 
 
-def _check_nylon_ranges(kwargs):
+#: Nylon fields that must be strictly positive (a zero fibre or heat capacity divides).
+NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_per_length",
+                  "heat_capacity_per_length", "heat_loss_per_length")
+#: The nylon set's per-coil-index tables (one row a coil index; columns last in an array).
+NYLON_TABLES = ("coil_index_table", "stroke_max_table", "tensile_strength_table")
+
+
+def _first(values, bad) -> str:
+    return f"{np.asarray(values)[np.broadcast_to(bad, np.shape(values))].flat[0]:g}"
+
+
+def check_nylon(values) -> None:
+    """The one validator of a nylon set's numbers: scalars, or arrays of one value a design
+    (a named set is the one-row case); each table's entries on its last axis.
+
+    ``values`` maps every numeric field of :class:`Nylon` (SI) to a number or an array.
+    The rules: :data:`NYLON_POSITIVE` > 0, every field inside :data:`NYLON_RANGES` (and
+    finite), t_max above t_amb, the coil-index table increasing with one s_max in (0, 1) and
+    one strength > 0 a row.
+
+    Raises
+    ------
+    ValueError
+        The first rule broken, one line naming the field and its accepted range.
+    """
+    v = {k: np.asarray(values[k], dtype=float) for k in (*NYLON_RANGES, "t_max", "t_amb")
+         if k in values}
+    for key in NYLON_POSITIVE:
+        bad = ~(v[key] > 0)  # NaN is not > 0
+        if np.any(bad):
+            raise ValueError(f"nylon.{key}: must be > 0, got {_first(v[key], bad)}")
     for key, (lo, hi, unit) in NYLON_RANGES.items():
-        values = kwargs[key] if key.endswith("_table") else (kwargs[key],)
-        for v in values:
-            if not (np.isfinite(v) and lo <= v <= hi):
-                u = f" {unit}" if unit else ""
-                raise ValueError(f"nylon.{key}: must be finite and in [{lo:g}, {hi:g}]{u}, "
-                                 f"got {v:g}")
+        bad = ~((v[key] >= lo) & (v[key] <= hi))
+        if np.any(bad):
+            raise ValueError(f"nylon.{key}: must be finite and in [{lo:g}, {hi:g}]"
+                             f"{' ' + unit if unit else ''}, got {_first(v[key], bad)}")
+    if np.any(~(v["t_max"] > v["t_amb"])):
+        raise ValueError("nylon.t_max: must be above nylon.t_amb")
+    c, smax, su = (np.atleast_1d(v[k]) for k in NYLON_TABLES)
+    if not (c.shape[-1] == smax.shape[-1] == su.shape[-1] >= 1) or \
+            np.any(np.diff(c, axis=-1) <= 0):
+        raise ValueError("nylon.coil_index_table: must increase, one s_max and sigma_u a row")
+    if np.any((smax <= 0) | (smax >= 1)):
+        raise ValueError("nylon.stroke_max_table: each s_max must be in (0, 1)")
+    if np.any(~(su > 0)):
+        raise ValueError("nylon.tensile_strength_table: each sigma_u must be > 0 Pa")
+
+
+def check_silicone(mu, alpha, kind="any", name=None) -> None:
+    """The one validator of Ogden constants: ``mu`` [Pa] and ``alpha`` [-] of shape
+    (..., terms) (a named set: one row), the same 1 to 6 terms, each term inside
+    :data:`SILICONE_RANGES` (alpha non-zero), and the initial shear modulus of each row in
+    its kind's range (:func:`check_shear_modulus`).
+
+    Raises
+    ------
+    ValueError
+        One line naming the field and its accepted range.
+    """
+    mu, alpha = np.asarray(mu, dtype=float), np.asarray(alpha, dtype=float)
+    if mu.ndim == 0 or alpha.ndim == 0 or mu.shape[-1] != alpha.shape[-1] or \
+            not 1 <= mu.shape[-1] <= 6:
+        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms")
+    if not np.all(np.abs(mu) <= SILICONE_RANGES["mu"]):  # NaN fails
+        raise ValueError(f"silicone.mu: each term must be finite and in "
+                         f"[-{SILICONE_RANGES['mu']:g}, {SILICONE_RANGES['mu']:g}] Pa")
+    if not np.all((np.abs(alpha) > 0) & (np.abs(alpha) <= SILICONE_RANGES["alpha"])):
+        raise ValueError(f"silicone.alpha: each term must be finite, non-zero and in "
+                         f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
+    check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1), kind=kind, name=name)
 
 
 def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
@@ -706,26 +757,6 @@ def nylon_parameters(nylon="silver_nylon66", **overrides) -> Nylon:
         if isinstance(v, bool) or (f.name.endswith("_table") and
                                    any(isinstance(x, bool) for x in v)):
             raise ValueError(f"nylon.{f.name}: must be a number, got {str(v).lower()}")
-    for key in (
-        "fibre_diameter",
-        "stroke_reference",
-        "sigma_g",
-        "resistance_per_length",
-        "heat_capacity_per_length",
-        "heat_loss_per_length",
-    ):
-        if not (np.isfinite(kwargs[key]) and kwargs[key] > 0):
-            raise ValueError(f"nylon.{key}: must be > 0, got {short(kwargs[key])}")
-    _check_nylon_ranges(kwargs)
-    if not kwargs["t_max"] > kwargs["t_amb"]:
-        raise ValueError("nylon.t_max: must be above nylon.t_amb")
-    c, smax, su = (kwargs[k] for k in ("coil_index_table", "stroke_max_table",
-                                        "tensile_strength_table"))
-    if not (len(c) == len(smax) == len(su) >= 1) or any(np.diff(c) <= 0):
-        raise ValueError("nylon.coil_index_table: must increase, one s_max and sigma_u a row")
-    if not all(0 < s < 1 for s in smax):
-        raise ValueError("nylon.stroke_max_table: each s_max must be in (0, 1)")
-    if not all(s > 0 for s in su):
-        raise ValueError("nylon.tensile_strength_table: each sigma_u must be > 0 Pa")
+    check_nylon(kwargs)
     return Nylon(name=name, description=p.get("description", ""),
                  sources=dict(p.get("sources", {})), **kwargs)

@@ -1,5 +1,6 @@
 import re
 
+import numpy as np
 import pytest
 
 from nylonflex.materials import (
@@ -131,3 +132,27 @@ def test_readme_docs_and_messages_quote_the_registrys_bounds():
         for kind in SILICONE_KINDS:
             assert f"`{kind}` {shear_modulus_range_text(kind)}" in text, (doc, kind)
         assert "100 Pa is refused" not in text and "[1 kPa, 100 MPa]" not in text
+
+
+@pytest.mark.parametrize("kind, field, bad, match", [
+    ("nylon", "fibre_diameter", -1e-4, r"^nylon\.fibre_diameter: must be > 0, got -0\.0001"),
+    ("nylon", "t_g", 900.0, r"^nylon\.t_g: must be finite and in \[150, 700\] K, got 900"),
+    ("nylon", "t_max", 250.0, r"^nylon\.t_max: must be above nylon\.t_amb"),
+    ("nylon", "heat_loss_per_length", 0.0, r"^nylon\.heat_loss_per_length: must be > 0, got 0"),
+    ("silicone", "mu", [2e9, 1e4], r"^silicone\.mu: each term must be finite and in"),
+    ("silicone", "alpha", [0.0, 2.0], r"^silicone\.alpha: each term must be finite, non-zero"),
+])
+def test_one_validator_for_a_named_set_and_for_arrays_of_designs(kind, field, bad, match):
+    # issue 28: a set is the one-row case of the arrays nf.evaluate takes; both paths run
+    # materials.check_nylon / check_silicone and refuse with the same line
+    import nylonflex as nf
+    from nylonflex.materials import nylon_parameters, silicone_parameters
+
+    base = {"set": "silver_nylon66" if kind == "nylon" else "tc5005"}
+    with pytest.raises(ValueError, match=match):
+        (nylon_parameters if kind == "nylon" else silicone_parameters)({**base, field: bad})
+    good = getattr(nylon_parameters() if kind == "nylon" else silicone_parameters(), field)
+    rows = np.array([np.asarray(good, float), np.asarray(bad, float)])  # a good and a bad row
+    with pytest.raises(ValueError, match=match):
+        nf.evaluate(np.array([10e-3, 12e-3]), 2e-3, 70e-3, 1.3, 0.14,
+                    **{kind: {**base, field: rows}})

@@ -20,8 +20,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
-from ..materials import (NYLON_PARAMETERS, SILICONE_PARAMETERS, Nylon, Silicone,
-                         check_shear_modulus, nylon_parameters, silicone_kind,
+from ..materials import (NYLON_PARAMETERS, NYLON_TABLES, SILICONE_PARAMETERS, Nylon, Silicone,
+                         check_nylon, check_silicone, nylon_parameters, silicone_kind,
                          silicone_parameters)
 from ..physics import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
@@ -42,9 +42,7 @@ _MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistan
                   "heat_capacity_per_length", "heat_loss_per_length",
                   "thermal_force_coefficient")
 _SILICONE_FIELDS = ("mu", "alpha")
-_NYLON_TABLES = ("coil_index_table", "stroke_max_table", "tensile_strength_table")
-_NYLON_POSITIVE = ("fibre_diameter", "stroke_reference", "sigma_g", "resistance_per_length",
-                   "heat_capacity_per_length", "heat_loss_per_length")
+_NYLON_TABLES = NYLON_TABLES
 
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
@@ -340,22 +338,12 @@ def _silicone_arrays(silicone):
     s = silicone_parameters({k: v for k, v in base.items()})  # the set and scalar fields
     mu = _as_array("silicone", "mu", arrays.get("mu", s.mu))
     alpha = _as_array("silicone", "alpha", arrays.get("alpha", s.alpha))
-    if mu.shape[-1] != alpha.shape[-1] or not 1 <= mu.shape[-1] <= 6:
+    if mu.shape[-1] != alpha.shape[-1]:
         raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms on the "
                          f"last axis, got shapes {mu.shape} and {alpha.shape}")
-    if np.any(alpha == 0):
-        raise ValueError("silicone.alpha: must be finite and non-zero")
-    from ..materials import SILICONE_RANGES
-
-    if np.any(np.abs(mu) > SILICONE_RANGES["mu"]):
-        raise ValueError(f"silicone.mu: each term must be in [-{SILICONE_RANGES['mu']:g}, "
-                         f"{SILICONE_RANGES['mu']:g}] Pa")
-    if np.any(np.abs(alpha) > SILICONE_RANGES["alpha"]):
-        raise ValueError(f"silicone.alpha: each term must be in "
-                         f"[-{SILICONE_RANGES['alpha']:g}, {SILICONE_RANGES['alpha']:g}]")
     name = base.get("set") if isinstance(base, Mapping) else None
-    check_shear_modulus(0.5 * np.sum(mu * alpha, axis=-1), kind=silicone_kind(base),
-                        name=name if isinstance(name, str) else None)
+    check_silicone(mu, alpha, kind=silicone_kind(base),
+                   name=name if isinstance(name, str) else None)
     return mu, alpha
 
 
@@ -380,25 +368,7 @@ def _nylon_arrays(nylon) -> dict:
         out[key] = _as_array("nylon", key, value)
     if not numeric and not arrays:
         return out
-    for key in _NYLON_POSITIVE:
-        if np.any(out[key] <= 0):
-            raise ValueError(f"nylon.{key}: must be > 0, got {out[key][out[key] <= 0].flat[0]:g}")
-    from ..materials import NYLON_RANGES
-
-    for key, (lo, hi, unit) in NYLON_RANGES.items():
-        bad = ~((out[key] >= lo) & (out[key] <= hi))
-        if np.any(bad):
-            raise ValueError(f"nylon.{key}: must be finite and in [{lo:g}, {hi:g}]"
-                             f"{' ' + unit if unit else ''}, got {out[key][bad].flat[0]:g}")
-    if np.any(out["t_max"] <= out["t_amb"]):
-        raise ValueError("nylon.t_max: must be above nylon.t_amb")
-    c, smax, su = (out[k] for k in _NYLON_TABLES)
-    if not (c.shape[-1] == smax.shape[-1] == su.shape[-1] >= 1) or np.any(np.diff(c) <= 0):
-        raise ValueError("nylon.coil_index_table: must increase, one s_max and sigma_u a row")
-    if np.any((smax <= 0) | (smax >= 1)):
-        raise ValueError("nylon.stroke_max_table: each s_max must be in (0, 1)")
-    if np.any(su <= 0):
-        raise ValueError("nylon.tensile_strength_table: each sigma_u must be > 0 Pa")
+    check_nylon(out)  # the named sets' own validator, on the arrays
     return out
 
 
