@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
            "THERMAL", "TRACKING", "UNCERTAIN",
-           "VARIABLES", "Variable", "label", "name_label", "quantile_name", "range_text",
+           "VARIABLES", "Variable", "validate", "label", "name_label", "quantile_name", "range_text",
            "slab_done_attrs", "to_display"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
@@ -415,3 +415,41 @@ def name_label(name: str, unit_note: str = "") -> str:
     'maximum tip force [N]'
     """
     return label(_Named(name), unit_note)
+
+
+def validate(ds) -> None:
+    """Check a cube against the registry (after sgkit's ``variables.validate``): every
+    variable or coordinate with a registered name has the registry's dimensions (a
+    model-dependent one may add ``model``, one the heat loss moves ``cooling``, in that
+    order), its SI units and its kind of dtype.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A cube (in memory or opened).
+
+    Raises
+    ------
+    ValueError
+        One line naming the first variable that disagrees and what the registry says.
+    """
+    kinds = {"float64": "f", "int8": "i", "str": "OSU"}
+    for name, var in ds.variables.items():
+        v = VARIABLES.get(name) or {"model": MODEL, "cooling": COOLING}.get(name)
+        if v is None:
+            continue
+        dims = tuple(var.dims)
+        extra = dims[len(v.dims):]
+        if dims[:len(v.dims)] != v.dims or list(extra) != [c for c in CATEGORIES if c in extra] \
+                or (extra and not v.by_model):
+            raise ValueError(f"cube: {name} has dimensions {dims}; the registry's are "
+                             f"{v.dims}{' (and model, cooling)' if v.by_model else ''}")
+        units = var.attrs.get("units")
+        if units is not None and str(units) != v.units:
+            raise ValueError(f"cube: {name} is in {units!r}; the registry's unit is "
+                             f"{v.units!r}")
+        # an incomplete cube's masked flags read as float (NaN where not computed)
+        allowed = kinds.get(v.dtype, "") + ("f" if v.dtype == "int8" else "")
+        if allowed and var.dtype.kind not in allowed:
+            raise ValueError(f"cube: {name} is stored as {var.dtype}; the registry's dtype "
+                             f"is {v.dtype}")

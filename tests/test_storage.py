@@ -321,3 +321,35 @@ def test_info_counts_the_flags_xarray_counts(tmp_path, incomplete):
     assert line.startswith(f"flagged   {flagged:,} of {total:,} design values")
     assert line.endswith(", ".join(f"{n} {c:,}" for n, c in zip(names, counts)))
     assert ("INCOMPLETE" in "\n".join(cube_summary(path))) == incomplete
+
+
+def test_a_cube_that_disagrees_with_the_registry_is_refused_on_open(tmp_path, capsys):
+    # issue 28: cubes are validated against the one variable table (variables.validate)
+    from helpers import write_cube
+
+    import nylonflex as nf
+    from nylonflex.cli import main
+    from nylonflex.variables import validate
+
+    raw = {"name": "v", "grid": {"radius": {"values": [10, 12], "units": "mm"},
+                                 "wall_thickness": {"values": [2], "units": "mm"},
+                                 "length": {"values": [70], "units": "mm"},
+                                 "coil_index": {"values": [1.3]},
+                                 "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                      "pressure": {"start": 0, "stop": 20, "num": 3, "units": "kPa"}}}
+    cube = write_cube(tmp_path, raw)
+    validate(nf.open_cube(cube))  # a sweep's own cube passes
+    with h5py.File(cube, "r+") as f:
+        f["tip_force_max"].attrs["units"] = "mN"
+    with pytest.raises(Exception, match=r"tip_force_max is in 'mN'; the registry's unit is 'N'"):
+        nf.open_cube(cube)
+    assert main(["query", str(cube), "--limit", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the registry's unit is 'N'" in err[0]
+    from nylonflex.config import parse_config
+
+    ds = nf.run_sweep(parse_config(raw))
+    with pytest.raises(ValueError, match=r"^cube: \w+ has dimensions \('wall_thickness', "
+                                         r"'radius'"):
+        validate(ds.transpose("wall_thickness", "radius", ...))

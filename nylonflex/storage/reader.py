@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from ..variables import AXES, CURVES, DESIGN, UNCERTAIN, is_complete
+from ..variables import AXES, CURVES, DESIGN, UNCERTAIN, is_complete, validate
 from .cube import require_filters
 from .journal import Journal
 
@@ -98,6 +98,11 @@ def open_cube(path, *, quiet: bool = False):
     ds = xr.open_dataset(path, engine="h5netcdf")
     for var in ds.variables.values():
         var.encoding = portable_encoding(var.encoding)
+    try:
+        validate(ds)  # the registry's dimensions, units and dtypes (metadata only)
+    except ValueError as err:
+        ds.close()
+        raise InputError(f"{path}: {err}") from None
     if not is_complete(attrs):
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
