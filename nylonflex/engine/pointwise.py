@@ -138,8 +138,8 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     width = d_f * (c_flat + 1.0)
     muscle = _single_muscle(nylon) if n == 1 and isinstance(nylon, str) else \
         [flat(ny[k]) for k in _MUSCLE_FIELDS]
-    r_per_len = np.vectorize(coil_resistance, otypes=[float])(
-        flat(ny["resistance_per_length"]), flat(ny["resistance_coil_index"]), c_flat)
+    r_per_len = _coil_resistances(flat(ny["resistance_per_length"]),
+                                  flat(ny["resistance_coil_index"]), c_flat)
     loss_per_len = _heat_loss(cooling, d_f, flat(ny["t_max"]), flat(ny["t_amb"]), c_flat,
                               flat(ny["heat_loss_per_length"]))
     options = (MODELS.index(model), voltage, stretch_max)
@@ -148,6 +148,18 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     check_supply_rise(voltage, out["muscle_length"], r_per_len.reshape(shape),
                       loss_per_len.reshape(shape), "supply_voltage")
     return out
+
+
+def _coil_resistances(r_ref, c_ref, c) -> np.ndarray:
+    """r'(C) [ohm/m] of each design (:func:`~nylonflex.physics.thermal.coil_resistance`, the
+    same bits), computed once per distinct coil index where the set's r'_ref and C_r are the
+    same for every design (a batch or a sampled slab repeats a few coil indices: the
+    Python-level formula once a design was a fifth of a sampled sweep's time)."""
+    if r_ref.size and np.all(r_ref == r_ref[0]) and np.all(c_ref == c_ref[0]):
+        values, where = np.unique(c, return_inverse=True)
+        one = np.array([coil_resistance(r_ref[0], c_ref[0], x) for x in values], dtype=float)
+        return one[where.reshape(-1)]
+    return np.vectorize(coil_resistance, otypes=[float])(r_ref, c_ref, c)
 
 
 def _heat_loss(cooling, d_f, t_max, t_amb, c, own):
