@@ -38,6 +38,7 @@ from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_E
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
                               _validity, _working_temperatures)
 from ..physics.nylon import _stroke_shape
+from ..physics.records import CoilRow, NodeTable, Ogden, Section, SolvedCurve, StrokeShape
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
@@ -83,6 +84,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     sigma_g = muscle.sigma_g[0]
     c_per_len = muscle.c_per_len[0]
     force_coeff = muscle.force_coeff[0]
+    shape = StrokeShape(t_amb, t_max, gamma, beta, t_g, sigma_g)
+    ogden = Ogden(mu, alpha)
     default = model == PAPER and voltage <= 0.0
     cauchy = model == CAUCHY_MOMENT
     top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
@@ -115,6 +118,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         wyy_nodes = np.empty(n_nodes)
         work = np.empty((MOMENT_WORK_ROWS, n_nodes))
         _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
+        section = Section(a, t, b)
+        table = NodeTable(y_nodes, wy_nodes, wyy_nodes, work)
         perimeter = _outer_perimeter(a, t, b)
         # the bend-angle curve first, with dkappa/dp and d2kappa/dp2: each solve starts from
         # the previous ones, and they start the coil loop's solves
@@ -134,6 +139,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * _curve_factor(
                     model, pressure[jp], a, t, length[il], mu, alpha)
                 out_tip[ia, it, il, jp] = moment / length[il]
+        curve = SolvedCurve(pressure, kappa_curve, rate_curve, rate2_curve)
         # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
         n_curve = npr if not cauchy else 0
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
@@ -145,6 +151,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
             loss_per_len = coil_loss[ic]
             tau = c_per_len / loss_per_len
             scale = s_max / top
+            coil_row = CoilRow(f_lim, s_max, scale, r_per_len, c_per_len, loss_per_len,
+                               force_coeff)
             kappa_full = 0.0
             if default:
                 p_full = _gauge_pressure(s_max, p_atm)
@@ -154,8 +162,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                                             rate2_curve, n_curve), NEWTON_RTOL, False)
                 # the working temperatures of a stroke-limited design (s* = s_max) depend
                 # on the coil index only: once per C, not per wrap angle
-                temps_full = _working_temperatures(model, s_max, t_max, scale, t_amb, t_max,
-                                                   gamma, beta, t_g, sigma_g)
+                temps_full = _working_temperatures(model, s_max, t_max, scale, shape)
             else:
                 temps_full = (0.0, 0.0, 0.0)
             for ip in range(npsi):
@@ -163,16 +170,13 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 cos_wrap = math.cos(wrap[ip])
                 lever = pitch / cos_wrap
                 if default:
-                    st = _stroke_state_nodes(a, t, b, lever, f_lim, s_max, kappa_full, mu,
-                                             alpha, y_nodes, wy_nodes, wyy_nodes, work,
-                                             p_atm, pressure, kappa_curve, rate_curve,
-                                             rate2_curve, n_curve)
+                    st = _stroke_state_nodes(section, lever, coil_row, kappa_full, ogden,
+                                             table, p_atm, curve, n_curve)
                     closes = False
                     if st[1] == 0:
                         temps = temps_full
                     else:
-                        temps = _working_temperatures(model, st[0], t_max, scale, t_amb,
-                                                      t_max, gamma, beta, t_g, sigma_g)
+                        temps = _working_temperatures(model, st[0], t_max, scale, shape)
                 else:
                     st = (0.0, 0, 0.0, 0.0, 0.0, 0.0, 0.0)
                     closes = False
@@ -182,18 +186,15 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                 cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                 for il in range(nl):
                     if not default and (il == 0 or voltage > 0.0):
-                        t_reach, s_free, limited = _reach(
-                            s_max, scale, length[il], pitch, a, t, b, wrap[ip], voltage,
-                            t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len, loss_per_len)
+                        t_reach, s_free, limited = _reach(coil_row, length[il], pitch, section,
+                                                          wrap[ip], voltage, shape)
                         ms = _model_state_nodes(
-                            model, a, t, b, lever, f_lim, s_free, s_max,
-                            force_coeff * (t_reach - t_amb), limited, mu, alpha, y_nodes,
-                            wy_nodes, wyy_nodes, work, p_atm, pressure, kappa_curve,
-                            rate_curve, rate2_curve, npr)
+                            model, section, lever, coil_row, s_free,
+                            force_coeff * (t_reach - t_amb), limited, ogden, table, p_atm,
+                            curve, npr)
                         st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
                         closes = ms[7]
-                        temps = _working_temperatures(model, ms[0], t_reach, scale, t_amb,
-                                                      t_max, gamma, beta, t_g, sigma_g)
+                        temps = _working_temperatures(model, ms[0], t_reach, scale, shape)
                         cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free
@@ -211,10 +212,10 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[ROW_RANGE_FRACTION, ia, it, il, ic, ip] = range_fraction
                     out_design[ROW_NYLON_FORCE_MAX, ia, it, il, ic, ip] = nylon_force_max
                     out_design[ROW_NYLON_USE, ia, it, il, ic, ip] = nylon_use
+                    thermal = _thermal_values_at(length[il], pitch, perimeter, cos_wrap,
+                                                 voltage, temps, t_amb, coil_row, tau, cooling)
                     (muscle_length, resistance, heating_power, heating_voltage, cooling_time,
-                     heating_time) = _thermal_values_at(length[il], pitch, perimeter, cos_wrap,
-                                                        voltage, temps[0], temps[2], t_amb,
-                                                        r_per_len, loss_per_len, tau, cooling)
+                     heating_time) = thermal
                     out_design[ROW_MUSCLE_LENGTH, ia, it, il, ic, ip] = muscle_length
                     out_design[ROW_RESISTANCE, ia, it, il, ic, ip] = resistance
                     out_design[ROW_HEATING_POWER, ia, it, il, ic, ip] = heating_power
@@ -222,17 +223,16 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                     out_design[ROW_COOLING_TIME, ia, it, il, ic, ip] = cooling_time
                     out_design[ROW_HEATING_TIME, ia, it, il, ic, ip] = heating_time
                     (cycle_time, cycle_rate, heating_energy, mechanical_work,
-                     efficiency) = _dynamic_values(model, usable_stroke, a, t, lever, solid, mu,
-                                                   alpha, p_atm, muscle_length, resistance,
-                                                   voltage, heating_time, temps[2], temps[1],
-                                                   t_amb, tau)
+                     efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid,
+                                                   ogden, p_atm, thermal, voltage, temps, t_amb,
+                                                   tau)
                     out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
                     out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
                     out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
                     out_design[ROW_MECHANICAL_WORK, ia, it, il, ic, ip] = mechanical_work
                     out_design[ROW_EFFICIENCY, ia, it, il, ic, ip] = efficiency
                     out_flags[ROW_VALIDITY, ia, it, il, ic, ip] = _validity(
-                        bend_angle_max, st[4] * lf, a, t, b, stretch_max, length[il] / pitch,
+                        bend_angle_max, st[4] * lf, section, stretch_max, length[il] / pitch,
                         closes, efficiency)
                 for js in range(ns):
                     if model == INCOMPRESSIBLE_WALL:
@@ -256,7 +256,6 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     radius, wall, base, length, wrap = designs
     s_max_all, f_lim_all, width_all, r_all, loss_all = coil
     mu_all, alpha_all = silicone
-    x_base, w_base, phi_trig, w_phi = nodes
     out_design, out_flags = out
     model, voltage, stretch_max = options
     t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
@@ -266,8 +265,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     step = 0 if mu_all.shape[0] == 1 else 1  # one row for all, or one a design
     for i in prange(n):
         row = i * step
-        mu = mu_all[row]
-        alpha = alpha_all[row]
+        ogden = Ogden(mu_all[row], alpha_all[row])
         a = radius[i]
         t = wall[i]
         b = base[i]
@@ -276,15 +274,17 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         s_max = s_max_all[i]
         t_amb = t_amb_all[i]
         t_max = t_max_all[i]
+        shape = StrokeShape(t_amb, t_max, gamma_all[i], beta_all[i], t_g_all[i],
+                            sigma_g_all[i])
         scale = s_max / _stroke_shape(t_max, t_amb, gamma_all[i], beta_all[i], t_g_all[i],
                                       sigma_g_all[i])
+        coil_row = CoilRow(f_lim, s_max, scale, r_all[i], c_all[i], loss_all[i], coeff_all[i])
+        section = Section(a, t, b)
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
         # one call, no branch in the prange body (writes after a branch were lost)
-        st = _design_state(model, voltage, a, t, b, length[i], psi, pitch, lever, f_lim, s_max,
-                           scale, t_amb, t_max, gamma_all[i], beta_all[i], t_g_all[i],
-                           sigma_g_all[i], r_all[i], loss_all[i], coeff_all[i], mu, alpha,
-                           x_base, w_base, phi_trig, w_phi, p_atm)
+        st = _design_state(model, voltage, section, length[i], psi, pitch, lever, coil_row,
+                           shape, ogden, nodes, p_atm)
         (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
          range_fraction, nylon_force_max, nylon_use) = _design_values(
             st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
@@ -297,12 +297,11 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         out_design[ROW_RANGE_FRACTION, i] = range_fraction
         out_design[ROW_NYLON_FORCE_MAX, i] = nylon_force_max
         out_design[ROW_NYLON_USE, i] = nylon_use
-        temps = _working_temperatures(model, usable_stroke, st[8], scale, t_amb, t_max,
-                                      gamma_all[i], beta_all[i], t_g_all[i], sigma_g_all[i])
+        temps = _working_temperatures(model, usable_stroke, st[8], scale, shape)
+        thermal = _thermal_values(length[i], pitch, section, psi, voltage, temps, t_amb,
+                                  coil_row)
         (muscle_length, resistance, heating_power, heating_voltage, cooling_time,
-         heating_time) = _thermal_values(length[i], pitch, a, t, b, psi, voltage, temps[0],
-                                         temps[1], temps[2], t_amb, r_all[i], c_all[i],
-                                         loss_all[i])
+         heating_time) = thermal
         out_design[ROW_MUSCLE_LENGTH, i] = muscle_length
         out_design[ROW_RESISTANCE, i] = resistance
         out_design[ROW_HEATING_POWER, i] = heating_power
@@ -311,15 +310,15 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         out_design[ROW_HEATING_TIME, i] = heating_time
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         (cycle_time, cycle_rate, heating_energy, mechanical_work,
-         efficiency) = _dynamic_values(model, usable_stroke, a, t, lever, solid, mu, alpha,
-                                       p_atm, muscle_length, resistance, voltage, heating_time,
-                                       temps[2], temps[1], t_amb, c_all[i] / loss_all[i])
+         efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid, ogden,
+                                       p_atm, thermal, voltage, temps, t_amb,
+                                       c_all[i] / loss_all[i])
         out_design[ROW_CYCLE_TIME, i] = cycle_time
         out_design[ROW_CYCLE_RATE, i] = cycle_rate
         out_design[ROW_HEATING_ENERGY, i] = heating_energy
         out_design[ROW_MECHANICAL_WORK, i] = mechanical_work
         out_design[ROW_EFFICIENCY, i] = efficiency
-        out_flags[ROW_VALIDITY, i] = _validity(bend_angle_max, st[4], a, t, b, stretch_max,
+        out_flags[ROW_VALIDITY, i] = _validity(bend_angle_max, st[4], section, stretch_max,
                                                length[i] / pitch, st[7], efficiency)
 
 

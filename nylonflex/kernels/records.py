@@ -9,16 +9,15 @@ from __future__ import annotations
 
 from collections import namedtuple
 
+from ..physics.records import Nodes, Ogden
+
 __all__ = ["AngleTables", "CoilTable", "Control", "GridAxes", "GridOut", "Muscle", "Muscles",
            "Nodes", "Ogden", "Options", "PointDesigns", "PointOut", "SimOut", "Supply"]
 
-#: Ogden constants of one silicone: ``mu`` [Pa] and ``alpha`` [-], one entry per term.
-#: The pointwise kernel takes 2-D arrays (sample, term) with one row or one row a design.
-Ogden = namedtuple("Ogden", "mu alpha")
-
-#: Gauss-Legendre nodes and weights on [-1, 1] of the material moment: the base layer's
-#: and each half disc's (``physics.bending.quadrature_nodes``).
-Nodes = namedtuple("Nodes", "x_base w_base phi_trig w_phi")
+# Ogden (``mu`` [Pa], ``alpha`` [-], one entry per term; the pointwise kernel takes 2-D
+# arrays (sample, term) with one row or one row a design) and Nodes (the quadrature of the
+# material moment) are the physics layer's records (:mod:`nylonflex.physics.records`),
+# which the formulas take too.
 
 #: The axes of a slab of the design grid: ``radius`` (the slab's radii), ``wall``,
 #: ``length``, ``wrap`` [m, m, m, rad]; ``base_thickness`` [m] (<= 0: b = t); the curve axes

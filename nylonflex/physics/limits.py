@@ -22,6 +22,7 @@ from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
+from .records import CoilRow, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from .thermal import _cooling_time, _heating_power, _heating_time, \
     _steady_temperature, check_supply_rise, coil_heat_loss_per_length, coil_resistance
@@ -186,33 +187,41 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
 
 
 @formula
-def _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
-                 s_max, force_blocked, supply_limited, mu, alpha, x_base, w_base, phi_trig,
-                 w_phi, p_atm):
+def _model_state(model, section, lever, coil, s_free, force_blocked, supply_limited, ogden,
+                 nodes, p_atm):
     """The length-free design limits of a model variant, with a reachable free stroke.
 
-    ``s_free`` is the free stroke at the reachable temperature (s_max without a supply),
-    ``force_blocked`` F_b = c (T - T_amb) at that temperature (``coupled_muscle``),
-    ``supply_limited`` whether the supply keeps the muscle below T_max. Returns
-    (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0 stroke, 1 strength,
-    2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes`` (``incompressible_wall``) when
-    the chamber would close before s_max, and then kappa_full is inf (range fraction 0).
+    ``section`` a :class:`~.records.Section`, ``lever`` the wrap's pitch over cos psi [m],
+    ``coil`` the :class:`~.records.CoilRow` (F_lim, s_max), ``ogden`` the silicone's
+    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
+    the initial chamber pressure [Pa]. ``s_free`` is the free stroke at the reachable
+    temperature (s_max without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that
+    temperature (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle
+    below T_max. Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0
+    stroke, 1 strength, 2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes``
+    (``incompressible_wall``) when the chamber would close before s_max, and then kappa_full
+    is inf (range fraction 0).
     """
-    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                                   phi_trig, w_phi)
-    return _model_state_nodes(model, radius, wall_thickness, base_thickness, lever,
-                              force_limit, s_free, s_max, force_blocked, supply_limited, mu,
-                              alpha, y, wy, wyy, work, p_atm, y, y, y, y, 0)
+    y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
+                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
+    return _model_state_nodes(model, section, lever, coil, s_free, force_blocked,
+                              supply_limited, ogden, NodeTable(y, wy, wyy, work), p_atm,
+                              SolvedCurve(y, y, y, y), 0)
 
 
 @formula
-def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, force_limit,
-                       s_free, s_max, force_blocked, supply_limited, mu, alpha, y, wy, wyy,
-                       work, p_atm, pressures, kappas, rates, rates2, n):
-    """:func:`_model_state` on a section's node table and scratch, with ``n`` solved points
-    of the model's kappa(p) to start the curvature solves from (:func:`_stroke_state_nodes`;
-    none: ``n`` = 0, the full-stroke solve from its own start and the strength-limited one
-    from a second-order Taylor of it)."""
+def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
+                       ogden, table, p_atm, curve, n):
+    """:func:`_model_state` on a section's node table and scratch (``table``, a
+    :class:`~.records.NodeTable`), with ``n`` solved points of the model's kappa(p) in
+    ``curve`` (a :class:`~.records.SolvedCurve`) to start the curvature solves from
+    (:func:`_stroke_state_nodes`; none: ``n`` = 0, the full-stroke solve from its own start
+    and the strength-limited one from a second-order Taylor of it)."""
+    radius, wall_thickness, base_thickness = section.radius, section.wall, section.base
+    force_limit, s_max = coil.force_limit, coil.s_max
+    mu, alpha = ogden.mu, ogden.alpha
+    y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
+    pressures, kappas, rates, rates2 = curve.pressure, curve.kappa, curve.rate, curve.rate2
     cauchy = model == CAUCHY_MOMENT
     solid = 0.0
     closes = False
@@ -270,28 +279,28 @@ def _model_state_nodes(model, radius, wall_thickness, base_thickness, lever, for
 
 
 @formula
-def _design_state(model, voltage, radius, wall_thickness, base_thickness, length, wrap_angle,
-                  pitch, lever, force_limit, s_max, coil_scale, t_amb, t_max, gamma, beta, t_g, sigma_g,
-                  r_per_len, loss_per_len, force_coeff, mu, alpha, x_base, w_base, phi_trig,
-                  w_phi, p_atm):
+def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coil, shape,
+                  ogden, nodes, p_atm):
     """The stroke state of one design in any model, with or without a supply.
+
+    ``voltage`` the supply [V] (<= 0: none), ``section`` a :class:`~.records.Section`,
+    ``length`` L [m], ``wrap_angle`` psi [rad], ``pitch`` of the wrap and ``lever`` pitch
+    over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of its coil index, ``shape``
+    the muscle's :class:`~.records.StrokeShape`, ``ogden`` the silicone's
+    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
+    the initial chamber pressure [Pa].
 
     Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
     model without a supply is :func:`_stroke_state` itself; otherwise :func:`_model_state`
     at the reachable temperature (:func:`_reach`).
     """
     if model == PAPER and voltage <= 0.0:
-        st = _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                           0.0, mu, alpha, x_base, w_base, phi_trig, w_phi, p_atm)
-        return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, t_max
-    t_reach, s_free, limited = _reach(s_max, coil_scale, length, pitch, radius,
-                                      wall_thickness, base_thickness, wrap_angle, voltage,
-                                      t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len,
-                                      loss_per_len)
-    ms = _model_state(model, radius, wall_thickness, base_thickness, lever, force_limit, s_free,
-                      s_max, force_coeff * (t_reach - t_amb), limited, mu, alpha, x_base,
-                      w_base, phi_trig, w_phi, p_atm)
-    lf = _length_factor(model, radius, length)
+        st = _stroke_state(section, lever, coil, 0.0, ogden, nodes, p_atm)
+        return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, shape.t_max
+    t_reach, s_free, limited = _reach(coil, length, pitch, section, wrap_angle, voltage, shape)
+    ms = _model_state(model, section, lever, coil, s_free,
+                      coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, nodes, p_atm)
+    lf = _length_factor(model, section.radius, length)
     return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
 
 
@@ -323,31 +332,35 @@ def _nylon_pressure(model, stroke, p_atm, solid):
 
 
 @formula
-def _reach(s_max, coil_scale, length, pitch, radius, wall_thickness, base_thickness,
-           wrap_angle, voltage, t_amb, t_max, gamma, beta, t_g, sigma_g, r_per_len,
-           loss_per_len):
+def _reach(coil, length, pitch, section, wrap_angle, voltage, shape):
     """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
 
-    ``voltage`` <= 0: no supply, T_max and s_max itself (docs/model.md s. 15).
+    ``coil`` a :class:`~.records.CoilRow`, ``length`` L and ``pitch`` [m], ``section`` a
+    :class:`~.records.Section`, ``wrap_angle`` psi [rad], ``voltage`` the supply [V],
+    ``shape`` the :class:`~.records.StrokeShape`. ``voltage`` <= 0: no supply, T_max and
+    s_max itself (docs/model.md s. 15).
     """
     if voltage > 0.0:
-        l_m = _muscle_length(length, pitch, radius, wall_thickness, base_thickness,
+        l_m = _muscle_length(length, pitch, section.radius, section.wall, section.base,
                              wrap_angle)
-        t_ss = _steady_temperature(voltage, l_m, t_amb, r_per_len, loss_per_len)
-        if t_ss < t_max:
-            return t_ss, _free_stroke(t_ss, coil_scale, t_amb, gamma, beta, t_g,
-                                      sigma_g), True
-    return t_max, s_max, False
+        t_ss = _steady_temperature(voltage, l_m, shape.t_amb, coil.r_per_len,
+                                   coil.loss_per_len)
+        if t_ss < shape.t_max:
+            return t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma, shape.beta,
+                                      shape.t_g, shape.sigma_g), True
+    return shape.t_max, coil.s_max, False
 
 
 @formula
-def _working_temperatures(model, s_star, t_reach, coil_scale, t_amb, t_max, gamma, beta, t_g,
-                          sigma_g):
+def _working_temperatures(model, s_star, t_reach, coil_scale, shape):
     """T* [K], and the temperatures where the free stroke is 5 % and 95 % of s(T*) [K].
 
-    T* is the temperature whose free stroke (eq. 2) is s* (in ``coupled_muscle``: the
-    reachable temperature it is heated to; docs/model.md s. 15).
+    T* is the temperature whose free stroke (eq. 2, ``coil_scale`` [-] times the
+    :class:`~.records.StrokeShape` ``shape``) is s* (in ``coupled_muscle``: the reachable
+    temperature ``t_reach`` [K] it is heated to; docs/model.md s. 15). Returns
+    (T*, T_5, T_95), the ``temps`` of :func:`_thermal_values` and :func:`_dynamic_values`.
     """
+    t_amb, t_max, gamma, beta, t_g, sigma_g = shape
     if model == COUPLED_MUSCLE:
         t_work = t_reach
     else:
@@ -362,27 +375,33 @@ def _working_temperatures(model, s_star, t_reach, coil_scale, t_amb, t_max, gamm
 
 
 @formula
-def _thermal_values(length, pitch, radius, wall_thickness, base_thickness, wrap_angle, voltage,
-                    t_work, t_cool, t_hot, t_amb, r_per_len, c_per_len, loss_per_len):
+def _thermal_values(length, pitch, section, wrap_angle, voltage, temps, t_amb, coil):
     """muscle_length, resistance, heating_power, heating_voltage, cooling_time, heating_time.
 
-    At the working temperature T* (:func:`_working_temperatures`); heating_time is NaN
-    without a supply (``voltage`` <= 0; docs/model.md s. 15).
+    Of a design of length L and wrap ``pitch`` [m], ``section`` (a
+    :class:`~.records.Section`), wrap angle psi [rad] and supply ``voltage`` [V], at the
+    working temperatures ``temps`` (T*, T_5, T_95) [K] of :func:`_working_temperatures`,
+    ambient ``t_amb`` [K] and the coil index's r', c', lambda' (``coil``, a
+    :class:`~.records.CoilRow`); heating_time is NaN without a supply (``voltage`` <= 0;
+    docs/model.md s. 15).
     """
-    tau = c_per_len / loss_per_len
-    return _thermal_values_at(length, pitch, _outer_perimeter(radius, wall_thickness,
-                                                              base_thickness),
-                              math.cos(wrap_angle), voltage, t_work, t_hot, t_amb, r_per_len,
-                              loss_per_len, tau, _cooling_time(t_work, t_cool, t_amb, tau))
+    t_work, t_cool = temps[0], temps[1]
+    tau = coil.c_per_len / coil.loss_per_len
+    return _thermal_values_at(length, pitch, _outer_perimeter(section.radius, section.wall,
+                                                              section.base),
+                              math.cos(wrap_angle), voltage, temps, t_amb, coil, tau,
+                              _cooling_time(t_work, t_cool, t_amb, tau))
 
 
 @formula
-def _thermal_values_at(length, pitch, perimeter, cos_wrap, voltage, t_work, t_hot, t_amb,
-                       r_per_len, loss_per_len, tau, cooling):
+def _thermal_values_at(length, pitch, perimeter, cos_wrap, voltage, temps, t_amb, coil, tau,
+                       cooling):
     """:func:`_thermal_values` from the parts that do not depend on the length: the outer
     perimeter [m], cos psi [-], the time constant tau = c'/lambda' [s] and the cooling time
     [s]. The grid kernel computes them once for all lengths (the same operations, the same
     bits)."""
+    t_work, t_hot = temps[0], temps[2]
+    r_per_len, loss_per_len = coil.r_per_len, coil.loss_per_len
     l_m = _muscle_length_at(length, pitch, perimeter, cos_wrap)
     r = r_per_len * l_m
     power = _heating_power(t_work, l_m, t_amb, loss_per_len)
@@ -410,9 +429,16 @@ def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha,
 
 
 @formula
-def _dynamic_values(model, s_star, radius, wall_thickness, lever, solid, mu, alpha, p_atm,
-                    muscle_length, resistance, voltage, heating, t_hot, t_cool, t_amb, tau):
+def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, thermal, voltage,
+                    temps, t_amb, tau):
     """cycle_time [s], cycle_rate [Hz], heating_energy [J], mechanical_work [J], efficiency.
+
+    Of a design with usable stroke ``s_star`` [-], ``section`` (a
+    :class:`~.records.Section`), ``lever`` [m], solid fraction ``solid`` [-]
+    (``incompressible_wall``, else 0), silicone ``ogden`` (an :class:`~.records.Ogden`),
+    initial chamber pressure ``p_atm`` [Pa], its ``thermal`` values (the six of
+    :func:`_thermal_values`), working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
+    ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s].
 
     With a supply V (``voltage`` > 0; NaN without): the cycle heats at V from ambient to
     95 % of the working stroke (``heating``, the heating time to T_95) and cools from there
@@ -422,17 +448,20 @@ def _dynamic_values(model, s_star, radius, wall_thickness, lever, solid, mu, alp
     """
     if not voltage > 0.0:
         return math.nan, math.nan, math.nan, math.nan, math.nan
-    cycle = heating + _cooling_time(t_hot, t_cool, t_amb, tau)
+    muscle_length, resistance, heating = thermal[0], thermal[1], thermal[5]
+    cycle = heating + _cooling_time(temps[2], temps[1], t_amb, tau)
     energy = voltage * voltage / resistance * heating
-    work = muscle_length * _stroke_work(model, s_star, radius, wall_thickness, lever, solid,
-                                        mu, alpha, p_atm)
+    work = muscle_length * _stroke_work(model, s_star, section.radius, section.wall, lever,
+                                        solid, ogden.mu, ogden.alpha, p_atm)
     return cycle, 1.0 / cycle, energy, work, work / energy
 
 
 @formula
-def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch_max,
-              turns, closes, efficiency):
-    """The ``validity`` bits (docs/model.md s. 17): 1 self contact (theta* > 2 pi), 2 the
+def _validity(bend_angle, kappa, section, stretch_max, turns, closes, efficiency):
+    """The ``validity`` bits (docs/model.md s. 17) of a design with bend angle theta* [rad],
+    curvature kappa* [1/m], ``section`` (a :class:`~.records.Section`), the silicone's
+    fitted ``stretch_max`` [-], wrap ``turns`` [-], ``closes`` and ``efficiency`` [-]: 1
+    self contact (theta* > 2 pi), 2 the
     largest axial stretch 1 + kappa* (b + a + t) beyond the silicone's fitted range, 4 fewer
     than one turn of wrap, 8 the chamber closes (``incompressible_wall``), 16 the efficiency
     above :data:`EFFICIENCY_BOUND` (NaN without a supply: never set)."""
@@ -441,7 +470,7 @@ def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch
         flags += 16
     if bend_angle > 2.0 * math.pi:
         flags += 1
-    if 1.0 + kappa * (base_thickness + radius + wall_thickness) > stretch_max:
+    if 1.0 + kappa * (section.base + section.radius + section.wall) > stretch_max:
         flags += 2
     if turns < 1.0:
         flags += 4
@@ -451,29 +480,33 @@ def _validity(bend_angle, kappa, radius, wall_thickness, base_thickness, stretch
 
 
 @formula
-def _stroke_state(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                  kappa_full, mu, alpha, x_base, w_base, phi_trig, w_phi, p_atm):
+def _stroke_state(section, lever, coil, kappa_full, ogden, nodes, p_atm):
     """The length-free part of the design limits.
 
-    ``kappa_full`` is the curvature at p(s_max) (<= 0: computed here). Returns
+    ``section`` a :class:`~.records.Section`, ``lever`` [m], ``coil`` the
+    :class:`~.records.CoilRow` (F_lim, s_max), ``ogden`` the silicone's
+    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
+    [Pa]. ``kappa_full`` is the curvature at p(s_max) [1/m] (<= 0: computed here). Returns
     (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full).
     """
-    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                                   phi_trig, w_phi)
-    return _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit,
-                               s_max, kappa_full, mu, alpha, y, wy, wyy, work, p_atm, y, y, y,
-                               y, 0)
+    y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
+                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
+    return _stroke_state_nodes(section, lever, coil, kappa_full, ogden,
+                               NodeTable(y, wy, wyy, work), p_atm, SolvedCurve(y, y, y, y), 0)
 
 
 @formula
-def _stroke_state_nodes(radius, wall_thickness, base_thickness, lever, force_limit, s_max,
-                        kappa_full, mu, alpha, y, wy, wyy, work, p_atm, pressures, kappas,
-                        rates, rates2, n):
-    """:func:`_stroke_state` on a section's node table and scratch (:func:`_section_moment`),
-    with ``n`` solved points of kappa(p)
-    and its first two derivatives in p (``pressures[:n]``, ``kappas[:n]``, ``rates[:n]``,
-    ``rates2[:n]``, :func:`_curvature_start`) to start the curvature solves from (none:
-    ``n`` = 0)."""
+def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, curve, n):
+    """:func:`_stroke_state` on a section's node table and scratch (``table``, a
+    :class:`~.records.NodeTable`; :func:`_section_moment`), with ``n`` solved points of
+    kappa(p) and its first two derivatives in p (``curve``, a :class:`~.records.SolvedCurve`
+    whose first ``n`` entries count, :func:`_curvature_start`) to start the curvature solves
+    from (none: ``n`` = 0)."""
+    radius, wall_thickness, base_thickness = section.radius, section.wall, section.base
+    force_limit, s_max = coil.force_limit, coil.s_max
+    mu, alpha = ogden.mu, ogden.alpha
+    y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
+    pressures, kappas, rates, rates2 = curve.pressure, curve.kappa, curve.rate, curve.rate2
     p_full = _gauge_pressure(s_max, p_atm)
     solved = kappa_full <= 0.0
     rate_full = 0.0
@@ -616,10 +649,12 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     a, t, L, c, psi, b = _inputs(radius, wall_thickness, length, coil_index, wrap_angle,
                                  base_thickness, ny)
     a, t, L, c, psi, b = np.broadcast_arrays(a, t, L, c, psi, b)
-    nodes = quadrature_nodes()
+    ogden = Ogden(mu, alpha)
+    nodes = Nodes(*quadrature_nodes())
     c_tab = np.asarray(ny.coil_index_table)
-    shape_args = (ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
-    top = _stroke_shape(ny.t_max, *shape_args)
+    shape = StrokeShape(ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
+    top = _stroke_shape(shape.t_max, shape.t_amb, shape.gamma, shape.beta, shape.t_g,
+                        shape.sigma_g)
     out = {name: np.empty(a.shape, dtype=np.int8 if name in ("limit", "validity") else float)
            for name in DESIGN_VARIABLES}
     r_all, loss_all = np.empty(a.shape), np.empty(a.shape)
@@ -632,22 +667,19 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         s_max = float(np.interp(ci, c_tab, ny.stroke_max_table))
         pitch = _pitch(ai, ti, bi, pi, ny.fibre_diameter * (ci + 1.0))
         lever = pitch / math.cos(pi)
-        *state, closes, t_reach = _design_state(
-            code, voltage, ai, ti, bi, Li, pi, pitch, lever, force_limit, s_max, s_max / top,
-            ny.t_amb, ny.t_max, ny.gamma, ny.beta, ny.t_g, ny.sigma_g,
-            r_per_len, loss_per_len, ny.thermal_force_coefficient,
-            mu, alpha, *nodes, P_ATM)
+        section = Section(ai, ti, bi)
+        coil = CoilRow(force_limit, s_max, s_max / top, r_per_len,
+                       ny.heat_capacity_per_length, loss_per_len, ny.thermal_force_coefficient)
+        *state, closes, t_reach = _design_state(code, voltage, section, Li, pi, pitch, lever,
+                                                coil, shape, ogden, nodes, P_ATM)
         values = _design_values(*state, force_limit, Li)
-        temps = _working_temperatures(code, values[0], t_reach, s_max / top, *shape_args[:1],
-                                      ny.t_max, *shape_args[1:])
-        thermal = _thermal_values(Li, pitch, ai, ti, bi, pi, voltage, *temps, ny.t_amb,
-                                  r_per_len, ny.heat_capacity_per_length, loss_per_len)
+        temps = _working_temperatures(code, values[0], t_reach, coil.scale, shape)
+        thermal = _thermal_values(Li, pitch, section, pi, voltage, temps, shape.t_amb, coil)
         solid = _solid_fraction(ai, ti, bi) if code == INCOMPRESSIBLE_WALL else 0.0
-        dynamic = _dynamic_values(code, values[0], ai, ti, lever, solid, mu, alpha, P_ATM,
-                                  thermal[0], thermal[1], voltage, thermal[5], temps[2],
-                                  temps[1], ny.t_amb,
-                                  ny.heat_capacity_per_length / loss_per_len)
-        flags = _validity(values[5], state[4], ai, ti, bi, stretch_max, Li / pitch, closes,
+        dynamic = _dynamic_values(code, values[0], section, lever, solid, ogden, P_ATM, thermal,
+                                  voltage, temps, shape.t_amb,
+                                  coil.c_per_len / coil.loss_per_len)
+        flags = _validity(values[5], state[4], section, stretch_max, Li / pitch, closes,
                           dynamic[4])
         r_all[idx], loss_all[idx] = r_per_len, loss_per_len
         for name, v in zip(DESIGN_VARIABLES, (*values, *thermal, *dynamic, flags)):

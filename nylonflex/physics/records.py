@@ -1,0 +1,53 @@
+"""Named records that the orchestration formulas of :mod:`.limits` take (issue 28).
+
+Plain :func:`collections.namedtuple` types, so that a group of values that always travel
+together is one argument with named fields instead of a run of positional floats, where a
+swapped pair would compile and run silently wrong. The uncompiled path builds them in
+Python; the kernels build them in compiled code, where Numba passes a namedtuple as a tuple
+with named fields and a field read costs nothing. The innermost formulas (stresses,
+pressures, the curvature and stroke solves) keep their plain arguments. SI units.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+__all__ = ["CoilRow", "NodeTable", "Nodes", "Ogden", "Section", "SolvedCurve", "StrokeShape"]
+
+#: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
+#: (bottom layer) thickness b [m] (docs/model.md s. 1).
+Section = namedtuple("Section", "radius wall base")
+
+#: The muscle's free-stroke shape, eq. (2) (docs/model.md s. 9): ambient ``t_amb`` and
+#: highest working temperature ``t_max`` [K], ``gamma`` [1/K], ``beta`` [-], the glass
+#: transition ``t_g`` and its width ``sigma_g`` [K].
+StrokeShape = namedtuple("StrokeShape", "t_amb t_max gamma beta t_g sigma_g")
+
+#: The muscle's values at one coil index C: ``force_limit`` F_lim [N], the largest stroke
+#: ``s_max`` [-], ``scale`` s_max over the stroke shape at T_max [-] (eq. 2), ``r_per_len``
+#: r' [ohm/m], ``c_per_len`` c' [J/(K m)], ``loss_per_len`` lambda' [W/(K m)] and
+#: ``force_coeff`` c of eq. (1) [N/K] (docs/model.md s. 9, 15).
+CoilRow = namedtuple("CoilRow", "force_limit s_max scale r_per_len c_per_len loss_per_len "
+                                "force_coeff")
+
+#: Ogden constants of one silicone: ``mu`` [Pa] and ``alpha`` [-], one entry per term
+#: (docs/model.md s. 5). The pointwise kernel's record of the same name holds 2-D arrays
+#: (row, term); the formulas take one row.
+Ogden = namedtuple("Ogden", "mu alpha")
+
+#: Gauss-Legendre nodes and weights on [-1, 1] of the material moment: the base layer's
+#: ``x_base``, ``w_base`` and each half disc's ``phi_trig`` (cos and sin of its nodes,
+#: shape (2, n)) and ``w_phi`` [-] (:func:`~.bending.quadrature_nodes`).
+Nodes = namedtuple("Nodes", "x_base w_base phi_trig w_phi")
+
+#: A section's node table (:func:`~.bending._node_table`): node heights ``y`` [m] and
+#: weights ``wy`` [m^3] and ``wyy`` (M_S = sum wy S, dM_S/dkappa = sum wyy S';
+#: :func:`~.bending._section_nodes`), and the solver's scratch ``work`` (shape
+#: (MOMENT_WORK_ROWS, n)).
+NodeTable = namedtuple("NodeTable", "y wy wyy work")
+
+#: Solved points of a section's kappa(p) that start later curvature solves
+#: (:func:`~.bending._curvature_start`): ``pressure`` [Pa], ``kappa`` [1/m], ``rate``
+#: dkappa/dp [1/(m Pa)] and ``rate2`` d2kappa/dp2 [1/(m Pa^2)]; the first ``n`` entries
+#: count (``n`` passed beside it).
+SolvedCurve = namedtuple("SolvedCurve", "pressure kappa rate rate2")
