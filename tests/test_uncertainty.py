@@ -341,3 +341,35 @@ def test_sampled_sweep_on_dask_and_resumed_equals_local(tmp_path):
             np.testing.assert_allclose(ds[name].values, want[name].values, rtol=1e-12,
                                        err_msg=f"{which} {name}")
     resumed.close()
+
+
+@pytest.mark.parametrize("silicone", ["tc5005", "elastosil_m4601", "dragon_skin_10",
+                                      {"file": "configs/fits/ecoflex_0050_ogden2.yaml"}])
+def test_perturbed_silicone_keeps_the_cubes_own_set(silicone):
+    # the samples' Ogden constants move; the set's stiffness kind and fitted stretch range
+    # (stretch_beyond_fit) stay the cube's own, not tc5005's
+    from nylonflex.engine.pointwise import _materials
+    from nylonflex.engine.sampled import perturbed_inputs
+
+    raw = {"name": "s", "silicone": silicone,
+           "grid": {"radius": {"values": [10], "units": "mm"},
+                    "wall_thickness": {"values": [2], "units": "mm"},
+                    "length": {"values": [70], "units": "mm"}, "coil_index": {"values": [1.3]},
+                    "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                      "pressure": {"start": 0, "stop": 20, "num": 3, "units": "kPa"}},
+           "uncertainty": {"samples": 8, "seed": 1,
+                           "parameters": {"silicone.mu": {"rel_sd": 0.1}}}}
+    cfg = parse_config(raw)
+    kw = perturbed_inputs({k: np.array([v[0]]) for k, v in cfg.axes.items()}, cfg,
+                          standard_samples(cfg.uncertainty))
+    _, stretch_max, _ = _materials(kw["silicone"], kw["nylon"])
+    assert stretch_max == cfg.silicone.stretch_range[1]
+    # the nominal sample (z = 0) is the grid's design, flags included
+    nominal = perturbed_inputs({k: np.array([v[0]]) for k, v in cfg.axes.items()}, cfg,
+                               np.zeros((1, 1)))
+    one = nf.evaluate(**nominal)
+    grid = nf.run_sweep(parse_config({k: v for k, v in raw.items() if k != "uncertainty"}))
+    for name in ("validity", "tip_force_max", "bend_angle_max"):
+        assert float(np.ravel(one[name])[0]) == pytest.approx(
+            float(grid[name].values.reshape(-1)[0]), rel=1e-10), name

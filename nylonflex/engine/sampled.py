@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import ResolvedConfig, UncertaintySpec
+from ..materials import SILICONE_PARAMETERS
 from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
 from .pointwise import evaluate
@@ -146,7 +147,14 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
     if "silicone" in touched:
         mu, alpha = (np.broadcast_to(np.atleast_2d(silicone[k]), (S, len(cfg.silicone.mu)))
                      for k in ("mu", "alpha"))
-        out["silicone"] = {"set": "tc5005", "mu": mu, "alpha": alpha}
+        # the cube's own set (its stiffness kind and fitted stretch range: the validity
+        # flag's stretch_beyond_fit), or for a fitted or overridden one its stretch range
+        # with any kind
+        named = cfg.silicone.name in SILICONE_PARAMETERS
+        out["silicone"] = {"set": cfg.silicone.name if named else "tc5005", "mu": mu,
+                           "alpha": alpha,
+                           "stretch_range": [float(x) for x in cfg.silicone.stretch_range],
+                           **({} if named else {"kind": "any"})}
     else:
         out["silicone"] = cfg.silicone
     if "nylon" in touched:
