@@ -19,9 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
-           "THERMAL", "TRACKING", "UNCERTAIN",
-           "VARIABLES", "Variable", "validate", "label", "name_label", "quantile_name", "range_text",
-           "slab_done_attrs", "to_display"]
+           "THERMAL", "TRACKING", "UNCERTAIN", "VARIABLES", "Variable", "label", "name_label",
+           "quantile_name", "range_text", "slab_done_attrs", "to_display", "validate"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.

@@ -30,8 +30,9 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
 
     With several models, the variables that depend on the model gain a ``model``
     dimension, and with several cooling sets those that depend on the heat loss a last
-    ``cooling`` one (:meth:`~nylonflex.variables.Variable.by_cooling`); ``heating_time`` is there only with a supply (docs/model.md s. 15-16); the
-    quantiles and feasibility only with ``uncertainty``/``requirements``.
+    ``cooling`` one (:meth:`~nylonflex.variables.Variable.by_cooling`); ``heating_time`` is
+    there only with a supply (docs/model.md s. 15-16); the quantiles and feasibility only
+    with ``uncertainty``/``requirements``.
     """
     from .sampled import uncertain_variables
     from .tracking import tracking_variables

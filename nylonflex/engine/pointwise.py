@@ -42,7 +42,6 @@ _MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistan
                   "heat_capacity_per_length", "heat_loss_per_length",
                   "thermal_force_coefficient")
 _SILICONE_FIELDS = ("mu", "alpha")
-_NYLON_TABLES = NYLON_TABLES
 
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
@@ -228,7 +227,7 @@ def _batch_shapes(ogden, ny) -> list:
     """The shapes the material arrays add to the designs' broadcast (tables: columns off)."""
     return [ogden[0].shape[:-1], ogden[1].shape[:-1], ny["coil_index_table"].shape[:-1],
             ny["stroke_max_table"].shape[:-1], ny["tensile_strength_table"].shape[:-1],
-            *(np.shape(v) for k, v in ny.items() if k not in _NYLON_TABLES)]
+            *(np.shape(v) for k, v in ny.items() if k not in NYLON_TABLES)]
 
 
 @lru_cache(maxsize=64)
@@ -369,9 +368,9 @@ def _silicone_rows(ogden, shape):
 
 def _nylon_arrays(nylon) -> dict:
     """Every numeric field of a nylon argument as an array (tables: columns last), checked."""
-    base, arrays = _split("nylon", nylon, NYLON_PARAMETERS, _NYLON_TABLES)
+    base, arrays = _split("nylon", nylon, NYLON_PARAMETERS, NYLON_TABLES)
     numeric = {k: v for k, v in (base.items() if isinstance(base, Mapping) else ())
-               if k != "set" and np.ndim(v) > 0 and k not in _NYLON_TABLES}
+               if k != "set" and np.ndim(v) > 0 and k not in NYLON_TABLES}
     scalar_base = {k: v for k, v in base.items() if k not in numeric} \
         if isinstance(base, Mapping) else base
     ny = nylon_parameters(scalar_base)

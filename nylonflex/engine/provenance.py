@@ -393,13 +393,10 @@ def _yaml_settings(attrs) -> CubeSettings:
 def _cooling_spec(resolved):
     """A config's ``cooling`` entry (a set name, or the set with its speed) of a resolved
     one (one set or a list)."""
-    from ..materials import COOLING_PARAMETERS
-
     def one(c):
-        own = COOLING_PARAMETERS.get(c.get("name"), {}).get("speed")
-        if own is not None and float(own) == float(c["speed"]):
-            return str(c["name"])
-        return {"set": str(c["name"]), "speed": float(c["speed"])}
+        env = _cooling(str(c.get("name", "custom")), str(c["fluid"]), float(c["speed"]))
+        # the set's own speed: its name alone (Cooling.label, the cube's coordinate)
+        return env.name if env.label == env.name else {"set": env.name, "speed": env.speed}
 
     return [one(c) for c in resolved] if isinstance(resolved, list) else one(resolved)
 

@@ -200,7 +200,6 @@ def design_tracking(cfg: ResolvedConfig, design: dict, bend_angle_max: float | N
     return {k: float(v.reshape(-1)[0]) for k, v in out.items()}
 
 
-
 def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=None,
                      bend_angle_max=None, parallel: bool = True) -> dict:
     """The tracking variables of one design under each sample of the uncertain parameters.
