@@ -157,3 +157,21 @@ def test_design_and_explore_ask_for_one_cooling_set(tmp_path, capsys):
     assert "--cooling: this cube holds 3 cooling sets" in capsys.readouterr().err
     assert main(["explore", str(cube), "--html", str(page), "--cooling", "still_water"]) == 0
     assert "(cooling: still_water)" in page.read_text()
+
+
+def test_a_speed_typed_with_its_unit_is_read_as_m_per_s():
+    # configs take units (docs/interface.md): "5 m/s" is 5, a wrong unit names the field
+    typed = parse_config(_with(cooling=["still_air", {"set": "forced_air", "speed": "5 m/s"}]))
+    assert [c.label for c in typed.coolings] == ["still_air", "forced_air 5 m/s"]
+    bare = parse_config(_with(cooling=["still_air", {"set": "forced_air", "speed": 5}]))
+    assert typed.sha256 == bare.sha256
+    one = parse_config(_with(cooling={"set": "forced_air", "speed": "5 m/s"}))
+    assert one.cooling.speed == 5.0
+    with pytest.raises(InputError, match=r"^cooling\[1\]\.speed: unknown unit 'km'"):
+        parse_config(_with(cooling=["still_air", {"set": "forced_air", "speed": "5 km"}]))
+    from nylonflex.sim import parse_sim_config
+    from nylonflex.config.safe_yaml import read_yaml
+
+    sim = parse_sim_config({**read_yaml("configs/control.yaml"),
+                            "cooling": {"set": "forced_air", "speed": "5 m/s"}})
+    assert sim.actuators[0].cooling.speed == 5.0

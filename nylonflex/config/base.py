@@ -59,6 +59,10 @@ def resolve_cooling(cooling, nylon: Nylon, field: str = "cooling") -> Cooling | 
     """
     if cooling is None:
         return None
+    if isinstance(cooling, dict) and isinstance(cooling.get("speed"), str):
+        # a speed typed with its unit ("5 m/s"); cooling_parameters takes m/s numbers
+        cooling = {**cooling, "speed": parse_quantity(cooling["speed"], f"{field}.speed",
+                                                      "speed", "m/s")}
     try:
         env = cooling_parameters(cooling)
     except ValueError as err:
