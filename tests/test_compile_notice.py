@@ -77,8 +77,8 @@ def test_each_kernel_family_is_known():
     from nylonflex.kernels import bytes as codec
     from nylonflex.kernels import control, design
 
-    assert compiling.family(design.design_slab_parallel) == "grid"
-    assert compiling.family(design.design_points_serial) == "pointwise"
+    assert compiling.family(design.design_slab) == "grid"
+    assert compiling.family(design.design_points) == "pointwise"
     assert compiling.family(control.closed_loop) == "control"
     assert compiling.family(codec._shuffle_bytes_jit) == "codec"
     assert set(compiling.MEASURED) == set(compiling.FAMILIES)
@@ -94,7 +94,7 @@ def test_warm_up_kernels_runs_each_kernel_once_and_reports_progress():
                           progress=lambda done, total, name: seen.append((done, total, name)))
     assert seen == [(1, 2, "pointwise"), (2, 2, "codec")]
     assert set(out) == {"pointwise", "codec"} and all(v >= 0.0 for v in out.values())
-    assert [k[0] for k in KERNELS] == ["grid", "grid-serial", "pointwise", "codec"]
+    assert [k[0] for k in KERNELS] == ["grid", "pointwise", "codec"]
 
 
 def test_the_warmup_command_names_every_kernel(capsys):
@@ -102,6 +102,6 @@ def test_the_warmup_command_names_every_kernel(capsys):
 
     assert main(["warmup"]) == 0
     out = capsys.readouterr().out
-    for name in ("grid", "grid-serial", "pointwise", "codec", "control"):
+    for name in ("grid", "pointwise", "codec", "control"):
         assert f" {name} " in out
     assert out.splitlines()[-1].startswith("warm: every kernel")

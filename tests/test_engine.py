@@ -89,8 +89,8 @@ def test_one_design_is_its_row_of_a_batch_bit_for_bit_through_one_compiled_body(
 
     d = random_designs(80, seed=27)
     batch = nf.evaluate(**d)
-    nf.evaluate(**{k: v[:3] for k, v in d.items()})  # a small batch: the serial loop
-    compiled = list(kernels.design_points_serial.signatures)
+    nf.evaluate(**{k: v[:3] for k, v in d.items()})  # a small batch: one thread
+    compiled = list(kernels.design_points.signatures)
     for i in (0, 17, 79):
         one = nf.evaluate(*(float(v[i]) for v in d.values()))
         for name in DESIGN:
@@ -99,7 +99,7 @@ def test_one_design_is_its_row_of_a_batch_bit_for_bit_through_one_compiled_body(
                         nylon={"set": "silver_nylon66"})  # a mapping: the general path
     for name in DESIGN:
         np.testing.assert_array_equal(again[name], batch[name][3], err_msg=name)
-    assert kernels.design_points_serial.signatures == compiled
+    assert kernels.design_points.signatures == compiled
 
 
 def test_a_single_out_of_range_design_says_what_the_array_check_says():

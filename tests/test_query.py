@@ -357,21 +357,6 @@ def test_exact_slice_between_grid_points(ds):
     assert res.data["tip_force_max"][i] == one["tip_force_max"]
 
 
-def test_an_exact_query_compiles_only_the_loop_its_evaluations_use(ds, monkeypatch):
-    # issue 27: a one-design --at off the grid is one evaluation of one design (the serial
-    # loop, n < 64); a slice is one evaluation per radius slab of its 3 x 2 x 3 = 18 designs
-    from nylonflex.engine import warmup
-
-    asked = []
-    monkeypatch.setattr(warmup, "warm_up_points",
-                        lambda settings, *, sizes=None, notice=None: asked.append(sizes))
-    at = dict(EXAMPLE_2, radius=8.6e-3)
-    query.query_cube(ds, at=at, log=lambda line: None)
-    query.query_cube(ds, at={"radius": 8.6e-3, "coil_index": 1.7}, log=lambda line: None)
-    query.query_cube(ds, at=at, interpolate=True, log=lambda line: None)
-    assert asked == [[1], [18], None]  # the interpolated flags' rows: either loop
-
-
 def test_repeated_at_merges_or_refuses(cube, capsys):
     rc, out, _ = run(capsys, cube, "--at", "radius=7.5mm,wall_thickness=2mm",
                      "--at", "length=70mm,coil_index=1.7,wrap_angle=8deg")

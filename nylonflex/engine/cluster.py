@@ -2,10 +2,11 @@
 
 :func:`nylonflex.run_sweep` with ``scheduler=`` hands the slabs still to do to a
 :class:`DaskExecutor`, the executor of the one slab loop (:mod:`.slabs`). Each task computes
-one slab of radii with the *serial* compilation of the design kernel
+one slab of radii with the design kernel in the worker's own thread
 (:func:`nylonflex.engine.grid.compute_slab` with ``parallel=False``): the
-cluster's worker processes and threads are the only level of parallelism, so Numba's
-threaded loops never run inside Dask's threads and never oversubscribe a worker's cores.
+cluster's worker processes and threads are the only level of parallelism, so the
+kernels are never split over threads inside Dask's threads and never oversubscribe a
+worker's cores.
 Results come back to the client as they finish; the client journals and writes each one, as
 a local run does, so resume and the cube's format are the same.
 

@@ -17,6 +17,7 @@ from ..physics.nylon import nylon_force_limit, stroke_max
 from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length
 from ..physics.wrap import muscle_width
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
+from .threads import run_chunks
 
 __all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
            "cube_variables", "global_arrays", "plan_slabs", "slab_variables"]
@@ -211,7 +212,8 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
                  pool: ArrayPool | None = None) -> dict:
     """Every radius-dependent variable of the radii [i0, i1), as a dict of arrays.
 
-    ``parallel`` picks the Numba-threaded kernel; the serial one is for Dask workers. With
+    ``parallel`` splits the kernel over the engine's threads (:mod:`.threads`); False runs it
+    in this thread (Dask workers). With
     several models (cooling sets) the kernel runs once a model (and cooling set) and the
     variables that depend on them are stacked along last axes, model then cooling
     (docs/model.md s. 9, 16). ``pool``: the kernel's output arrays
@@ -251,7 +253,6 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
     from ..kernels import design
     from ..kernels.records import GridAxes, GridOut, Nodes, Ogden, Options
 
-    kernel = design.design_slab_parallel if parallel else design.design_slab_serial
     grid = GridAxes(radius=np.ascontiguousarray(cfg.axes["radius"][i0:i1]),
                     wall=cfg.axes["wall_thickness"], length=cfg.axes["length"],
                     wrap=cfg.axes["wrap_angle"],
@@ -270,8 +271,10 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
                   tip_force=empty(shape("tip_force")))
     voltage = -1.0 if cfg.supply_voltage is None else float(cfg.supply_voltage)
     options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
-    kernel(grid, coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
-           _muscle(cfg), options, out)
+    args = (grid, coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
+            _muscle(cfg), options, out)
+    run_chunks(lambda k0, k1: design.design_slab(*args, k0, k1),
+               len(grid.radius) * len(grid.wall), parallel=parallel)
     # the kernel's rows by name (kernels.rows, the one table both sides read)
     arrays = {name: out.design[row] for name, row in DESIGN_ROWS.items()}
     arrays.update({name: out.flags[row] for name, row in FLAG_ROWS.items()})

@@ -30,12 +30,13 @@ from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
 from ..physics.thermal import check_supply_rise, coil_resistance
 from ..variables import DESIGN
+from .threads import run_chunks
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
 
-#: Designs below which the serial loop is used (threads cost more than they save).
+#: Designs below which the kernel runs in the calling thread (threads cost more than they save).
 _PARALLEL_FROM = 64
-#: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls use the serial loop.
+#: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls run in it.
 _SERIAL = threading.local()
 
 _MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistance_per_length",
@@ -260,10 +261,10 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
                  _silicone_rows(ogden, shape))
     out = PointOut(np.empty((N_FLOAT_DESIGN, n)), np.empty((N_FLAGS, n), dtype=np.int8))
-    kernel = kernels.design_points_parallel if n >= _PARALLEL_FROM and \
-        not getattr(_SERIAL, "on", False) else kernels.design_points_serial
-    kernel(PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
-           Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
+    args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
+            Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
+    run_chunks(lambda i0, i1: kernels.design_points(*args, i0, i1), n,
+               parallel=n >= _PARALLEL_FROM and not getattr(_SERIAL, "on", False))
     # the kernel's rows by name (kernels.rows, the one table both sides read)
     result = {name: out.design[row].reshape(shape) for name, row in DESIGN_ROWS.items()}
     result.update({name: out.flags[row].reshape(shape) for name, row in FLAG_ROWS.items()})
@@ -282,7 +283,7 @@ def _kernels():
 
 @contextmanager
 def serial():
-    """Within this block, this thread's :func:`evaluate` calls run the serial loop (Dask
+    """Within this block, this thread's :func:`evaluate` calls run in this thread (Dask
     workers: one level of parallelism, no Numba thread pool)."""
     before = getattr(_SERIAL, "on", False)
     _SERIAL.on = True

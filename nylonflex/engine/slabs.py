@@ -3,7 +3,7 @@
 :func:`run_slabs` drives every sweep, in memory or to a cube file, local or on Dask:
 
 - an *executor* yields ``(k, arrays)`` for the slab indices it is given, as they finish:
-  :class:`LocalExecutor` (Numba threads, the next slab computed while the last is stored)
+  :class:`LocalExecutor` (the engine's threads, the next slab computed while the last is stored)
   or :class:`nylonflex.engine.cluster.DaskExecutor`;
 - a *sink* stores them: ``sink.put(k, i0, i1, arrays)``. :class:`MemorySink` fills an
   in-memory :class:`xarray.Dataset`; :class:`nylonflex.storage.CubeSink` journals each slab
@@ -29,6 +29,7 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..units import InputError
+from . import threads
 from .grid import ArrayPool, compute_slab, coords, cube_variables, global_arrays
 
 __all__ = ["LocalExecutor", "MemorySink", "RunStats", "deferred_signals", "run_slabs",
@@ -111,20 +112,13 @@ def deferred_signals(on_second=None, earlier=()):
 
 
 def set_workers(workers=None) -> int:
-    """Set (or read) the number of Numba threads; ``workers`` in [1, cores]."""
-    import numba
-
-    if workers is None:
-        return numba.get_num_threads()
-    if not 1 <= workers <= numba.config.NUMBA_NUM_THREADS:
-        raise InputError(f"--workers: must be in [1, {numba.config.NUMBA_NUM_THREADS}], "
-                         f"got {workers}")
-    numba.set_num_threads(workers)
-    return workers
+    """Set (or read) the number of threads a kernel is split over; ``workers`` in
+    [1, cores] (:mod:`.threads`)."""
+    return threads.set_workers(workers)
 
 
 class LocalExecutor:
-    """Slabs on this machine's cores: the Numba-threaded kernel, one slab ahead.
+    """Slabs on this machine's cores: the kernel split over the engine's threads, one slab ahead.
 
     The kernel releases the GIL, so storing slab k (compression, journal) overlaps the
     arithmetic of slab k+1; at most two slabs are in memory.
@@ -134,7 +128,7 @@ class LocalExecutor:
         self.workers = set_workers(workers)
 
     def info(self) -> dict:
-        return {"scheduler": "local (numba threads)", "workers": str(self.workers)}
+        return {"scheduler": "local (threads)", "workers": str(self.workers)}
 
     def map_slabs(self, cfg, slabs, todo, prepare=None):
         """Yield ``(k, arrays)`` as slabs finish; with ``prepare``, ``(k, prepare(i0,

@@ -25,6 +25,8 @@ from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_len
     steady_temperature
 from ..physics.wrap import muscle_length
 from ..variables import TRACKING
+from . import threads
+from .threads import run_chunks
 
 __all__ = ["PLANT_POINTS", "design_tracking", "sampled_tracking", "slab_tracking",
            "tracking_variables"]
@@ -123,9 +125,9 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     nodes = quadrature_nodes()
     kappa = np.empty((len(a), len(t), PLANT_POINTS))
     slope = np.empty_like(kappa)
-    (kt.kappa_tables if parallel else kt.kappa_tables_serial)(
+    run_chunks(lambda q0, q1: kt.kappa_tables(
         p_group, a, t, -1.0 if base is None else base, mu, alpha, *nodes, NEWTON_RTOL,
-        kappa, slope)
+        kappa, slope, q0, q1), len(a) * len(t), parallel=parallel)
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
     muscle = (np.ascontiguousarray(np.atleast_1d(coil_resistance_per_length(C, ny)), float),
               ny.heat_capacity_per_length,
@@ -143,10 +145,10 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     bandwidth = (0, 0.0, 1.0, 1.0, 0, 1) if b is None else \
         (1, b["error"], b["low"], b["high"], b["iterations"], b["periods"])
     out = np.empty((N_TRACKING, lm.size))
-    kernel = kt.track_slab_parallel if parallel else kt.track_slab_serial
-    kernel((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
-           kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
-           bandwidth, sensor_noise(spec, _longest_run(spec)), out)
+    args = ((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
+            kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
+            bandwidth, sensor_noise(spec, _longest_run(spec)), out)
+    run_chunks(lambda q0, q1: kt.track_slab(*args, q0, q1), lm.size, parallel=parallel)
     wanted = tracking_variables(cfg)
     return {name: out[row].reshape(lm.shape) for name, row in TRACKING_ROWS.items()
             if name in wanted}
@@ -235,8 +237,6 @@ def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=Non
     from concurrent.futures import ThreadPoolExecutor
     from dataclasses import replace
 
-    import numba
-
     from .sampled import perturbed_configs
 
     names = tuple(tracking_variables(cfg) if names is None else names)
@@ -261,7 +261,7 @@ def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=Non
         return design_tracking(c, d, None if theta[s] is None else float(theta[s]),
                                parallel=False)
 
-    workers = numba.get_num_threads() if parallel else 1
+    workers = threads.workers() if parallel else 1
     if workers > 1 and len(pairs) > 1:
         with ThreadPoolExecutor(workers, thread_name_prefix="nylonflex-track") as pool:
             rows = list(pool.map(run, range(len(pairs))))

@@ -51,7 +51,7 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     cfg : ResolvedConfig
         The sweep's config; a one-design copy of it is computed.
     parallel : bool
-        Warm the threaded kernel (local runs) or the serial one.
+        Run the warm-up on the engine's threads or in this one (the same compiled kernel).
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
@@ -71,17 +71,14 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     return timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
 
 
-def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0) -> float:
-    """Compile (or load from cache) the pointwise kernels of :func:`nylonflex.evaluate`.
+def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
+    """Compile (or load from cache) the pointwise kernel of :func:`nylonflex.evaluate` (one
+    compiled loop for every batch size, threaded or not).
 
     Parameters
     ----------
     settings : dict, optional
         Keyword arguments of :func:`~nylonflex.engine.pointwise.evaluate` (materials).
-    sizes : iterable of int, optional
-        How many designs the caller's evaluations will hold: only the loops those use are
-        compiled (the serial one below 64 designs, the threaded one from 64; each is a
-        compile of its own, half the cold cost of a one-design ``query --at``). None: both.
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
@@ -95,15 +92,12 @@ def warm_up_points(settings=None, *, sizes=None, notice=None, after: float = 1.0
     """
     import numpy as np
 
-    from .pointwise import _PARALLEL_FROM, evaluate
+    from .pointwise import evaluate
 
     kw = dict(settings or {})
-    loops = sorted({1 if n < _PARALLEL_FROM else _PARALLEL_FROM
-                    for n in ((1, _PARALLEL_FROM) if sizes is None else sizes)})
 
     def call():
-        for n in loops:  # the serial and/or the threaded loop
-            evaluate(np.full(n, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
+        evaluate(np.full(2, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
 
     return timed(call, notice, after)
 
@@ -143,10 +137,8 @@ def _tiny_config():
 #: taking ``notice``). The closed-loop kernels (``simulate``) sit above the engine and are
 #: warmed by ``nylonflex warmup`` itself.
 KERNELS = (
-    ("grid", "sweeps (threaded)",
+    ("grid", "sweeps (local threads and Dask workers' slabs)",
      lambda notice: warm_up_grid(_tiny_config(), parallel=True, notice=notice)),
-    ("grid-serial", "Dask workers' slabs",
-     lambda notice: warm_up_grid(_tiny_config(), parallel=False, notice=notice)),
     ("pointwise", "nylonflex.evaluate, design, query --at, sampled sweeps",
      lambda notice: warm_up_points(notice=notice)),
     ("codec", "the cube writer's byte shuffle", lambda notice: warm_up_codec(notice=notice)),

@@ -25,8 +25,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
-
 from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _curvature_rates, _curvature_solve, _curvature_start,
                                _node_count, _pressure_moment, _section_nodes)
@@ -51,8 +49,10 @@ from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYC
                    ROW_VALIDITY)
 
 
-def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
-    """Fill ``out`` (a :class:`~.records.GridOut`) for the radii ``grid.radius``.
+def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
+    """Fill ``out`` (a :class:`~.records.GridOut`) for the radii ``grid.radius``: the
+    (radius, wall) pairs k0 <= k < k1, k = radius index x walls + wall index (a thread's
+    chunk, :func:`nylonflex.engine.threads.run_chunks`).
 
     ``grid`` is a :class:`~.records.GridAxes` (all other axes whole), ``coil`` a
     :class:`~.records.CoilTable` with one entry a coil index of the axis, ``silicone`` an
@@ -72,7 +72,6 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
     stroke, pressure, p_atm = grid.stroke, grid.pressure, grid.p_atm
     mu, alpha = silicone.mu, silicone.alpha
     x_base, w_base, phi_trig, w_phi = nodes.x_base, nodes.w_base, nodes.phi_trig, nodes.w_phi
-    # unpacked before the loop: a record's fields written inside prange are lost (Numba)
     out_design, out_flags, out_force, out_angle, out_tip = out
     coil_s_max, coil_force_limit, coil_width, coil_r, coil_loss = coil
     model, voltage, stretch_max = options
@@ -107,7 +106,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
         else:
             stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
     n_nodes = _node_count(x_base, w_phi)
-    for k in prange(na * nt):
+    for k in range(k0, k1):
         ia = k // nt
         it = k % nt
         a = radius[ia]
@@ -244,8 +243,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out):
                             stroke_pressure[js], stroke_hoop[js], a, t, lever)
 
 
-def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
-    """Every design variable of scattered designs, one a design (``prange`` over them).
+def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, i0, i1):
+    """Every design variable of the scattered designs i0 <= i < i1 (a thread's chunk).
 
     ``designs`` is a :class:`~.records.PointDesigns`, ``coil`` a
     :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
@@ -261,9 +260,8 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
     t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
         muscle.t_amb, muscle.t_max, muscle.gamma, muscle.beta, muscle.t_g, muscle.sigma_g
     c_all, coeff_all = muscle.c_per_len, muscle.force_coeff
-    n = radius.shape[0]
     step = 0 if mu_all.shape[0] == 1 else 1  # one row for all, or one a design
-    for i in prange(n):
+    for i in range(i0, i1):
         row = i * step
         ogden = Ogden(mu_all[row], alpha_all[row])
         a = radius[i]
@@ -282,7 +280,6 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
         section = Section(a, t, b)
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
-        # one call, no branch in the prange body (writes after a branch were lost)
         st = _design_state(model, voltage, section, length[i], psi, pitch, lever, coil_row,
                            shape, ogden, nodes, p_atm)
         (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
@@ -322,9 +319,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out):
                                                length[i] / pitch, st[7], efficiency)
 
 
-#: Threaded (Numba prange) and serial compilations of the same loops. The serial ones are
-#: for Dask workers, where a second level of threads would oversubscribe the cores.
-design_slab_parallel = jit_kernel(_design_slab, parallel=True)
-design_slab_serial = jit_kernel(_design_slab, parallel=False)
-design_points_parallel = jit_kernel(_design_points, parallel=True)
-design_points_serial = jit_kernel(_design_points, parallel=False)
+#: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
+#: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
+design_slab = jit_kernel(_design_slab)
+design_points = jit_kernel(_design_points)

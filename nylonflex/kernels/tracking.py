@@ -9,8 +9,8 @@ the time series are not kept, the metrics are summed as the loop goes. Private, 
 - :func:`kappa_tables` tabulates the curvature kappa(p) and its slope once per (radius,
   wall) of a slab (the angle is kappa L, so every length shares it), up to the highest
   pressure any of its designs reaches;
-- :func:`track_slab_parallel` / :func:`track_slab_serial` (Dask workers) run every
-  design's loop, and its bandwidth search, one design per iteration.
+- :func:`track_slab` runs every design's loop, and its bandwidth search, one design per
+  iteration (a chunk of the designs a call: the engine's threads split a slab).
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
 from ..physics.chamber import _gauge_pressure
 from ..physics.nylon import _stroke_shape
@@ -28,16 +27,16 @@ from .control import _duty, angle_table, estimate_angle, plant_angle
 from .rows import (ROW_TRACKING_BANDWIDTH, ROW_TRACKING_ENERGY, ROW_TRACKING_MAX_TEMPERATURE,
                    ROW_TRACKING_RMS_ERROR)
 
-__all__ = ["kappa_tables", "kappa_tables_serial", "run_loop", "track_slab_parallel",
-           "track_slab_serial"]
+__all__ = ["kappa_tables", "run_loop", "track_slab"]
 
 def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig, w_phi,
-                  rtol, out_kappa, out_slope):
+                  rtol, out_kappa, out_slope, q0, q1):
     """kappa(k dp) [1/m] and d kappa/dp [1/(m Pa)], dp = p_max[i, j] / (points - 1), of
-    every (radius i, wall j); ``base`` <= 0 means b = t. NaN rows where p_max is NaN."""
+    the (radius i, wall j) pairs q0 <= q = i nt + j < q1 (a thread's chunk); ``base`` <= 0
+    means b = t. NaN rows where p_max is NaN."""
     na, nt = p_max.shape
     points = out_kappa.shape[2]
-    for q in prange(na * nt):
+    for q in range(q0, q1):
         i = q // nt
         j = q % nt
         b = wall[j] if base <= 0.0 else base
@@ -50,8 +49,7 @@ def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig
             out_slope[i, j, :] = np.nan
 
 
-kappa_tables = jit_kernel(_kappa_tables, parallel=True)
-kappa_tables_serial = jit_kernel(_kappa_tables, parallel=False)
+kappa_tables = jit_kernel(_kappa_tables)
 
 
 @jit_kernel
@@ -181,7 +179,7 @@ def _one_design(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t
 
 
 def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, muscle,
-                silicone, nodes, rtol, settings, reference, bandwidth, noise, out):
+                silicone, nodes, rtol, settings, reference, bandwidth, noise, out, q0, q1):
     """Every design's tracking metrics into ``out`` (4, n), designs in C order of the
     slab's (radius, wall, length, coil, wrap).
 
@@ -222,6 +220,8 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         Written, in the rows of :mod:`.rows` (``ROW_TRACKING_*``, the registry's
         ``TRACKING`` order): rms error [rad], highest temperature [K], energy [J],
         bandwidth [Hz].
+    q0, q1 : int
+        The designs q0 <= q < q1 of that C order are computed (a thread's chunk).
     """
     radius, wall, length, base = axes
     r_per_len, c_per_len, loss_per_len, t_amb, t_start, gamma, beta, t_g, sigma_g = muscle
@@ -233,8 +233,7 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
     bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods = bandwidth
     na, nt, nl, nc, nw = lm.shape
     plant_points = kappa.shape[2]
-    n = na * nt * nl * nc * nw
-    for q in prange(n):
+    for q in range(q0, q1):
         i = q // (nt * nl * nc * nw)
         j = (q // (nl * nc * nw)) % nt
         li = (q // (nc * nw)) % nl
@@ -242,7 +241,6 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         wi = q % nw
         b = wall[j] if base <= 0.0 else base
         g = ref_scale[i, j, li, ci, wi]
-        # one call, no branch in the prange body (writes after a branch were lost)
         (tracking_rms_error, tracking_max_temperature, tracking_energy,
          tracking_bandwidth) = _one_design(
             dt, m, voltage, p_atm, lm[i, j, li, ci, wi], r_per_len[ci], c_per_len,
@@ -258,6 +256,5 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         out[ROW_TRACKING_BANDWIDTH, q] = tracking_bandwidth
 
 
-#: Threaded (Numba prange) and serial (Dask workers) compilations of the same loop.
-track_slab_parallel = jit_kernel(_track_slab, parallel=True)
-track_slab_serial = jit_kernel(_track_slab, parallel=False)
+#: The compiled loop, for threaded runs (chunks on the engine's threads) and serial ones.
+track_slab = jit_kernel(_track_slab)

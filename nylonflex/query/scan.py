@@ -233,15 +233,6 @@ def at_value(at_loc, name, ds):
     return float(grid[i0]) if on_grid else float(grid[i0] * (1 - w) + grid[i1] * w)
 
 
-def _exact_size(ds, at_loc, r0, r1) -> int:
-    """How many designs :func:`_exact_rows` evaluates for radius indices [r0, r1)."""
-    n = 1
-    for name in AXES:
-        if name not in at_loc:
-            n *= (r1 - r0) if name == "radius" else ds.sizes[name]
-    return n
-
-
 def _exact_rows(ds, at, at_loc, r0, r1, settings):
     """Rows of radius indices [r0, r1) with the design variables from the exact model.
 
@@ -383,11 +374,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     if settings is not None and log is not None:
         from ..engine.warmup import warm_up_points
 
-        # the exact path evaluates each slab's designs in one call: only the loop those
-        # sizes use is compiled (the interpolated path's flag rows: either)
-        warm_up_points(settings, notice=log,
-                       sizes=[_exact_size(ds, at_loc, r0, r1) for r0, r1 in slabs]
-                       if exact else None)
+        warm_up_points(settings, notice=log)
     done = ds["slab_done"].values.astype(bool) if "slab_done" in ds and not exact else None
 
     kept = {name: np.empty(0, dtype=object if name in CATEGORIES else float)
