@@ -1,10 +1,18 @@
-"""The NumPy yardstick of ``nylonflex bench`` computes what the grid kernel computes."""
+"""The NumPy yardstick of ``nylonflex bench`` (benchmarks/yardstick.py) computes what the
+grid kernel computes."""
+
+import importlib
+from pathlib import Path
 
 import numpy as np
 
-from nylonflex.bench import QUICK, bench_config
-from nylonflex.bench.yardstick import MECHANICAL, grid_numpy
+from nylonflex.cli.bench import SUITE, benchmarks_folder, load_suite
 from nylonflex.engine.grid import compute_slab
+
+suite = load_suite(benchmarks_folder(Path(__file__).resolve().parents[1]))
+QUICK, bench_config = suite.QUICK, suite.bench_config
+yardstick = importlib.import_module(f"{SUITE}.yardstick")
+MECHANICAL, grid_numpy = yardstick.MECHANICAL, yardstick.grid_numpy
 
 
 def test_numpy_yardstick_matches_the_kernel_to_1e_9():

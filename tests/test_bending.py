@@ -6,7 +6,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import dblquad
 
-from nylonflex.bench import reference as ref
+import naive
 from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
 from nylonflex.physics import bending, silicone
 
@@ -27,9 +27,9 @@ def test_pressure_moment_is_first_moment_of_the_half_disc():
                                        (12e-3, 2e-3, 150.0)])
 def test_material_moment_matches_adaptive_quadrature(name, a, t, kappa):
     # docs/model.md section 6 as written, by scipy quad/dblquad at epsrel 1e-12
-    # (nylonflex.bench.reference)
+    # (tests/naive.py)
     mu, alpha = silicone_parameters(name).arrays()
-    expected = ref.material_moment(kappa, a, t, t, mu, alpha)
+    expected = naive.material_moment(kappa, a, t, t, mu, alpha)
     assert bending.material_moment(kappa, a, t, None, name) == pytest.approx(expected,
                                                                              rel=1e-11)
 
@@ -59,7 +59,7 @@ def test_curvature_matches_slow_reference(name):
     mu, alpha = silicone_parameters(name).arrays()
     for a, t, p in _GRID:
         fast = bending.curvature(p, a, t, None, name)
-        slow = ref.curvature(p, a, t, t, mu, alpha, near=fast if fast > 0 else None)
+        slow = naive.curvature(p, a, t, t, mu, alpha, near=fast if fast > 0 else None)
         assert fast == pytest.approx(slow, rel=1e-9, abs=0.0), (a, t, p)
 
 
@@ -73,14 +73,14 @@ def test_curvature_matches_slow_reference(name):
 def test_curvature_matches_slow_reference_anywhere(name, a, t, p, b):
     mu, alpha = silicone_parameters(name).arrays()
     fast = bending.curvature(p, a, t, b, name)
-    slow = ref.curvature(p, a, t, b, mu, alpha, near=fast if fast > 0 else None)
+    slow = naive.curvature(p, a, t, b, mu, alpha, near=fast if fast > 0 else None)
     assert fast == pytest.approx(slow, rel=1e-9, abs=0.0)
 
 
 def test_curvature_solves_the_moment_balance_without_a_guess():
     mu, alpha = silicone_parameters("tc5005").arrays()
     assert bending.curvature(30e3, 20e-3, 4e-3) == pytest.approx(
-        ref.curvature(30e3, 20e-3, 4e-3, 4e-3, mu, alpha), rel=1e-9)
+        naive.curvature(30e3, 20e-3, 4e-3, 4e-3, mu, alpha), rel=1e-9)
 
 
 @settings(max_examples=30, deadline=None)
@@ -120,8 +120,8 @@ def test_nominal_stress_on_undeformed_section_choice():
                           * (t + r * math.sin(phi)) * r, 0, math.pi, a, a + t)
         return base + wall
 
-    nominal = moment(lambda lam: ref.stress(lam, mu, alpha))
-    cauchy = moment(lambda lam: ref.stress(lam, mu, alpha) * lam)
+    nominal = moment(lambda lam: naive.stress(lam, mu, alpha))
+    cauchy = moment(lambda lam: naive.stress(lam, mu, alpha) * lam)
     got = bending.material_moment(kappa, a, t)
     assert got == pytest.approx(nominal, rel=1e-8)
     assert abs(got - cauchy) > 0.05 * cauchy

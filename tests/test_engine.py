@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import nylonflex as nf
-from nylonflex.bench import random_designs
+from naive import random_designs
 from nylonflex.engine.pointwise import _interp
 from nylonflex.physics import design_limits as python_loop
 from nylonflex.variables import DESIGN

@@ -3,8 +3,8 @@
 Each module of the package sits in one of the named layers of :data:`NAMED_LAYERS`, lowest
 first: foundation (units) <- files <- registry (variables) <- material files <- materials
 <- condition grammar <- config <- physics <- simulate config <- kernels <- engine <-
-simulation <- outputs (storage, charts, query) <- finite elements <- applications (bench,
-calibration, design, explore, uncertainty, the JSON Schema) <- cli. An import of another
+simulation <- outputs (storage, charts, query) <- finite elements <- applications
+(calibration, design, explore, uncertainty, the JSON Schema) <- cli. An import of another
 nylonflex module must reach a lower layer (or its own package). The physics imports
 neither numba, xarray nor matplotlib.
 """
@@ -38,8 +38,7 @@ NAMED_LAYERS = (
     ("simulation", ("sim",)),
     ("outputs", ("storage", "charts", "query")),
     ("finite elements", ("fe",)),
-    ("applications", ("bench", "calibration", "design", "explore", "uncertainty",
-                      "config.schema")),
+    ("applications", ("calibration", "design", "explore", "uncertainty", "config.schema")),
     ("cli", ("cli",)),
 )
 
@@ -290,7 +289,53 @@ def test_no_private_name_is_imported_across_packages():
 #: The modules the package root holds (issue 28); everything else lives in a subpackage.
 ROOT = {"__init__", "__main__", "_version", "errors", "materials", "units", "variables"}
 
+#: The subpackages the package root holds (issue 28). The benchmarks and the slow reference
+#: are not among them: they live in the repository's benchmarks/ and tests/naive.py.
+SUBPACKAGES = {"physics", "kernels", "engine", "storage", "config", "query", "sim",
+               "calibration", "uncertainty", "design", "charts", "explore", "fe", "cli",
+               "examples"}
 
-def test_the_package_root_holds_only_its_listed_modules():
-    extra = {p.stem for p in PKG.glob("*.py")} - ROOT
-    assert not extra, f"move these into a subpackage: {sorted(extra)}"
+
+def _root_contents(pkg: Path):
+    """The package root's modules (stems) and folders, build outputs left out: a folder
+    that holds nothing but ``__pycache__`` (what git leaves of a removed subpackage) does
+    not count."""
+    modules = {p.stem for p in pkg.glob("*.py")}
+    folders = {p.name for p in pkg.iterdir() if p.is_dir() and p.name != "__pycache__"
+               and any(q.name != "__pycache__" for q in p.iterdir())}
+    return modules, folders
+
+
+def test_the_package_root_holds_only_its_listed_modules_and_folders():
+    modules, folders = _root_contents(PKG)
+    assert not modules - ROOT, f"move these into a subpackage: {sorted(modules - ROOT)}"
+    assert not folders - SUBPACKAGES, \
+        f"folders the package root may not hold (issue 28): {sorted(folders - SUBPACKAGES)}"
+    assert SUBPACKAGES <= folders  # the list is the package's, not a wish list
+
+
+def test_the_root_contents_check_sees_a_stray_module_and_folder(tmp_path):
+    for name in SUBPACKAGES:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "__init__.py").write_text("")
+    (tmp_path / "__init__.py").write_text("")
+    (tmp_path / "__pycache__").mkdir()
+    (tmp_path / "bench" / "__pycache__").mkdir(parents=True)  # left behind by a checkout
+    assert _root_contents(tmp_path) == ({"__init__"}, SUBPACKAGES)
+    (tmp_path / "bench" / "__init__.py").write_text("")
+    (tmp_path / "helpers.py").write_text("")
+    modules, folders = _root_contents(tmp_path)
+    assert modules - ROOT == {"helpers"} and folders - SUBPACKAGES == {"bench"}
+
+
+def test_nothing_imports_the_old_bench_subpackage():
+    # the benchmarks moved to the repository's benchmarks/, the reference to tests/naive.py
+    old = lambda name: name == "nylonflex.bench" or name.startswith("nylonflex.bench.")  # noqa
+    found = [f"{m} -> {n}" for path, m in _modules() for n in _imports(path, m) if old(n)]
+    repo = PKG.parent
+    for path in sorted([*(repo / "tests").glob("*.py"), *(repo / "benchmarks").glob("*.py")]):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) else []
+            found += [f"{path.relative_to(repo)} -> {n}" for n in names if old(n)]
+    assert not found, "; ".join(found)

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from nylonflex.bench import reference as ref
+import naive
 from conftest import DEG, EXAMPLE_1, EXAMPLE_2
 from nylonflex import design_limits
 from nylonflex.materials import nylon_parameters, silicone_parameters
@@ -76,7 +76,7 @@ def test_stroke_limit_matches_slow_reference(design):
     ny = nylon_parameters()
     mu, alpha = silicone_parameters().arrays()
     c, t = design["coil_index"], design["wall_thickness"]
-    s_ref = ref.stroke_limit(nylon.nylon_force_limit(c), nylon.stroke_max(c), design["radius"],
+    s_ref = naive.stroke_limit(nylon.nylon_force_limit(c), nylon.stroke_max(c), design["radius"],
                              t, t, design["wrap_angle"], c, mu, alpha, ny.fibre_diameter)
     assert design_limits(**design)["usable_stroke"] == pytest.approx(s_ref, rel=1e-9)
 
@@ -85,7 +85,7 @@ def test_nylon_force_formula_against_reference():
     mu, alpha = silicone_parameters().arrays()
     for s in (0.0, 0.03, 0.09):
         got = wrap.nylon_force(s, 12e-3, 3e-3, 10 * DEG, 1.3)
-        exp = ref.nylon_force(s, 12e-3, 3e-3, 3e-3, 10 * DEG, 1.3, mu, alpha, 0.34e-3)
+        exp = naive.nylon_force(s, 12e-3, 3e-3, 3e-3, 10 * DEG, 1.3, mu, alpha, 0.34e-3)
         assert got == pytest.approx(exp, rel=1e-14)
 
 

@@ -1,4 +1,5 @@
-"""The NumPy yardstick of ``nylonflex bench``: the grid kernel's structure in plain NumPy.
+"""The NumPy yardstick of ``nylonflex bench`` (benchmarks/suite.py): the grid kernel's
+structure in plain NumPy.
 
 What a user might write instead of the Numba kernel: the same quadrature (one node table per
 section, :func:`nylonflex.physics.bending.quadrature_nodes`), safeguarded Newton solves to
@@ -22,9 +23,10 @@ import math
 
 import numpy as np
 
-from ..physics.bending import NEWTON_RTOL, quadrature_nodes
-from ..physics.chamber import P_ATM
-from ..physics.limits import STROKE_RTOL
+from nylonflex.engine.grid import coil_table
+from nylonflex.physics.bending import NEWTON_RTOL, quadrature_nodes
+from nylonflex.physics.chamber import P_ATM
+from nylonflex.physics.limits import STROKE_RTOL
 
 __all__ = ["MECHANICAL", "grid_numpy"]
 
@@ -168,8 +170,6 @@ def _stroke_limit(f_lim, s_max, a, t, lever, mu, alpha):
 def grid_numpy(cfg) -> dict:
     """The mechanical variables and curves of ``cfg``'s whole grid (paper model, no
     supply), as :func:`nylonflex.engine.grid.compute_slab` shapes them [SI]."""
-    from ..engine.grid import coil_table
-
     mu, alpha = cfg.silicone.arrays()
     ax, cv = cfg.axes, cfg.curves
     a1, t1 = ax["radius"], ax["wall_thickness"]

@@ -1,25 +1,53 @@
 """``nylonflex bench``: the kernels against the scipy reference, side by side in one run.
 
 Timings on shared machines are noisy, so the figures that matter are the ratios measured in
-the same process: the per-design speed-up over the adaptive-quadrature reference, and the kernel's speed-up
-over a plain NumPy implementation of the same structure (:mod:`.yardstick`).
+the same process: the per-design speed-up over the adaptive-quadrature reference, and the
+kernel's speed-up over a plain NumPy implementation of the same structure
+(:mod:`.yardstick`).
 
-Both yardsticks live in this subpackage because ``nylonflex bench`` times them at run time
-(an installed package has no tests/ or benchmarks/): :mod:`.reference`, the independent
-scipy reference the tests also hold the model to, and :mod:`.yardstick`.
+The suite lives in the repository's ``benchmarks/``, outside the package: ``nylonflex
+bench`` (nylonflex/cli/bench.py) finds this folder beside the package of a source checkout
+and runs :func:`run_bench`. The scipy reference it times is the tests' own,
+``tests/naive.py`` (:func:`naive`), so that the speed-up is over the very reference the
+tests hold the model to, not over a copy of it that could drift.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import resource
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..config import parse_config
+from nylonflex.config import parse_config
+from nylonflex.engine import evaluate
+from nylonflex.engine.grid import compute_slab, plan_slabs
+from nylonflex.physics import design_limits as python_loop
+from nylonflex.sim import parse_sim_config, run_simulation
+from nylonflex.storage import open_cube
+from nylonflex.storage.sweep import run_sweep, sweep_file
+
+from .yardstick import grid_numpy
+
+#: The checkout's tests/naive.py, the slow reference of the tests.
+NAIVE = Path(__file__).resolve().parents[1] / "tests" / "naive.py"
+
+
+def naive():
+    """``tests/naive.py`` of this checkout as a module (loaded by its path, once)."""
+    name = "nylonflex_tests_naive"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, NAIVE)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
 
 #: The benchmark grid of issue 3: 100 x 40 x 10 x 5 x 10 = 2,000,000 designs with curves.
 FULL = {"radius": 100, "wall_thickness": 40, "length": 10, "coil_index": 5, "wrap_angle": 10,
@@ -74,8 +102,6 @@ def sampled_config(quick: bool = False):
 
 def _sampled_seconds(quick: bool) -> tuple[float, int]:
     """Seconds of a sampled sweep in memory, and its evaluations (designs x samples)."""
-    from ..storage.sweep import run_sweep
-
     cfg = sampled_config(quick)
     t0 = time.perf_counter()
     ds = run_sweep(cfg)
@@ -86,43 +112,22 @@ def _sampled_seconds(quick: bool) -> tuple[float, int]:
 
 def _reference_design(cfg, a, t, c, psi):
     """One design's s*, kappa(s_max) and kappa* by scipy quadrature and brentq."""
-    from ..physics.chamber import chamber_pressure
-    from ..physics.nylon import nylon_force_limit, stroke_max
-    from . import reference as ref
-
+    ref = naive()
+    ny = cfg.nylon
     mu, alpha = cfg.silicone.arrays()
-    s_max = float(stroke_max(c, cfg.nylon))
-    s = ref.stroke_limit(float(nylon_force_limit(c, cfg.nylon)), s_max, a, t, t, psi, c, mu,
-                         alpha, cfg.nylon.fibre_diameter)
-    k_full = ref.curvature(float(chamber_pressure(s_max)), a, t, t, mu, alpha)
-    k = k_full if s == s_max else ref.curvature(float(chamber_pressure(s)), a, t, t, mu, alpha)
+    s_max = ref.table_value(c, ny.coil_index_table, ny.stroke_max_table)
+    force_limit = ref.force_limit(c, ny.coil_index_table, ny.tensile_strength_table,
+                                  ny.fibre_diameter)
+    s = ref.stroke_limit(force_limit, s_max, a, t, t, psi, c, mu, alpha, ny.fibre_diameter)
+    k_full = ref.curvature(ref.gauge_pressure(s_max), a, t, t, mu, alpha)
+    k = k_full if s == s_max else ref.curvature(ref.gauge_pressure(s), a, t, t, mu, alpha)
     return s, k_full, k
-
-
-def random_designs(n: int, seed: int = 2026) -> dict:
-    """``n`` designs drawn over the whole accepted range of each axis (log-uniform lengths).
-
-    Radius, wall and length log-uniform over the registry's ranges, coil index uniform over
-    the default table, wrap angle uniform over its range; SI.
-    """
-    from ..variables import COORDS
-
-    rng = np.random.default_rng(seed)
-    log_uniform = lambda v: np.exp(rng.uniform(np.log(v.lo), np.log(v.hi), n))  # noqa: E731
-    return {"radius": log_uniform(COORDS["radius"]),
-            "wall_thickness": log_uniform(COORDS["wall_thickness"]),
-            "length": log_uniform(COORDS["length"]),
-            "coil_index": rng.uniform(1.1, 1.7, n),
-            "wrap_angle": rng.uniform(COORDS["wrap_angle"].lo, COORDS["wrap_angle"].hi, n)}
 
 
 def _pointwise_seconds(n: int) -> tuple[float, float, int]:
     """Per-design time [s] of ``nf.evaluate`` on ``n`` random designs, and of the uncompiled
     python loop (:func:`nylonflex.physics.design_limits`) on a 50th of them, same run."""
-    from ..engine import evaluate
-    from ..physics import design_limits as python_loop
-
-    d = random_designs(n)
+    d = naive().random_designs(n)
     evaluate(**{k: v[:64] for k, v in d.items()})  # compile or load the cache
     t0 = time.perf_counter()
     evaluate(**d)
@@ -136,9 +141,7 @@ def _pointwise_seconds(n: int) -> tuple[float, float, int]:
 def _single_vs_batch_cpu(n: int = 20_000, calls: int = 2000) -> tuple[float, float]:
     """CPU seconds [s] of ``nf.evaluate`` for one design, and per design of an ``n``-design
     batch, measured back to back in this process (issue 27: at most 20x)."""
-    from ..engine import evaluate
-
-    d = random_designs(n, seed=27)
+    d = naive().random_designs(n, seed=27)
     one = {k: float(v[0]) for k, v in d.items()}
     evaluate(**d), evaluate(**one)  # compile or load the cache: both loops
     t0 = time.process_time()
@@ -167,8 +170,6 @@ def _matmul_gflops(n: int = 1024) -> float:
 def _closed_loop_seconds(duration: float) -> tuple[float, float]:
     """Loop time [s] of the figure-9 closed loop over ``duration`` [s] at 10 ms, and the
     whole run's (tables and output included), once compiled."""
-    from ..sim import parse_sim_config, run_simulation
-
     cfg = parse_sim_config({
         "name": "bench",
         "design": {"radius": "7.5 mm", "wall_thickness": "2 mm", "length": "70 mm",
@@ -195,9 +196,6 @@ def _numpy_yardstick(cfg) -> tuple[float, float]:
     """Seconds of the NumPy yardstick (:mod:`.yardstick`) on ``cfg``'s whole grid
     and of the threaded kernel on the same grid in one slab, back to back (after the
     sweep, so that its memory does not count in the sweep's peak)."""
-    from ..engine.grid import compute_slab
-    from .yardstick import grid_numpy
-
     t0 = time.perf_counter()
     grid_numpy(cfg)
     t_numpy = time.perf_counter() - t0
@@ -211,10 +209,6 @@ def run_bench(quick: bool = False, log=None) -> dict:
 
     ``log`` receives each line of the report as it is measured; the figures are returned.
     """
-    from ..engine.grid import compute_slab, plan_slabs
-    from ..storage import open_cube
-    from ..storage.sweep import sweep_file
-
     sizes = QUICK if quick else FULL
     cfg = bench_config(sizes)
     say = log or (lambda msg: None)
@@ -301,7 +295,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
     say(f"  NumPy yardstick            {t_numpy:8.2f} s  {result['numpy_designs_per_s']:>12,.0f}"
         f" designs/s  (same structure vectorised over designs, mechanics only)")
     say(f"  kernel vs NumPy            {result['kernel_vs_numpy']:>12.1f} x  (kernel "
-        f"{t_kernel_whole:.2f} s on the same grid, same run; nylonflex/bench/yardstick.py)")
+        f"{t_kernel_whole:.2f} s on the same grid, same run; benchmarks/yardstick.py)")
     say(f"  scipy reference            {t_ref:8.3f} s per design ({n_ref} designs)")
     say(f"  speed-up per design        {result['speedup']:>12,.0f} x  (reference / sweep, "
         "same run)")
