@@ -199,16 +199,9 @@ def test_design_thermal_values_match_naive(name, supply):
     assert limits == ({0, 1, 2} if supply else {0, 1})  # every branch seen
 
 
-# nf.evaluate reads the muscle set through Nylon.to_dict(), which leaves
-# resistance_coil_index out when it is 0 (so that such a set hashes as before issue 30):
-# a set with one r' at every C, as 'fit thermal' writes it, fails with KeyError there
-_EVALUATE_SETS = [pytest.param(name, marks=pytest.mark.xfail(
-    raises=KeyError, strict=True, reason="nf.evaluate: KeyError 'resistance_coil_index' "
-    "for a set with resistance_coil_index 0 (engine/pointwise.py, _nylon_arrays)"))
-    if SETS[name].resistance_coil_index == 0.0 else name for name in sorted(SETS)]
-
-
-@pytest.mark.parametrize("name", _EVALUATE_SETS)
+# every set, also one with resistance_coil_index 0 (one r' at every C, as 'fit thermal'
+# writes it), which Nylon.to_dict() leaves out so that such a set hashes as before issue 30
+@pytest.mark.parametrize("name", sorted(SETS))
 def test_the_compiled_design_limits_match_naive_too(name):
     # nf.design_limits (nf.evaluate's compiled kernel), with a supply, at fewer designs
     _check_design_values(name, True, nf.design_limits, n=6, seed=61)

@@ -376,6 +376,8 @@ def _nylon_arrays(nylon) -> dict:
         if isinstance(base, Mapping) else base
     ny = nylon_parameters(scalar_base)
     out = {k: np.asarray(v, float) for k, v in ny.to_dict().items() if k != "name"}
+    # to_dict leaves a resistance_coil_index of 0 out (the set's hash); the kernel needs it
+    out.setdefault("resistance_coil_index", np.asarray(ny.resistance_coil_index, float))
     for key, value in {**numeric, **arrays}.items():
         out[key] = _as_array("nylon", key, value)
     if not numeric and not arrays:
