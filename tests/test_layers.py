@@ -236,6 +236,21 @@ def test_the_light_command_probe_sees_what_a_command_imports(small_cube, tmp_pat
         == ["xarray"]
 
 
+def test_an_off_grid_query_of_a_few_designs_imports_no_numba(small_cube, tmp_path):
+    # issue 27: query's exact model of up to PYTHON_LOOP_UP_TO designs is the physics
+    # layer's Python loop, so a first query --at on a new install compiles nothing; a
+    # slice above it runs the compiled kernel (the probe sees Numba there)
+    from nylonflex.query.scan import PYTHON_LOOP_UP_TO
+
+    one = "radius=7.3mm,wall_thickness=2.2mm,length=80mm,coil_index=1.37,wrap_angle=9deg"
+    assert _loaded(["query", str(small_cube), "--at", one], ["numba"], tmp_path) == []
+    slice_ = "radius=7.3mm"  # 3 x 2 x 3 x 3 = 54 designs: still the Python loop
+    assert _loaded(["query", str(small_cube), "--at", slice_], ["numba"], tmp_path) == []
+    assert 54 <= PYTHON_LOOP_UP_TO < 5 * 54
+    assert _loaded(["query", str(small_cube), "--at", "wrap_angle=9deg"], ["numba"],
+                   tmp_path) == ["numba"]  # 5 x 3 x 2 x 3 = 90 designs: the kernel
+
+
 def test_no_pyplot_and_no_backend_switch_in_the_package():
     # figures are matplotlib.figure.Figure objects: a notebook user's backend and pyplot
     # state are left alone (no matplotlib.use, no pyplot import)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..physics import design_limits
 from ..units import InputError, from_si
 from ..variables import CATEGORIES, AXES, DESIGN, VARIABLES
 from .parse import (_CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
@@ -233,15 +234,36 @@ def at_value(at_loc, name, ds):
     return float(grid[i0]) if on_grid else float(grid[i0] * (1 - w) + grid[i1] * w)
 
 
-def _exact_rows(ds, at, at_loc, r0, r1, settings):
+#: Designs up to which the exact model of an off-grid ``--at`` runs the physics layer's
+#: Python loop (:func:`nylonflex.physics.design_limits`, about 4 ms a design) instead of the
+#: compiled kernel: a query of a few designs then loads no Numba and, on a new install or
+#: after an upgrade, compiles nothing (the kernel's compile is 15-20 CPU-s). The two run the
+#: same formulas and agree to 1e-9 relative (tests/test_engine.py; typically 1e-15).
+PYTHON_LOOP_UP_TO = 64
+
+
+def _exact_count(ds, at_loc) -> int:
+    """How many designs the exact model evaluates for an ``--at`` (every slab) [1]."""
+    return int(np.prod([ds.sizes[name] for name in AXES if name not in at_loc]))
+
+
+def _evaluator(n_total: int):
+    """The exact model for a query of ``n_total`` designs: the Python loop or the kernel."""
+    if n_total <= PYTHON_LOOP_UP_TO:
+        return design_limits
+    from ..engine.pointwise import evaluate
+
+    return evaluate
+
+
+def _exact_rows(ds, at, at_loc, r0, r1, settings, evaluate):
     """Rows of radius indices [r0, r1) with the design variables from the exact model.
 
     The ``--at`` axes take their typed values (the grid value on a grid point), the others
-    their grid values; :func:`nylonflex.evaluate` computes every design variable there with
-    the cube's materials and settings (``settings``, from its provenance).
+    their grid values; the exact model ``evaluate`` (:func:`_evaluator`) computes every
+    design variable there with the cube's materials and settings (``settings``, from its
+    provenance).
     """
-    from ..engine.pointwise import evaluate
-
     free = [name for name in AXES if name not in at_loc]
     grids = []
     for name in free:
@@ -371,7 +393,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         except InputError:
             flags = "unknown where the grid points disagree"
     slabs = radius_slabs(ds, at_loc)
-    if settings is not None and log is not None:
+    evaluate = None if settings is None else _evaluator(_exact_count(ds, at_loc))
+    if evaluate is not None and evaluate is not design_limits and log is not None:
         from ..engine.warmup import warm_up_points
 
         warm_up_points(settings, notice=log)
@@ -389,7 +412,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             limit - len(kept[COLUMNS[0]])
         n_where = None
         if exact:
-            rows = _exact_rows(ds, at, at_loc, r0, r1, settings)
+            rows = _exact_rows(ds, at, at_loc, r0, r1, settings, evaluate)
         elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
             # variable by variable (a cube of several models or cooling sets is read
             # whole, per slab)
@@ -397,7 +420,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         else:
             rows = slab_rows(ds, at_loc, r0, r1)
         if flags == EXACT:
-            rows = _exact_flags(rows, settings)
+            rows = _exact_flags(rows, settings, evaluate)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
@@ -425,11 +448,9 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
                        every=every)
 
 
-def _exact_flags(rows, settings):
+def _exact_flags(rows, settings, evaluate):
     """``rows`` with ``limit`` and ``validity`` from the exact model at each design (an
     interpolated row's flags: a flag between two grid points is not their mean)."""
-    from ..engine.pointwise import evaluate
-
     if not len(rows[AXES[0]]):
         return rows
     out = evaluate(*(rows[name] for name in AXES), **settings)
