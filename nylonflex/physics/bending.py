@@ -46,7 +46,7 @@ QUADRATURE_ORDERS = {"phi": 24, "base": 7}
 #: Tolerance of the curvature solve [-]: it stops after a step whose predicted relative error
 #: is of the order of NEWTON_RTOL^2. A Newton step leaves an error of the order of its
 #: square, so it stops below NEWTON_RTOL (the NumPy yardstick,
-#: :mod:`nylonflex.bench.yardstick`); a Halley step leaves one of the order of its cube
+#: benchmarks/yardstick.py); a Halley step leaves one of the order of its cube
 #: (:func:`_curvature_solve`), so it stops below NEWTON_RTOL^(2/3) = 1e-6 (docs/model.md
 #: s. 12).
 NEWTON_RTOL = 1e-9
