@@ -28,7 +28,10 @@ A, T, L = 20e-3, 6e-3, 90e-3
 
 
 def _volume(body):
-    region = felupe.RegionHexahedron(felupe.Mesh(body.points, body.cells, "hexahedron"))
+    from nylonflex.fe.model import element
+
+    kind, Region, _ = element(body.cells)
+    region = Region(felupe.Mesh(body.points, body.cells, kind))
     assert np.all(region.dV > 0)
     return float(region.dV.sum())
 
@@ -42,6 +45,24 @@ def test_body_volume_is_the_sections_times_the_length(level):
     # the arcs are polygons: the wall loses the segments between chord and arc
     tol = 2 * (1 - math.sin(math.pi / 4 / n_arc * 2) / (math.pi / 2 / n_arc))
     assert _volume(body) == pytest.approx(exact, rel=tol)
+
+
+def test_quadratic_body_has_the_sections_volume_and_curved_arcs():
+    """20-node cells (``MeshSize.order`` 2): the arcs' midpoints on the arcs, so the
+    volume is the section's to far better than the polygons' (above), and the chamber's
+    surface keeps its points on r = a, y = b or the caps."""
+    import dataclasses
+
+    body = body_mesh(A, T, L, mesh=dataclasses.replace(MESHES["coarse"], order=2))
+    assert body.cells.shape[1] == 20
+    r = A + T
+    exact = (math.pi * (r * r - A * A) / 4 + r * T) * (L + 2 * T) + math.pi * A * A / 4 * 2 * T
+    assert _volume(body) == pytest.approx(exact, rel=1e-4)
+    pts = body.points[body.chamber]
+    on_wall = np.isclose(np.hypot(pts[:, 0], pts[:, 1] - T), A, rtol=1e-9)
+    on_floor = np.isclose(pts[:, 1], T, rtol=1e-9)
+    on_cap = np.isclose(pts[:, 2], 0.0, atol=1e-12) | np.isclose(pts[:, 2], L, rtol=1e-12)
+    assert np.all(on_wall | on_floor | on_cap)
 
 
 def test_chamber_surface_and_layers():
@@ -189,26 +210,34 @@ def _tube_pressure(inner_stretch, ratio, silicone="tc5005"):
     return integrate.quad(integrand, a, b, epsrel=1e-12)[0]
 
 
-def test_thick_walled_tube_under_internal_pressure():
+@pytest.mark.parametrize("order, n_r, n_phi, tol", [(1, 4, 8, 5e-3), (2, 2, 4, 1e-3)])
+def test_thick_walled_tube_under_internal_pressure(order, n_r, n_phi, tol):
     """A quarter of a plane-strain tube (outer/inner radius 1.5), pressurised inside
-    (follower load): the inner radius against the closed form's inverse."""
-    from nylonflex.fe.mesh import _ccw, _extrude, _grid
+    (follower load): the inner radius against the closed form's inverse. The twin's
+    quadratic hexahedra (``MeshSize.order`` 2, midpoints on the arcs) on a quarter of
+    the linear ones' cells are five times closer."""
+    from nylonflex.fe.mesh import _ccw, _extrude, _grid, _quadratic
+    from nylonflex.fe.model import element
 
     sil = silicone_parameters("tc5005")
     mu_f, alpha_f = felupe_ogden(sil.mu, sil.alpha)
-    radii, phis = np.linspace(1.0, 1.5, 5), np.linspace(0, math.pi / 2, 9)
+    radii, phis = np.linspace(1.0, 1.5, n_r + 1), np.linspace(0, math.pi / 2, n_phi + 1)
     _, quads = _grid(radii, phis)
     rr, pp = np.meshgrid(radii, phis, indexing="ij")
     pts2 = np.stack([rr * np.cos(pp), rr * np.sin(pp)], -1).reshape(-1, 2)
     pts, cells = _extrude(pts2, _ccw(pts2, quads), np.array([0.0, 0.1]))
-    mesh = felupe.Mesh(pts, cells, "hexahedron")
-    region = felupe.RegionHexahedron(mesh)
+    inner = np.isclose(np.hypot(pts[:, 0], pts[:, 1]), 1.0)
+    if order == 2:
+        pts, cells, inner = _quadratic(pts, cells, inner, 1.0, 0.0, 1e-9)
+        assert np.allclose(np.hypot(pts[inner, 0], pts[inner, 1]), 1.0)  # on the arc
+    kind, Region, Boundary = element(cells)
+    mesh = felupe.Mesh(pts, cells, kind)
+    region = Region(mesh)
     assert np.all(region.dV > 0)
     field = felupe.FieldContainer([felupe.Field(region, dim=3)])
     umat = OgdenIsochoric(mu_f, alpha_f)  # the twin's material
     solid = felupe.SolidBodyNearlyIncompressible(umat, field, bulk=5000 * sum(mu_f))
-    inner = np.isclose(np.hypot(pts[:, 0], pts[:, 1]), 1.0)
-    face = felupe.RegionHexahedronBoundary(mesh, only_surface=True, mask=inner)
+    face = Boundary(mesh, only_surface=True, mask=inner)
     pressure = felupe.SolidBodyPressure(felupe.FieldContainer([felupe.Field(face, dim=3)]))
     pressure.field.link(field)
     bounds = {"x": felupe.Boundary(field[0], fx=0, skip=(0, 1, 1)),
@@ -221,7 +250,7 @@ def test_thick_walled_tube_under_internal_pressure():
         felupe.newtonraphson(items=[solid, pressure], dof1=dof1, dof0=dof0, tol=1e-9)
     moved = pts + field[0].values
     r_inner = np.hypot(moved[inner, 0], moved[inner, 1])
-    assert r_inner.mean() == pytest.approx(1.25, rel=5e-3)
+    assert r_inner.mean() == pytest.approx(1.25, rel=tol)
 
 
 def test_bad_input_is_refused_before_any_solve():
@@ -350,3 +379,22 @@ def test_mesh_convergence_on_the_first_example():
     exact = th["fine"] + (th["fine"] - th["default"]) / (REFINEMENT ** 2 - 1)
     assert abs(th["default"] / exact - 1) < 0.03
     assert th["coarse"] < th["default"] < th["fine"]  # the coarse mesh is the stiffest
+
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="open: the default mesh is 5.5 % below the fine one "
+                   "here (docs/fidelity.md, Convergence); no tried mesh change reaches 3 %")
+def test_default_mesh_agrees_with_the_fine_one_on_the_slender_example_at_10_kpa():
+    # example 2 (7.5/2/70 mm) at 10 kPa, an 88 deg bend: the issue's target, 3 %. Measured:
+    # default 83.343 deg, fine 88.227 deg (the levels converge at first order or slower;
+    # more axial divisions or 20-node cells did not close it, docs/fidelity.md).
+    from nylonflex.fe.solve import solve_bend
+
+    a, t, length = 7.5e-3, 2e-3, 70e-3
+    mu, alpha = silicone_parameters("tc5005").arrays()
+    th = {m: solve_bend(body_mesh(a, t, length, mesh=m), mu, alpha, [10e3])[0]
+          for m in ("default", "fine")}
+    assert math.degrees(th["fine"]) > 80.0
+    assert abs(th["default"] / th["fine"] - 1) < 0.03
+    assert th["default"] < th["fine"]

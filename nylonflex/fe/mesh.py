@@ -25,13 +25,15 @@ class MeshSize:
     """Divisions of a mesh level: ``wall`` through the wall thickness, ``arc`` along the
     quarter arc (even), ``base`` through the floor (above its skin layer), ``axial`` per
     characteristic length along the chamber (see :func:`body_mesh`), ``cap`` through each
-    end cap."""
+    end cap; ``order`` the elements' (1: 8-node hexahedra, 2: 20-node serendipity
+    hexahedra, their edges' midpoints on the arcs)."""
 
     wall: int
     arc: int
     base: int
     axial: int
     cap: int
+    order: int = 1
 
 
 #: The mesh levels, coarse to fine; each refines the previous one by about 1.5 in every
@@ -56,7 +58,8 @@ SKIN_FRACTION = 0.05
 class BodyMesh:
     """A hexahedral mesh of the body and the sets the FE model needs.
 
-    ``points`` (n, 3) [m], ``cells`` (m, 8) hexahedra; ``skin`` and ``wrap`` are the cell
+    ``points`` (n, 3) [m], ``cells`` (m, 8) hexahedra or (m, 20) quadratic ones (the
+    corners first, then the edges' midpoints, :data:`HEX_EDGES`); ``skin`` and ``wrap`` are the cell
     indices of the strain-limiting layer (y < skin thickness) and of the wrap layer (the
     outermost cells of the wall and of the floor's side), ``wrap_direction`` (len(wrap), 3)
     the unit hoop direction of each wrap cell, ``skin_thickness`` and ``wrap_thickness``
@@ -219,9 +222,39 @@ def body_mesh(radius, wall_thickness, length, *, base_thickness=None, mesh="defa
     in_disc = (r_p <= a + tol) & (py >= b - tol)
     on_caps = (np.abs(pz) < tol) | (np.abs(pz - L) < tol)
     chamber = (along & ((on_wall_in & (py >= b - tol)) | on_floor)) | (on_caps & in_disc)
+    if size.order == 2:
+        points, cells, chamber = _quadratic(points, cells, chamber, a, b, tol)
+    elif size.order != 1:
+        raise ValueError(f"mesh order: 1 or 2, got {size.order!r}")
     return BodyMesh(points=points, cells=cells, skin=skin_cells, skin_thickness=skin,
                     wrap=wrap_cells, wrap_direction=direction, wrap_thickness=thickness,
                     chamber=chamber, radius=a, wall_thickness=t, base_thickness=b, length=L)
+
+
+#: The edges of a hexahedron, in the order of the 20-node element's midpoints (VTK's).
+HEX_EDGES = np.array([(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4),
+                      (0, 4), (1, 5), (2, 6), (3, 7)])
+
+
+def _quadratic(points, cells, chamber, a, b, tol):
+    """20-node hexahedra from 8-node ones: a point at the middle of every edge (appended
+    after the corners), on the arc where both ends lie at one radius r >= a about (0, b)
+    in one section (the wall's and the chamber's arcs: the element's edges follow the
+    curved surfaces). A midpoint is on the chamber's surface where both its ends are."""
+    edges = np.sort(cells[:, HEX_EDGES].reshape(-1, 2), axis=1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    p0, p1 = points[unique[:, 0]], points[unique[:, 1]]
+    mid = 0.5 * (p0 + p1)
+    r0 = np.hypot(p0[:, 0], p0[:, 1] - b)
+    r1 = np.hypot(p1[:, 0], p1[:, 1] - b)
+    arc = ((np.abs(r0 - r1) < tol) & (np.abs(p0[:, 2] - p1[:, 2]) < tol) & (r0 >= a - tol)
+           & (p0[:, 1] >= b - tol) & (p1[:, 1] >= b - tol))
+    phi = 0.5 * (np.arctan2(p0[arc, 1] - b, p0[arc, 0]) + np.arctan2(p1[arc, 1] - b, p1[arc, 0]))
+    mid[arc, 0] = r0[arc] * np.cos(phi)
+    mid[arc, 1] = b + r0[arc] * np.sin(phi)
+    cells20 = np.concatenate([cells, len(points) + inverse.reshape(len(cells), 12)], axis=1)
+    on = chamber[unique[:, 0]] & chamber[unique[:, 1]]
+    return np.concatenate([points, mid]), cells20, np.concatenate([chamber, on])
 
 
 def _merge(pieces, scale):

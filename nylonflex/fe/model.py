@@ -24,7 +24,7 @@ from .mesh import BodyMesh
 from .ogden import OgdenIsochoric
 
 __all__ = ["BULK_RATIO", "SKIN_RATIO", "WRAP_RATIO", "FibreMaterial", "build_model",
-           "felupe_ogden"]
+           "element", "felupe_ogden"]
 
 #: Bulk modulus of the volumetric penalty over the initial shear modulus (Poisson's ratio
 #: 0.4999 at 5000).
@@ -87,6 +87,18 @@ class FibreMaterial:
         return [A]
 
 
+def element(cells):
+    """FElupe's cell type, region and boundary region of hexahedral ``cells`` (m, 8) or
+    (m, 20): 8-node hexahedra (2 x 2 x 2 Gauss points) or 20-node serendipity ones
+    (3 x 3 x 3)."""
+    import felupe as fem
+
+    if np.shape(cells)[1] == 20:
+        return ("hexahedron20", fem.RegionQuadraticHexahedron,
+                fem.RegionQuadraticHexahedronBoundary)
+    return "hexahedron", fem.RegionHexahedron, fem.RegionHexahedronBoundary
+
+
 def build_model(body: BodyMesh, mu, alpha):
     """FElupe items of the body: (field, items, pressure item, boundaries, dof sets).
 
@@ -97,8 +109,9 @@ def build_model(body: BodyMesh, mu, alpha):
     a, t, b = body.radius, body.wall_thickness, body.base_thickness
     mu_f, alpha_f = felupe_ogden(mu, alpha)
     mu0 = float(sum(mu_f))
-    mesh = fem.Mesh(body.points, body.cells, "hexahedron")
-    region = fem.RegionHexahedron(mesh)
+    kind, Region, Boundary = element(body.cells)
+    mesh = fem.Mesh(body.points, body.cells, kind)
+    region = Region(mesh)
     field = fem.FieldContainer([fem.Field(region, dim=3)])
     silicone = OgdenIsochoric(mu_f, alpha_f)
     items = [fem.SolidBodyNearlyIncompressible(silicone, field, bulk=BULK_RATIO * mu0)]
@@ -111,11 +124,11 @@ def build_model(body: BodyMesh, mu, alpha):
             (body.skin, np.full(n_skin, 0.5 * WRAP_RATIO * mu0 * (a + t) / body.skin_thickness),
              np.tile([1.0, 0.0, 0.0], (n_skin, 1))),
             (body.wrap, wrap_k, body.wrap_direction)):
-        sub = fem.Mesh(body.points, body.cells[cells], "hexahedron")
-        sub_field = fem.FieldContainer([fem.Field(fem.RegionHexahedron(sub), dim=3)])
+        sub = fem.Mesh(body.points, body.cells[cells], kind)
+        sub_field = fem.FieldContainer([fem.Field(Region(sub), dim=3)])
         sub_field.link(field)
         items.append(fem.SolidBody(FibreMaterial(k, direction), sub_field))
-    boundary = fem.RegionHexahedronBoundary(mesh, only_surface=True, mask=body.chamber)
+    boundary = Boundary(mesh, only_surface=True, mask=body.chamber)
     pressure = fem.SolidBodyPressure(fem.FieldContainer([fem.Field(boundary, dim=3)]))
     pressure.field.link(field)
     x, z = body.points[:, 0], body.points[:, 2]
