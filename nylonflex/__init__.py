@@ -6,6 +6,8 @@
 0.150...
 """
 
+import importlib
+
 from ._version import __version__
 
 
@@ -42,8 +44,6 @@ def __dir__():
 
 def __getattr__(name):
     if name in _LAZY:
-        import importlib
-
         value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value  # later look-ups are plain (20 us a call of nf.evaluate)
         return value

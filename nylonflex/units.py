@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import reprlib
 
 __all__ = ["UNITS", "InputError", "json_text", "parse_quantity", "short", "to_si", "from_si",
            "unit_kind"]
@@ -139,8 +140,6 @@ def _units_of(kind):
 
 def _finite(obj):
     """``obj`` with every non-finite float (NaN, inf) as None, numpy scalars as Python's."""
-    import math
-
     if isinstance(obj, dict):
         return {str(k): _finite(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -166,8 +165,6 @@ def short(value, limit: int = 60) -> str:
     Built with :mod:`reprlib`, so a huge or deeply shared value (a YAML alias bomb) is never
     expanded to be cut afterwards.
     """
-    import reprlib
-
     r = reprlib.Repr()
     r.maxlevel, r.maxlist, r.maxtuple, r.maxdict, r.maxset = 2, 4, 4, 4, 4
     r.maxstring = r.maxother = r.maxlong = limit

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .units import from_si
+
 __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
            "THERMAL", "TRACKING", "UNCERTAIN", "VARIABLES", "Variable", "label", "name_label",
            "quantile_name", "range_text", "slab_done_attrs", "to_display", "validate"]
@@ -335,8 +337,6 @@ def range_text(name: str, lo=None, hi=None, unit: str | None = None) -> str:
     ``lo``/``hi`` [SI] replace the registry's bounds (the coil index's come from the
     muscle's table); ``unit`` defaults to the display unit.
     """
-    from .units import from_si
-
     v = {**VARIABLES, **INPUTS}[name]
     lo = v.lo if lo is None else lo
     hi = v.hi if hi is None else hi
@@ -348,8 +348,6 @@ def range_text(name: str, lo=None, hi=None, unit: str | None = None) -> str:
 
 def to_display(name: str, si):
     """SI values of a registered name in its display unit (mm, deg, kPa, ...)."""
-    from .units import from_si
-
     return from_si(np.asarray(si, dtype=float), VARIABLES[name].display)
 
 

@@ -6,7 +6,8 @@ first: foundation (units) <- files <- registry (variables) <- material files <- 
 simulation <- outputs (storage, charts, query) <- finite elements <- applications
 (calibration, design, explore, uncertainty, the JSON Schema) <- cli. An import of another
 nylonflex module must reach a lower layer (or its own package). The physics imports
-neither numba, xarray nor matplotlib.
+neither numba, xarray nor matplotlib. Imports sit at module top unless they are heavy
+(:data:`HEAVY_IMPORTS`, docs/architecture.md); no private name crosses a package.
 """
 
 import ast
@@ -273,6 +274,14 @@ def _private_imports():
     for path, module in _modules():
         package = module if path.name == "__init__.py" else module.rpartition(".")[0]
         for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):  # ``import nylonflex.pkg._module``
+                for alias in node.names:
+                    parts = alias.name.split(".")
+                    if parts[0] == "nylonflex" and len(parts) > 2 and \
+                            module.split(".")[1:2] != parts[1:2] and \
+                            any(n.startswith("_") and not n.startswith("__") for n in parts[2:]):
+                        out.add(f"{'.'.join(module.split('.')[1:])} -> {'.'.join(parts[1:])}")
+                continue
             if not isinstance(node, ast.ImportFrom):
                 continue
             base = node.module or ""
@@ -354,3 +363,223 @@ def test_nothing_imports_the_old_bench_subpackage():
                 [node.module or ""] if isinstance(node, ast.ImportFrom) else []
             found += [f"{path.relative_to(repo)} -> {n}" for n in names if old(n)]
     assert not found, "; ".join(found)
+
+
+# -------------------------------------------------------------- imports at module top
+#: The modules whose import a light command would feel (docs/architecture.md, "Imports at
+#: module top"), in ms: ``python -X importtime -c "import X"``, the cumulative times of the
+#: entries Python's own start lacks, median of 6 fresh processes (two sets of 3) on this
+#: 2-core machine, shared (single runs move by up to a factor of 2). The bar is 2 ms, 2 %
+#: of ``nylonflex --help`` (0.09 CPU-s, 55 ms of imports). A key names a module and all
+#: under it, unless a longer key names a submodule that costs more. Not here (under 2 ms):
+#: threading 1.9, copy 1.6, signal 1.4, weakref 1.2, isal 1.1, csv 1.1, zlib 0.8, math 0.6,
+#: fcntl 0.5, and the modules Python's start loads (os, re, pathlib, functools, ...).
+HEAVY_IMPORTS = {
+    "numpy": 174,
+    "numba": 675,
+    "numba.np.linalg": 89,  # beyond numba
+    "numba.np.arraymath": 855,  # beyond numba, with its BLAS probe's scipy.linalg
+    "llvmlite.ir": 8,
+    "scipy": 198,
+    "scipy.integrate": 942,
+    "scipy.optimize": 1220,
+    "scipy.sparse": 622,  # scipy.sparse.linalg 860
+    "scipy.special": 619,
+    "scipy.stats": 2269,
+    "matplotlib": 614,  # matplotlib.figure 1306, backends.backend_agg 1160, tri 884
+    "bokeh": 119,  # bokeh.plotting 1319, server.server 1464
+    "dask": 318,  # dask.array 1879
+    "distributed": 944,
+    "SALib": 761,  # SALib.sample 844
+    "felupe": 1213,
+    "pypardiso": 621,
+    "h5py": 289,
+    "h5netcdf": 311,
+    "hdf5plugin": 345,
+    "xarray": 1038,
+    "pandas": 582,
+    "netCDF4": 221,  # the tests' reader; the package writes netCDF-4 through h5py
+    "yaml": 26,
+    "pydantic": 102,
+    "tqdm": 128,
+    "psutil": 40,
+    "zstandard": 13,
+    "isal.isal_zlib": 5,
+    # the standard library's
+    "asyncio": 94,
+    "importlib.metadata": 82,
+    "importlib.resources": 23,
+    "inspect": 16,
+    "multiprocessing": 15,
+    "dataclasses": 14,
+    "concurrent.futures": 14,
+    "logging": 12,
+    "secrets": 12,
+    "subprocess": 10,
+    "tempfile": 9,
+    "socket": 8,
+    "pkgutil": 7,
+    "fractions": 6,
+    "hashlib": 6,
+    "uuid": 6,
+    "shutil": 5,
+    "typing": 5,
+    "platform": 4,
+    "json": 4,
+    "argparse": 3,
+    "html": 3,
+    "datetime": 3,
+    "difflib": 2,
+}
+
+
+#: Modules some platforms lack, imported where they are used: ``fcntl`` (POSIX) locks a
+#: cube being written; reading one (``nylonflex info``, which loads the journal) needs none.
+PLATFORM_IMPORTS = ("fcntl",)
+
+
+def _heavy_key(name: str) -> str | None:
+    """The key of :data:`HEAVY_IMPORTS` a dotted module name falls under (the longest)."""
+    parts = name.split(".")
+    return next((".".join(parts[:i]) for i in range(len(parts), 0, -1)
+                 if ".".join(parts[:i]) in HEAVY_IMPORTS), None)
+
+
+def _lazy_names(path: Path, module: str) -> dict[str, str]:
+    """A package's names imported on first use (PEP 562: ``_LAZY``, ``_WHERE``): name ->
+    the nylonflex module that defines it."""
+    out = {}
+    tree = ast.parse(path.read_text())
+    if path.name != "__init__.py" or not any(
+            isinstance(n, ast.FunctionDef) and n.name == "__getattr__" for n in tree.body):
+        return out
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Dict):
+            for key, value in zip(node.value.keys, node.value.values):
+                if isinstance(key, ast.Constant) and isinstance(value, ast.Constant) \
+                        and isinstance(value.value, str):
+                    level = len(value.value) - len(value.value.lstrip("."))
+                    anchor = module.split(".")[:len(module.split(".")) - max(level - 1, 0)]
+                    out[key.value] = _resolve(".".join([*anchor, value.value.lstrip(".")]))
+    return out
+
+
+def _import_statements(path: Path):
+    """``(node, in_function)`` for each import statement of a module."""
+    out = []
+
+    def visit(node, in_function):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.Import, ast.ImportFrom)):
+                out.append((child, in_function))
+            visit(child, in_function or isinstance(child, (ast.FunctionDef,
+                                                           ast.AsyncFunctionDef, ast.Lambda)))
+
+    visit(ast.parse(path.read_text()), False)
+    return out
+
+
+def _loads(node, path: Path, module: str, lazy: dict) -> tuple[set[str], set[str]]:
+    """The nylonflex modules (with the packages above them) and the heavy keys one import
+    statement loads."""
+    if isinstance(node, ast.Import):
+        names = [a.name for a in node.names]
+    else:
+        package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+        base = node.module or ""
+        if node.level:
+            anchor = package.split(".")
+            anchor = anchor[:len(anchor) - (node.level - 1)]
+            base = ".".join([*anchor, base] if base else anchor)
+        names = [f"{base}.{a.name}" for a in node.names]
+    ours, heavy = set(), set()
+    for name in names:
+        if name.split(".")[0] in PLATFORM_IMPORTS:
+            heavy.add(name.split(".")[0])
+        elif name.split(".")[0] != "nylonflex":
+            if _heavy_key(name):
+                heavy.add(_heavy_key(name))
+            continue
+        target = _resolve(name)
+        owner, _, attr = name.rpartition(".")
+        if target == owner and attr in lazy.get(owner, {}):
+            target = lazy[owner][attr]  # ``from package import name``: its module, lazily
+        parts = target.split(".")
+        ours.update(".".join(parts[:i]) for i in range(1, len(parts) + 1))
+    return ours, heavy
+
+
+def _function_level_imports():
+    """``(where, statement, heavy keys it would add at module top)`` for each import inside
+    a function, with what each module's module-top imports load (transitively)."""
+    modules = dict((m, p) for p, m in _modules())
+    lazy = {m: _lazy_names(p, m) for m, p in modules.items()}
+    top, inner = {}, []
+    for module, path in modules.items():
+        parts = module.split(".")
+        ours = {".".join(parts[:i]) for i in range(1, len(parts))}  # its packages load first
+        heavy = set()
+        for node, in_function in _import_statements(path):
+            loaded = _loads(node, path, module, lazy)
+            if in_function:
+                inner.append((module, path, node, loaded))
+            else:
+                ours |= loaded[0]
+                heavy |= loaded[1]
+        top[module] = (ours - {module}, heavy)
+    reach: dict[str, set[str]] = {}
+
+    def reaches(module):  # the heavy keys a module's import loads (no circles: tested above)
+        if module not in reach:
+            reach[module] = set()
+            ours, heavy = top.get(module, ((), ()))
+            reach[module] = set(heavy).union(*(reaches(m) for m in ours))
+        return reach[module]
+
+    for module, path, node, (ours, heavy) in inner:
+        adds = set(heavy).union(*(reaches(m) for m in ours)) - reaches(module)
+        yield (f"{path.relative_to(PKG.parent)}:{node.lineno}", ast.unparse(node), adds)
+
+
+def test_imports_sit_at_module_top_unless_they_are_heavy():
+    # a function imports only what would cost a light command (or `import nylonflex`)
+    # time at module top: a heavy module, or a nylonflex module that loads one, that the
+    # module's own top does not load already. Everything else is imported at module top.
+    wrong = [f"{where}: {statement} (loads nothing slow that the module does not)"
+             for where, statement, adds in _function_level_imports() if not adds]
+    assert not wrong, "move to module top: " + "; ".join(wrong)
+
+
+def test_the_import_rule_fails_on_a_cheap_function_level_import():
+    # a probe module (outside the physics and kernels, whose sources name the model): numpy
+    # at its top; in a function a cheap module, numpy again, a module its own package
+    # loads already, and two heavy ones
+    bad = PKG / "query" / "_import_probe.py"
+    bad.write_text("import numpy\n\n\ndef f():\n    import json\n    import numpy as np\n"
+                   "    from . import scan\n    import scipy.optimize\n"
+                   "    from ..kernels import design\n")
+    try:
+        adds = {statement: heavy for where, statement, heavy in _function_level_imports()
+                if where.startswith("nylonflex/query/_import_probe.py")}
+        assert adds["import json"] == adds["import numpy as np"] == set()
+        assert adds["from . import scan"] == set()
+        assert adds["import scipy.optimize"] == {"scipy.optimize"}
+        assert "numba" in adds["from ..kernels import design"]
+        with pytest.raises(AssertionError, match=r"_import_probe.py:5: import json .*"
+                           r"_import_probe.py:6: import numpy as np .*"
+                           r"_import_probe.py:7: from . import scan \("):
+            test_imports_sit_at_module_top_unless_they_are_heavy()
+    finally:
+        bad.unlink()
+
+
+def test_the_private_name_check_fails_on_a_private_import():
+    bad = PKG / "cli" / "_private_probe.py"
+    bad.write_text("import nylonflex.charts._common\n\n\ndef f():\n"
+                   "    from ..storage.cube import _chunks\n    from . import _common\n")
+    try:
+        found = {f for f in _private_imports() if f.startswith("cli._private_probe")}
+        assert found == {"cli._private_probe -> charts._common",
+                         "cli._private_probe -> storage.cube._chunks"}
+    finally:
+        bad.unlink()

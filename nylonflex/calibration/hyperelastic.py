@@ -22,7 +22,9 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
+from scipy.optimize import nnls
 
+from ..materials import WALL_STRETCH_RANGE
 from ..units import InputError
 from ._lsq import derived, solve, solve_ar1
 from .data import Table, column, read_table
@@ -130,8 +132,6 @@ def silicone_data(table: Table, max_stretch=None):
 
 def _ogden_starts(n_terms, lam, stress, test, rng, per_pattern):
     """Starts over the sign patterns of alpha; mu from a sign-constrained linear fit."""
-    from scipy.optimize import nnls
-
     for signs in itertools.combinations_with_replacement((1.0, -1.0), n_terms):
         signs = np.array(signs)
         mags = [np.array([2.0, 5.0, 0.5][:n_terms]), np.array([1.0, 8.0, 3.0][:n_terms])]
@@ -147,8 +147,6 @@ def _ogden_starts(n_terms, lam, stress, test, rng, per_pattern):
 
 def _window(max_stretch):
     """(top stretch or None for the whole curve, how it was chosen) of ``max_stretch``."""
-    from ..materials import WALL_STRETCH_RANGE
-
     if max_stretch is None or (isinstance(max_stretch, str) and max_stretch == "all"):
         return None, "all"
     if isinstance(max_stretch, str) and max_stretch == "design":
@@ -231,8 +229,6 @@ def fit_silicone(data, model="ogden2", test="uniaxial", max_stretch="design", na
 
 
 def _window_notes(lam_all, lam, top, how):
-    from ..materials import WALL_STRETCH_RANGE
-
     design = float(WALL_STRETCH_RANGE[1])
     notes = []
     if how == "design" and lam_all[-1] > top:

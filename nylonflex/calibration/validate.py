@@ -24,6 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..config import DESIGN_RANGES, read_yaml
+from ..materials import nylon_parameters, silicone_parameters
+from ..physics import bend_angle, chamber_pressure, tip_force
 from ..units import InputError, parse_quantity
 from .data import Table, column, read_table
 from ..config.material_files import anchor_material_files
@@ -70,9 +73,6 @@ def design_from_config(path) -> dict:
     InputError
         No ``design`` section, or a field out of its range; the message names the field.
     """
-    from ..config import DESIGN_RANGES, read_yaml
-    from ..materials import nylon_parameters, silicone_parameters
-
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     if not isinstance(raw, dict) or not isinstance(raw.get("design"), dict):
         raise InputError(f"{path}: needs a 'design:' section (radius, wall_thickness, length, "
@@ -120,8 +120,6 @@ def validate_design(config, data) -> list[Comparison]:
     InputError
         No known pair of columns, or values outside the model's range.
     """
-    from ..physics import bend_angle, chamber_pressure, tip_force
-
     design = config if isinstance(config, dict) else design_from_config(config)
     table = data if isinstance(data, Table) else read_table(data)
     a, t, L, b = (design[k] for k in ("radius", "wall_thickness", "length", "base_thickness"))

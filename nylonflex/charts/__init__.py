@@ -16,15 +16,18 @@ where the slice holds them exactly, with the cube's values there.
 
 from __future__ import annotations
 
+import inspect
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..config.charts import CHART_REGISTRY
-from ..storage.files import save_figure
+from ..storage.files import OwnedFiles, save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
 from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
+from ._parallel import draw_all
 from .compare import comparable, compare
 from .curves import fig4, fig6, fig7
 from .dynamics import cycle_rate_lines, cycle_rate_map, force_rate, tracking_map
@@ -111,8 +114,6 @@ def chart_slice(ds, at=None, coil_index=None) -> dict:
 
 def _slice_kwargs(func, chosen):
     """The keyword arguments of chart ``func`` that the slice ``chosen`` sets."""
-    import inspect
-
     params = inspect.signature(func).parameters
     kw = {name: value for name, value in chosen.items() if name in params}
     if "wall_thickness" in chosen and "walls" in params:
@@ -226,7 +227,6 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
             raise InputError(f"--variable: compare draws one of {', '.join(comparable(ds))}; "
                              f"got {variable!r}")
         chosen["variable"] = variable
-    from ..storage.files import OwnedFiles
 
     owner = chart_owner(ds)
     ds = _short_attrs(ds)
@@ -250,14 +250,11 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
                      "--overwrite')"
         if reason:
             if on_skip is None:
-                import warnings
-
                 warnings.warn(reason, stacklevel=2)
             else:
                 on_skip(reason)
             continue
         todo.append((name, model, path, fmt, _slice_kwargs(CHARTS[name], chosen)))
-    from ._parallel import draw_all
 
     warm_up()  # once, before the drawing processes fork
 

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..variables import VARIABLES, to_display
+from ..variables import VARIABLES, is_complete, to_display
 
 #: Image formats a chart can be written in.
 FORMATS = ("png", "pdf", "svg")
@@ -183,7 +183,6 @@ def _footer(fig, ds):
     version = ds.attrs.get("nylonflex_version", "?")
     note = f"cube '{name}' (nylonflex {version}, {ds.attrs.get('silicone', '?')} / " \
            f"{ds.attrs.get('nylon', '?')})"
-    from ..variables import is_complete
 
     if not is_complete(ds.attrs):
         note += " - INCOMPLETE cube: missing radii are blank"

@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from ..storage.files import save_figure
 
@@ -18,8 +19,6 @@ __all__ = ["draw_simulation_charts", "figure9", "figure10a"]
 
 
 def _config_reference_kind(ds, j=0):
-    import yaml
-
     try:
         return yaml.safe_load(ds.attrs["config"])["actuators"][j]["reference"]["kind"]
     except Exception:  # noqa: BLE001 - a chart without the config's label still draws
@@ -28,8 +27,6 @@ def _config_reference_kind(ds, j=0):
 
 def _design_line(ds, j=0):
     """``"control: a 7.5 mm, t 2 mm, L 70 mm, C 1.7, psi 8 deg, 12 V"`` from the config."""
-    import yaml
-
     try:
         cfg = yaml.safe_load(ds.attrs["config"])
         d = cfg["actuators"][j]["design"]

@@ -12,8 +12,13 @@ Command modules import nothing heavy at module level, so ``nylonflex --help`` st
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
+import os
+import signal
 import sys
+import threading
+import warnings
 
 from .. import __version__
 
@@ -99,9 +104,6 @@ def run():
     something (a non-daemon thread) or the output cannot be flushed (a closed pipe), the
     exit is the usual one.
     """
-    import os
-    import threading
-
     _block_unused_dask(_command(sys.argv[1:]))
     code = main()
     try:
@@ -112,7 +114,6 @@ def run():
     if any(t is not threading.main_thread() and not t.daemon
            for t in threading.enumerate()):
         sys.exit(code)
-    import atexit
 
     atexit._run_exitfuncs()
     try:
@@ -176,9 +177,6 @@ class _early_signals:
     """
 
     def __enter__(self):
-        import signal
-        import threading
-
         self.previous = {}
         if threading.current_thread() is not threading.main_thread():
             return self
@@ -189,8 +187,6 @@ class _early_signals:
         return self
 
     def __exit__(self, *exc):
-        import signal
-
         for sig, old in self.previous.items():
             signal.signal(sig, old)
         return False
@@ -204,8 +200,6 @@ def _record_signal(signum, frame):
 def interrupted_status() -> int:
     """The exit status of a command a signal stopped: 128 + the signal's number, the shell's
     convention (130 for Ctrl-C, 143 for SIGTERM)."""
-    import signal
-
     if EARLY_SIGNALS:
         return 128 + EARLY_SIGNALS[0]
     slabs = sys.modules.get("nylonflex.engine.slabs")  # it records the sweep's signals
@@ -221,8 +215,6 @@ def _lighten_process():
     OpenBLAS spin as they start, about 0.2 CPU-s of every command on a 2-core machine, for
     no BLAS work.
     """
-    import os
-
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
@@ -262,8 +254,6 @@ class _compile_notices:
         self.command = command
 
     def __enter__(self):
-        import warnings
-
         self._show = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
@@ -276,8 +266,6 @@ class _compile_notices:
         return self
 
     def __exit__(self, *exc):
-        import warnings
-
         warnings.showwarning = self._show
         return False
 

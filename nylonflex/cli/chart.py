@@ -5,6 +5,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ..units import InputError
+from ._common import open_cube_for, progress_bar
+
 HELP = "draw design charts from a cube"
 
 
@@ -33,8 +36,6 @@ def add_arguments(c):
 
 
 def _coil_indices(text):
-    from ..units import InputError
-
     try:
         return [float(x) for x in str(text).split(",") if x.strip()]
     except ValueError:
@@ -45,8 +46,6 @@ def _coil_indices(text):
 def run(args) -> int:
     from ..charts import draw_charts
     from ..query import parse_at
-    from ..units import InputError
-    from ._common import open_cube_for, progress_bar
 
     from ..config import CHARTS
 

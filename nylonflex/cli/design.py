@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
+
+from . import warn
+from ._common import progress_bar
 
 HELP = "design from a spec: best design or Pareto front, refined off the grid"
 DESCRIPTION = """Design from a specification (objectives, constraints with units, a cube or grid).
@@ -23,9 +27,6 @@ def add_arguments(p):
 def run(args) -> int:
     from ..design import run_design
     from ..design.report import format_csv, format_json, format_table, summary
-    from . import warn
-
-    from ._common import progress_bar
 
     with progress_bar("refine", unit="start") as bar:
         res = run_design(args.spec, cube=args.cube, progress=bar)
@@ -36,8 +37,6 @@ def run(args) -> int:
             print(f"nylonflex design: {line.strip()}", file=sys.stderr)
     if args.chart:
         from ..charts.design import draw_front
-
-        from pathlib import Path
 
         target = Path(args.chart) / f"{res.spec.name}.png"
         if target.exists():

@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import sys
+from pathlib import Path
+
+from ..units import InputError
+from . import warn
+from ._common import open_cube_for
 
 HELP = "explore a cube in a local web page (or write one offline HTML file)"
 DESCRIPTION = """\
@@ -39,8 +46,6 @@ _NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explor
 
 def _has(module: str) -> bool:
     """Whether ``module`` can be imported (the optional ``explore`` extra)."""
-    import importlib.util
-
     return importlib.util.find_spec(module) is not None
 
 
@@ -57,12 +62,6 @@ def port_free(port: int, host: str = "127.0.0.1") -> bool:
 
 
 def run(args) -> int:
-    import os
-    from pathlib import Path
-
-    from ..units import InputError
-    from ._common import open_cube_for
-
     if args.html:
         from ..storage.files import refuse_special
 
@@ -113,8 +112,6 @@ def run(args) -> int:
 def _one_cooling(ds, name, source):
     """The cube at the cooling set ``name`` (a cube of several: the page shows one), and the
     page's source line naming it."""
-    from ..units import InputError
-
     have = [str(c) for c in ds["cooling"].values] if "cooling" in ds.dims else []
     if name is None and not have:
         return ds, source
@@ -132,7 +129,6 @@ def _fidelity(cube):
     """(dataset, file name) of the cube's fidelity dataset (``nylonflex verify``), or None;
     an unreadable one is a warning, and the page goes on without it."""
     from ..fe.verify import fidelity_path, open_fidelity
-    from . import warn
 
     try:
         fid = open_fidelity(cube)

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import re
 import sys
+
+from ..units import InputError, json_text, parse_quantity
+from ._common import progress_bar
 
 HELP = "bend angle of one design by the finite-element twin (needs the [fe] extra)"
 DESCRIPTION = """\
@@ -33,8 +37,6 @@ def add_arguments(p):
 
 def parse_design(text):
     """``radius=20mm,...`` -> (design dict in SI, silicone name or None)."""
-    from ..units import InputError, parse_quantity
-
     design, silicone = {}, None
     for part in [s for s in str(text).split(",") if s.strip()]:
         if "=" not in part:
@@ -59,11 +61,7 @@ def parse_design(text):
 
 def parse_pressures(text):
     """``0:12:4kPa`` or ``2,5,10`` (kPa when bare) -> pressures [Pa]."""
-    import re
-
     import numpy as np
-
-    from ..units import InputError, parse_quantity
 
     text = str(text).strip()
     m = re.fullmatch(r"\s*([^:]+):([^:]+):([^:]+?)\s*([A-Za-z]+)?\s*", text)
@@ -96,11 +94,9 @@ def run(args) -> int:
     import numpy as np
 
     from ..engine import bend_angle
-    from ..units import json_text
     from ..fe import fe_bend, require_felupe
     from ..fe.verify import ANGLE_MODELS
     from ..variables import MODELS
-    from ._common import progress_bar
 
     design, silicone = parse_design(args.at)
     pressures = parse_pressures(args.pressure)

@@ -3,7 +3,14 @@
 
 from __future__ import annotations
 
+import os
 import sys
+from pathlib import Path
+
+from .. import __version__
+from ..units import InputError, json_text, parse_quantity
+from . import warn
+from ._common import progress_bar
 
 HELP = "fit a silicone or nylon muscle set to bench data, or fe_calibrated to the FE twin"
 DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
@@ -53,15 +60,12 @@ def add_arguments(p):
 
 
 def _q(text, field, kind, unit):
-    from ..units import parse_quantity
-
     return None if text is None else parse_quantity(text, field, kind, unit)
 
 
 def fit(args):
     """The FitResult the arguments ask for."""
     from ..calibration import fit_muscle, fit_silicone, fit_stroke, fit_thermal
-    from ..units import InputError
 
     t_amb = _q(args.t_amb, "--t-amb", "temperature", "degC")
     t_max = _q(args.t_max, "--t-max", "temperature", "degC")
@@ -127,20 +131,15 @@ def format_table(res) -> str:
 
 def run_fe(args) -> int:
     """``fit fe``: the training runs (journaled beside --out), the fit, its JSON file."""
-    import os
     from datetime import datetime, timezone
-    from pathlib import Path
 
     import numpy as np
 
-    from .. import __version__
     from ..fe import MESH_NAMES, require_felupe
     from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
     from ..physics.calibrated import CORRECTION, TERMS
     from ..fe.verify import MAX_DESIGNS
     from ..storage.files import refuse_special, write_atomic
-    from ..units import InputError, json_text
-    from ._common import progress_bar
 
     if args.data is not None:
         raise InputError(f"fit fe: takes no data file (got {args.data!r}); the FE twin "
@@ -209,17 +208,9 @@ def run_fe(args) -> int:
 def run(args) -> int:
     if args.kind == "fe":
         return run_fe(args)
-    from ..units import InputError as _InputError
-
     if args.data is None:
-        raise _InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
+        raise InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
     from ..calibration import write_material_file
-    from ..units import InputError, json_text
-    from . import warn
-
-    import os
-    from pathlib import Path
-
     from ..storage.files import refuse_special
 
     # refused before the work: a link, a special file, the data file itself, or (without

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import sys
 
+from ..units import InputError
+from ._common import progress_bar
+
 HELP = "describe a cube"
 
 
@@ -23,7 +26,6 @@ def run(args) -> int:
     if args.config:
         from ..engine.provenance import runnable_config
         from ..storage import cube_attrs
-        from ..units import InputError
 
         attrs = cube_attrs(args.cube)
         if attrs is None:
@@ -40,8 +42,6 @@ def run(args) -> int:
         print(line)
     damaged = any(line.startswith("damaged ") for line in lines)
     if args.check:
-        from ._common import progress_bar
-
         with progress_bar("check", unit="variable") as bar:
             problems = check_cube(args.cube, full=True, progress=bar)
         for line in problems:

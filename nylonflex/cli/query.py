@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
+
+from ..units import InputError
+from ._common import open_cube_for, progress_bar
 
 HELP = "ask a cube about designs"
 
@@ -11,8 +15,6 @@ DEFAULT_LIMIT = 20
 
 
 def _limit(text):
-    import argparse
-
     if str(text).strip().lower() in ("all", "none"):
         return None
     try:
@@ -60,8 +62,6 @@ def run(args) -> int:
 
     from ..query import (format_csv, format_json, format_table, held_back, parse_at,
                          parse_where, query_cube)
-    from ..units import InputError
-    from ._common import open_cube_for, progress_bar
 
     ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
     try:

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import math
 import sys
+from pathlib import Path
+
+from ..units import InputError, json_text
 
 HELP = "Sobol' sensitivity of design variables to the uncertain parameters"
 DESCRIPTION = """Sobol' first-order and total indices (SALib, Saltelli sampling, 95 %
@@ -39,12 +42,9 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from pathlib import Path
-
     from ..config import load_config
     from ..query import parse_at
     from ..uncertainty import sobol_indices
-    from ..units import InputError, json_text
     from ..variables import AXES
 
     cfg = load_config(args.config, args.set)

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import gc
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 
 from . import EARLY_SIGNALS
+from ._common import progress_bar
 
 HELP = "evaluate a design space into a cube"
 
@@ -56,8 +59,6 @@ def run(args) -> int:
 
 
 def _run(args, charts: bool) -> int:
-    from contextlib import ExitStack
-
     from ..storage.files import refuse_special
 
     def log(msg):
@@ -88,7 +89,6 @@ def _run(args, charts: bool) -> int:
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if not charts or not cfg.charts:
         return 0
-    from ._common import progress_bar
 
     names = list(cfg.charts)
     if unchanged:  # nothing was computed: the charts already beside it stay as they are
@@ -157,15 +157,11 @@ class _collect_after_start:
     """
 
     def __enter__(self):
-        import gc
-
         self.enabled = gc.isenabled()
         gc.disable()
         return self
 
     def __exit__(self, *exc):
-        import gc
-
         gc.freeze()
         if self.enabled:
             gc.enable()

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
+
+from ..units import json_text
 
 HELP = "compare a design's model with actuator measurements"
 DESCRIPTION = """Compare the model of the design in CONFIG (a `design:` section, as in
@@ -20,11 +23,8 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from pathlib import Path
-
     from ..calibration.data import read_table
     from ..calibration.validate import validate_design
-    from ..units import json_text
 
     table = read_table(args.data)
     comps = validate_design(args.config, table)

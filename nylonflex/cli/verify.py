@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
+import time
+
+from ._common import progress_bar
 
 HELP = "hold a cube's models against the FE twin (needs the [fe] extra)"
 DESCRIPTION = """\
@@ -15,8 +19,6 @@ resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the
 
 def _integer(text):
     """An integer flag's value (argparse names the flag in its message)."""
-    import argparse
-
     try:
         return int(text)
     except ValueError:
@@ -39,15 +41,12 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    import time
-
     import xarray as xr
 
     from ..charts.fidelity import fidelity_map
     from ..fe import require_felupe
     from ..fe.verify import fidelity_summary, run_verify
     from ..storage.files import save_figure
-    from ._common import progress_bar
 
     require_felupe()
     start = time.monotonic()

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from .._version import __version__
 from ..units import InputError
 from .safe_yaml import read_yaml
 
@@ -51,8 +52,6 @@ def material_document(result, name=None, fields=None) -> dict:
     fields : dict, optional
         For a nylon fit: ``{"base": set name, field: value, ...}`` to write.
     """
-    from .._version import __version__
-
     name = name or result.name or Path(result.data["path"]).stem
     doc = {"kind": "silicone" if result.kind == "silicone" else "nylon", "name": name,
            "fit": result.kind, "model": result.model}

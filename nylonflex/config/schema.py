@@ -10,7 +10,8 @@ from __future__ import annotations
 from typing import Any, Literal, Union
 
 from .base import _Strict
-from .sweep import FixedThickness, Grid
+from .simulate import SimConfigModel
+from .sweep import FixedThickness, Grid, SweepConfig
 
 __all__ = ["SCHEMAS", "json_schema"]
 
@@ -51,9 +52,6 @@ class DesignSpecModel(_Strict):
 
 
 def _models() -> dict:
-    from .simulate import SimConfigModel
-    from .sweep import SweepConfig
-
     return {"sweep": SweepConfig, "simulate": SimConfigModel, "design": DesignSpecModel}
 
 

@@ -26,9 +26,10 @@ from pydantic import BeforeValidator, ValidationError, field_validator, model_va
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
+from .material_files import anchor_material_files
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
-from ..variables import INPUTS, VARIABLES
+from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES
 from .charts import CHART_REGISTRY
 from .base import (
     Count,
@@ -357,8 +358,6 @@ def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
 
 def _models(model) -> tuple[str, ...]:
     """The model variants of a config's ``model`` (one name or a list), checked."""
-    from ..variables import MODELS
-
     names = [model] if isinstance(model, str) else list(model)
     if not names:
         raise InputError(f"model: needs at least one of {', '.join(MODELS)}")
@@ -382,8 +381,6 @@ def _supply(supply) -> float | None:
 
 def cube_bytes(axes: dict, curves: dict) -> int:
     """Bytes of a cube's variables before compression, from the registry's dims and dtypes."""
-    from ..variables import CURVES, DESIGN
-
     sizes = {k: len(v) for k, v in {**axes, **curves}.items()}
     return sum(int(np.prod([sizes[d] for d in v.dims], dtype=float)) *
                np.dtype(v.dtype).itemsize for v in (*DESIGN.values(), *CURVES.values()))
@@ -449,7 +446,5 @@ def apply_overrides(raw: dict, overrides) -> dict:
 
 def load_config(path, overrides=()) -> ResolvedConfig:
     """Read, override (``KEY=VALUE`` strings) and validate a sweep config file."""
-    from .material_files import anchor_material_files
-
     raw = anchor_material_files(read_yaml(path), Path(path).parent)
     return parse_config(apply_overrides(raw, overrides), str(path))

@@ -20,7 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..config import parse_config
+from ..engine.provenance import cube_settings
 from ..query import COLUMNS
+from ..storage import open_cube
+from ..storage.sweep import run_sweep
 from ..units import InputError
 from .refine import Model, evaluate_rows, meets, refine
 from .resolution import check_fixed, merge_equal, snap
@@ -96,8 +100,6 @@ def _materials(ds, spec):
     ``model: fe_calibrated`` is answered under it, whatever the spec's default); a cube of
     several variants is refused, since its rows would mix them.
     """
-    from ..engine.provenance import cube_settings
-
     try:
         s = cube_settings(ds)
     except ValueError as err:
@@ -121,10 +123,6 @@ def _memo(settings) -> dict:
 
 
 def _open(spec, cube):
-    from ..config import parse_config
-    from ..storage import open_cube
-    from ..storage.sweep import run_sweep
-
     if cube is not None or spec.cube is not None:
         return open_cube(Path(cube if cube is not None else spec.cube), quiet=True)
     return run_sweep(parse_config(spec.sweep, "grid"))

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..engine import evaluate
 from ..variables import AXES
 
 __all__ = ["Model", "evaluate_rows", "meets", "refine"]
@@ -102,8 +103,6 @@ def _exact(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thick
            silicone, nylon, model, supply_voltage=None, cooling=None):
     """The one call into the exact pointwise model, :func:`nylonflex.evaluate` (compiled;
     every design variable, SI)."""
-    from ..engine import evaluate
-
     return evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
                     base_thickness=base_thickness, silicone=silicone, nylon=nylon,
                     model=model, supply_voltage=supply_voltage, cooling=cooling)

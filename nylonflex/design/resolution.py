@@ -26,6 +26,7 @@ import numpy as np
 
 from ..units import InputError, from_si, to_si
 from ..variables import AXES, VARIABLES
+from .refine import evaluate_rows, meets
 
 __all__ = ["check_fixed", "merge_equal", "on_resolution", "snap"]
 
@@ -106,8 +107,6 @@ def snap(model, spec, rows, ranges, keep_bits=False) -> tuple[dict, np.ndarray, 
     lost : int
         Designs none of whose neighbours meets every constraint (dropped).
     """
-    from .refine import evaluate_rows, meets
-
     res = spec.resolution
     n = len(rows["radius"])
     X, moved, origin = [], [], []

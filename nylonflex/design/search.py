@@ -19,6 +19,7 @@ from ..variables import TRACKING
 from ..query.scan import radius_slabs
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
+from .spec import fixed_axes
 
 __all__ = ["GridScan", "nondominated", "scan_grid", "violation"]
 
@@ -141,8 +142,6 @@ def scan_grid(ds, spec, keep: int = 1) -> GridScan:
     -------
     GridScan
     """
-    from .spec import fixed_axes
-
     asked = [*(o.name for o in spec.objectives), *(c.name for c in spec.constraints)]
     missing = [n for n in asked if n not in ds.variables]
     if missing:

@@ -25,9 +25,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..config import read_yaml
 from ..query import COLUMNS, Condition, parse_constraint
-from ..variables import TRACKING
-from ..units import InputError
+from ..variables import TRACKING, VARIABLES
+from ..units import InputError, parse_quantity
 from ..variables import AXES
 
 __all__ = ["DesignSpec", "Objective", "load_spec", "parse_spec"]
@@ -145,9 +146,6 @@ def _refine(value, multi):
 
 def _resolution(value) -> dict:
     """``{axis: step}`` [SI] from ``resolution: {coil_index: 0.05, wall_thickness: 0.5 mm}``."""
-    from ..units import parse_quantity
-    from ..variables import VARIABLES
-
     if value is None:
         return {}
     if not isinstance(value, dict):
@@ -249,8 +247,6 @@ def parse_spec(raw, source: str = "spec") -> DesignSpec:
 
 def load_spec(path) -> DesignSpec:
     """Read and validate a spec file (YAML)."""
-    from ..config import read_yaml
-
     try:
         raw = read_yaml(path)
     except InputError as err:

@@ -24,12 +24,22 @@ versions before any work (and each task checks again, for workers that join late
 
 from __future__ import annotations
 
+import contextlib
+import logging
+import os
 import re
+import threading
+import time
 import uuid
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy
+
+from .. import __version__
+from ..kernels import source_digest
 from ..units import InputError
+from .grid import compute_slab
 
 __all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "STALL_TIMEOUT", "WORKER_WAIT",
            "DaskExecutor"]
@@ -68,10 +78,6 @@ def _versions() -> dict:
     side is caught even where the version number did not change.
     """
     import numba
-    import numpy
-
-    from .. import __version__
-    from ..kernels import source_digest
 
     return {"nylonflex": __version__, "model": source_digest(), "numba": numba.__version__,
             "numpy": numpy.__version__}
@@ -89,8 +95,6 @@ def _connect(client_class, address, timeout):
     (a web server, the dashboard port typed for the scheduler's): its handshake waits
     forever. The client is made in a daemon thread, which is abandoned after the deadline.
     """
-    import threading
-
     box: dict = {}
 
     def connect():
@@ -114,8 +118,6 @@ def _disarm(exc, client_class):
     """Close the half-made client a failed connection left in ``exc``'s traceback (a
     listener that answered garbage), so that its finaliser does not wait 10 s at exit and
     print "Exception ignored ... TimeoutError" after the one line of the error."""
-    import contextlib
-
     tb = exc.__traceback__
     while tb is not None:
         obj = tb.tb_frame.f_locals.get("self")
@@ -131,8 +133,6 @@ def _disarm(exc, client_class):
 def _quiet_dask_logs() -> dict:
     """Silence dask.distributed's loggers below CRITICAL (a lost scheduler makes them log
     reconnect tracebacks); returns the levels to restore with :func:`_restore_logs`."""
-    import logging
-
     names = ["distributed", *(n for n in logging.root.manager.loggerDict
                               if n.startswith("distributed."))]
     saved = {}
@@ -144,16 +144,12 @@ def _quiet_dask_logs() -> dict:
 
 
 def _restore_logs(saved: dict):
-    import logging
-
     for name, level in saved.items():
         logging.getLogger(name).setLevel(level)
 
 
 def _stall_seconds() -> float:
     """The stall timeout [s]: ``NYLONFLEX_DASK_STALL`` if set, else :data:`STALL_TIMEOUT`."""
-    import os
-
     text = os.environ.get("NYLONFLEX_DASK_STALL", "").strip()
     if not text:
         return STALL_TIMEOUT
@@ -173,7 +169,6 @@ def _slab_task(cfg, i0: int, i1: int, expected: dict) -> dict:
     if bad:
         raise RuntimeError(f"this Dask worker runs {bad}; install the client's versions so "
                            "that the cube is reproducible")
-    from .grid import compute_slab
 
     return compute_slab(cfg, i0, i1, parallel=False)
 
@@ -336,8 +331,6 @@ class DaskExecutor:
     def _wait_until(self, ready):
         """Wait until ``ready()``; give up after ``stall`` seconds with no live worker
         (every worker died, or the scheduler is gone)."""
-        import time
-
         last_alive = time.monotonic()
         while not ready():
             time.sleep(0.2)

@@ -7,16 +7,24 @@ executor computes and a sink stores (:mod:`.slabs`).
 
 from __future__ import annotations
 
+import threading
+import weakref
+
 import numpy as np
 
 from ..config import ResolvedConfig
+from ..kernels.records import CoilTable, GridAxes, GridOut, Muscle, Nodes, Ogden, Options
 from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, FLOAT_DESIGN, N_FLAGS, N_FLOAT_DESIGN
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
-from ..physics.nylon import nylon_force_limit, stroke_max
-from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length
-from ..physics.wrap import muscle_width
+from ..physics.limits import MODELS
+from ..physics.nylon import check_stroke_shape, nylon_force_limit, stroke_max
+from ..physics.thermal import (check_supply_rise, coil_heat_loss_per_length,
+                               coil_resistance_per_length)
+from ..physics.wrap import muscle_width, outer_perimeter
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
+from .sampled import slab_statistics, uncertain_variables
+from .tracking import slab_tracking, tracking_variables
 from .threads import run_chunks
 
 __all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
@@ -35,9 +43,6 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
     there only with a supply (docs/model.md s. 15-16); the quantiles and feasibility only
     with ``uncertainty``/``requirements``.
     """
-    from .sampled import uncertain_variables
-    from .tracking import tracking_variables
-
     supply = cfg.supply_voltage is not None
     out = {n: (v, v.dims_for(cfg.models, cfg.cooling_names, supply))
            for n, v in {**DESIGN, **CURVES}.items() if supply or n not in SUPPLY_ONLY}
@@ -98,10 +103,6 @@ def check_physics(cfg: ResolvedConfig):
     w / cos psi) is L min(1 / sin psi, P_out / w), and psi is independent of P_out and w, so
     its largest value over the grid is L_max min(1 / sin psi_min, P_max / w_min).
     """
-    from ..physics.nylon import check_stroke_shape
-    from ..physics.thermal import check_supply_rise
-    from ..physics.wrap import muscle_width, outer_perimeter
-
     ny = cfg.nylon
     check_stroke_shape(ny.t_max, ny.t_amb, ny.gamma, ny.beta, ny.t_g, ny.sigma_g)
     if cfg.supply_voltage is None:
@@ -156,8 +157,6 @@ def coil_table(cfg: ResolvedConfig):
     """The kernels' per-coil-index table (:class:`~nylonflex.kernels.records.CoilTable`) of
     ``cfg``'s coil-index axis: s_max [-], force limit [N], muscle width [m], r' [ohm/m] and
     heat loss per length [W/(K m)], one contiguous float64 column each."""
-    from ..kernels.records import CoilTable
-
     c = cfg.axes["coil_index"]
     column = lambda x: np.ascontiguousarray(x, dtype=float).reshape(-1)  # noqa: E731
     return CoilTable(column(stroke_max(c, cfg.nylon)), column(nylon_force_limit(c, cfg.nylon)),
@@ -176,15 +175,11 @@ class ArrayPool:
     """
 
     def __init__(self):
-        import threading
-
         self._free: dict = {}
         self._made: dict = {}  # id -> weak reference of each array the pool made
         self._lock = threading.Lock()
 
     def empty(self, shape, dtype=float) -> np.ndarray:
-        import weakref
-
         key = (tuple(int(n) for n in shape), np.dtype(dtype).str)
         with self._lock:
             free = self._free.get(key)
@@ -219,8 +214,6 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
     (docs/model.md s. 9, 16). ``pool``: the kernel's output arrays
     come from it (and go back to it when the caller is done with the slab).
     """
-    from ..physics.limits import MODELS
-
     coolings = [cfg.with_cooling(c) for c in cfg.coolings] or [cfg]
     slabs = {(m, k): _compute_model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
              for m in cfg.models for k, one in enumerate(coolings)}
@@ -239,8 +232,6 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
 
 
 def _muscle(cfg: ResolvedConfig):
-    from ..kernels.records import Muscle
-
     ny = cfg.nylon
     one = lambda x: np.array([float(x)])  # noqa: E731
     return Muscle(one(ny.t_amb), one(ny.t_max), one(ny.gamma), one(ny.beta), one(ny.t_g),
@@ -251,7 +242,6 @@ def _muscle(cfg: ResolvedConfig):
 
 def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
     from ..kernels import design
-    from ..kernels.records import GridAxes, GridOut, Nodes, Ogden, Options
 
     grid = GridAxes(radius=np.ascontiguousarray(cfg.axes["radius"][i0:i1]),
                     wall=cfg.axes["wall_thickness"], length=cfg.axes["length"],
@@ -281,12 +271,8 @@ def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
     arrays.update(nylon_force=out.nylon_force, bend_angle=out.bend_angle,
                   tip_force=out.tip_force)
     if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
-        from .sampled import slab_statistics
-
         arrays.update(slab_statistics(cfg, i0, i1, arrays, parallel=parallel))
     if cfg.tracking is not None:  # docs/model.md s. 19
-        from .tracking import slab_tracking
-
         arrays.update(slab_tracking(cfg, i0, i1, arrays, parallel=parallel))
     return arrays
 

@@ -19,16 +19,18 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..kernels.records import CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut
 from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
 from ..materials import (NYLON_PARAMETERS, NYLON_TABLES, SILICONE_PARAMETERS, Nylon, Silicone,
-                         check_nylon, check_silicone, nylon_parameters, silicone_kind,
-                         silicone_parameters)
+                         check_nylon, check_silicone, cooling_parameters, nylon_parameters,
+                         silicone_kind, silicone_parameters)
 from ..physics import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
-from ..physics.thermal import check_supply_rise, coil_resistance
+from ..physics.thermal import check_supply_rise, coil_resistance, convection_loss_per_length
+from ..units import short
 from ..variables import DESIGN
 from .threads import run_chunks
 
@@ -168,8 +170,6 @@ def _heat_loss(cooling, d_f, t_max, t_amb, c, own):
     (docs/model.md s. 9)."""
     if cooling is None:
         return own
-    from ..materials import cooling_parameters
-    from ..physics.thermal import convection_loss_per_length
 
     env = cooling_parameters(cooling)
     keys, inverse = np.unique(np.stack([d_f, t_max, t_amb, c]), axis=1, return_inverse=True)
@@ -275,8 +275,6 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
 def _kernels():
     """The pointwise kernels' module and records, imported on first use (Numba)."""
     from ..kernels import design as kernels
-    from ..kernels.records import (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns,
-                                   PointOut)
 
     return kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut)
 
@@ -314,8 +312,6 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 # --------------------------------------------------------------------------- materials
 
 def _short(value, n=40):
-    from ..units import short
-
     return short(value, n)
 
 

@@ -3,14 +3,25 @@
 from __future__ import annotations
 
 import dataclasses
+import datetime as dt
+import os
+import platform
+from pathlib import Path
 
 import numpy as np
+import yaml
 
-from ..config import ResolvedConfig
-from ..materials import Cooling, Nylon, Silicone
+from .. import __version__
+from ..config import ResolvedConfig, parse_config
+from ..config.tracking import tracking_section
+from ..kernels import source_digest
+from ..materials import (COOLING_PARAMETERS, Cooling, Nylon, Silicone, cooling_parameters,
+                         nylon_parameters, silicone_parameters)
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
+from ..units import decimal_to_si, from_si
 from ..variables import is_complete  # noqa: F401 - re-exported
+from ..variables import AXES, VARIABLES
 
 __all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "cube_settings",
            "is_complete", "provenance", "run_attrs", "runnable_config", "settings_attrs",
@@ -58,12 +69,6 @@ def run_attrs(info: dict, *, complete: bool, seconds: float, computed: int,
     resumed : int
         Slabs restored from the journal [-].
     """
-    import datetime as dt
-    import os
-    import platform
-
-    from .. import __version__
-
     created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
     out = typed_info(info)
     out.update({
@@ -89,10 +94,6 @@ def provenance(cfg: ResolvedConfig) -> dict:
 
     import h5py
     import numba
-    import yaml
-
-    from .. import __version__
-    from ..kernels import source_digest
 
     def material(m):
         d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}
@@ -327,8 +328,6 @@ def _cooling(name: str, fluid: str, speed: float) -> Cooling:
     """A cube's cooling set: the named set at its speed, as the config resolved it (its
     description and sources from the set's table), or, for a set this version does not
     name, the fluid and speed alone."""
-    from ..materials import COOLING_PARAMETERS, cooling_parameters
-
     own = COOLING_PARAMETERS.get(name)
     if own is not None and own.get("fluid") == fluid:
         return cooling_parameters({"set": name, "speed": speed})
@@ -338,8 +337,6 @@ def _cooling(name: str, fluid: str, speed: float) -> Cooling:
 def _yaml_settings(attrs) -> CubeSettings:
     """The settings of a cube of format 1, from ``config_yaml`` (the resolved config, SI)
     and the sets' ``<kind>_parameters`` (their descriptions and stretch range)."""
-    import yaml
-
     def load(key):
         try:
             doc = yaml.safe_load(_text(attrs, key))
@@ -403,8 +400,6 @@ def _cooling_spec(resolved):
 
 def _sampling(cfg: ResolvedConfig) -> dict:
     """The distributions, sample count and seed of a sampled sweep; its requirements."""
-    import yaml
-
     out = {}
     if cfg.uncertainty is not None:
         spec = cfg.uncertainty
@@ -445,10 +440,6 @@ def runnable_config(attrs) -> str:
     ValueError
         The attributes hold no readable ``config_yaml`` (not a nylonflex cube).
     """
-    import yaml
-
-    from ..config import parse_config
-
     doc = yaml.safe_load(attrs.get("config_yaml") or "null") if attrs else None
     if not isinstance(doc, dict) or "grid" not in doc:
         raise ValueError("cube: no readable config_yaml attribute; cannot rebuild its "
@@ -457,7 +448,6 @@ def runnable_config(attrs) -> str:
            "silicone": _material_spec("silicone", doc["silicone"],
                                       attrs.get("silicone_parameters")),
            "nylon": _material_spec("nylon", doc["nylon"], attrs.get("nylon_parameters"))}
-    from ..variables import AXES
 
     out["grid"] = {k: _axis_spec(k, doc["grid"][k]) for k in AXES}
     base = doc.get("base_thickness", "wall")
@@ -475,8 +465,6 @@ def runnable_config(attrs) -> str:
     if doc.get("requirements"):
         out["requirements"] = list(doc["requirements"])
     if "tracking" in doc:  # docs/model.md s. 19
-        from ..config.tracking import tracking_section
-
         out["tracking"] = tracking_section(doc["tracking"])
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
@@ -502,9 +490,6 @@ _SI_UNITS = {"radius": "m", "wall_thickness": "m", "length": "m", "wrap_angle": 
 def _decimals(name: str, values) -> list | None:
     """The shortest decimals in the axis's display unit that convert back to ``values``
     [SI] exactly, or None."""
-    from ..units import decimal_to_si, from_si
-    from ..variables import VARIABLES
-
     unit = VARIABLES[name].display
     out = []
     for x in values:
@@ -524,8 +509,6 @@ def _axis_spec(name: str, values) -> dict:
     evenly spaced, else values (exactness is checked by :func:`runnable_config`)."""
     from fractions import Fraction
 
-    from ..variables import VARIABLES
-
     unit = VARIABLES[name].display
     units = {} if unit == "1" else {"units": unit}
     dec = _decimals(name, values)
@@ -541,10 +524,6 @@ def _axis_spec(name: str, values) -> dict:
 def _material_spec(kind: str, resolved: dict, parameters_text):
     """A material as a config names it: the set's name, ``{set, changed fields}``, the
     fitted file (where it still holds these values), or every field over the default set."""
-    import yaml
-
-    from ..materials import nylon_parameters, silicone_parameters
-
     make = silicone_parameters if kind == "silicone" else nylon_parameters
     fields = {k: v for k, v in resolved.items() if k != "name"}
     name = str(resolved.get("name", ""))
@@ -565,8 +544,6 @@ def _material_spec(kind: str, resolved: dict, parameters_text):
         return {"set": base, **changed}
     source = (extra.get("sources") or {}).get("file")
     if source:
-        from pathlib import Path
-
         path = Path(source).resolve()
         try:
             if path.is_file() and make({"file": str(path)}).to_dict() == resolved:

@@ -15,13 +15,16 @@ of samples meeting every requirement (docs/uncertainty.md).
 
 from __future__ import annotations
 
+import warnings
+from dataclasses import fields, replace
+
 import numpy as np
 
 from ..config import ResolvedConfig, UncertaintySpec
 from ..materials import SILICONE_PARAMETERS
 from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
-from .pointwise import evaluate
+from .pointwise import evaluate, serial
 
 __all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_statistics",
            "slab_statistics", "standard_from_unit", "standard_samples", "uncertain_variables"]
@@ -57,7 +60,6 @@ def standard_samples(spec: UncertaintySpec, samples: int | None = None) -> np.nd
     dims = sum(p.dims for p in spec.parameters)
     if dims == 0:
         return np.zeros((n, 0))
-    import warnings
 
     with warnings.catch_warnings():  # a sample count not a power of 2: still a valid QMC set
         warnings.simplefilter("ignore", UserWarning)
@@ -189,8 +191,6 @@ def perturbed_configs(cfg: ResolvedConfig, design: dict, z: np.ndarray) -> list:
         S pairs: the sample's design axes [SI] (moved where an axis is uncertain) and its
         config (``cfg`` itself where no material is uncertain).
     """
-    from dataclasses import fields, replace
-
     S = z.shape[0]
     args = perturbed_inputs({k: np.asarray(design[k], float) for k in AXES}, cfg, z)
     axes = {k: np.broadcast_to(np.asarray(args[k], float).reshape(-1), (S,)) for k in AXES}
@@ -272,8 +272,6 @@ def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     runs the evaluator on one Numba thread: one level of parallelism.
     """
     if not parallel:
-        from .pointwise import serial
-
         with serial():
             return slab_statistics(cfg, i0, i1, nominal, parallel=True)
     reqs = parse_requirements(list(cfg.requirements))

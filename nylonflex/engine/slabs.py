@@ -29,6 +29,7 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..units import InputError
+from ..variables import COOLING, COORDS, MODEL, slab_done_attrs
 from . import threads
 from .grid import ArrayPool, compute_slab, coords, cube_variables, global_arrays
 
@@ -235,8 +236,6 @@ class MemorySink:
     def dataset(self, attrs: dict):
         """The cube as an :class:`xarray.Dataset` (every variable with its registry attrs)."""
         import xarray as xr
-
-        from ..variables import COOLING, COORDS, MODEL, slab_done_attrs
 
         coords = {name: (name, values, COORDS[name].attrs())
                   for name, values in self.coords.items()}

@@ -13,6 +13,8 @@ points up to each design's own (both within 1e-9 of the curvature solve).
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 
 import numpy as np
 
@@ -24,8 +26,10 @@ from ..physics.nylon import stroke, stroke_scale
 from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length, \
     steady_temperature
 from ..physics.wrap import muscle_length
-from ..variables import TRACKING
+from ..variables import AXES, TRACKING
 from . import threads
+from .pointwise import evaluate
+from .sampled import perturbed_configs, perturbed_inputs
 from .threads import run_chunks
 
 __all__ = ["PLANT_POINTS", "design_tracking", "sampled_tracking", "slab_tracking",
@@ -180,10 +184,6 @@ def design_tracking(cfg: ResolvedConfig, design: dict, bend_angle_max: float | N
     dict of str to float
         :func:`tracking_variables`' names.
     """
-    from dataclasses import replace
-
-    from ..variables import AXES
-
     one = {k: np.array([float(design[k])]) for k in AXES}
     ny, ax = cfg.nylon, cfg.axes
     base = None if cfg.base_thickness is None else float(cfg.base_thickness)
@@ -234,10 +234,6 @@ def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=Non
     dict of str to ndarray
         ``names``, shape (S,) each.
     """
-    from concurrent.futures import ThreadPoolExecutor
-    from dataclasses import replace
-
-    from .sampled import perturbed_configs
 
     names = tuple(tracking_variables(cfg) if names is None else names)
     pairs = perturbed_configs(cfg, design, z)
@@ -247,9 +243,6 @@ def sampled_tracking(cfg: ResolvedConfig, design: dict, z: np.ndarray, names=Non
         quick = replace(cfg.tracking, bandwidth=None)
         pairs = [(d, replace(c, tracking=quick)) for d, c in pairs]
     if cfg.tracking.relative_to == "bend_angle_max" and bend_angle_max is None:
-        from .pointwise import evaluate
-        from .sampled import perturbed_inputs
-
         one = {k: np.asarray(design[k], float) for k in design}
         bend_angle_max = np.asarray(evaluate(**perturbed_inputs(one, cfg, z))
                                     ["bend_angle_max"], float).reshape(-1)

@@ -16,7 +16,11 @@ import dataclasses
 import time
 from contextlib import nullcontext
 
-from ..config import ResolvedConfig
+import numpy as np
+
+from ..config import ResolvedConfig, parse_config
+from .grid import compute_slab
+from .pointwise import evaluate
 
 __all__ = ["COMPILE_NOTICE", "KERNELS", "timed", "warm_up_codec", "warm_up_grid", "warm_up_kernels",
            "warm_up_points"]
@@ -63,8 +67,6 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     float
         Seconds [s] the warm-up took when a kernel compiled, else 0.0 (a warm cache).
     """
-    from .grid import compute_slab
-
     tiny = dataclasses.replace(
         cfg, axes={k: v[:1] for k, v in cfg.axes.items()},
         curves={k: v[:2] for k, v in cfg.curves.items()})
@@ -90,10 +92,6 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     float
         Seconds [s] the warm-up took when a kernel compiled, else 0.0 (a warm cache).
     """
-    import numpy as np
-
-    from .pointwise import evaluate
-
     kw = dict(settings or {})
 
     def call():
@@ -105,8 +103,6 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
 def warm_up_codec(*, notice=None) -> float:
     """Compile (or load from cache) the cube codec's byte shuffles (both loops), on a few
     bytes. Returns the seconds [s] it took when a kernel compiled, else 0.0."""
-    import numpy as np
-
     from ..kernels.bytes import shuffle_bytes
 
     def call():
@@ -119,8 +115,6 @@ def warm_up_codec(*, notice=None) -> float:
 
 def _tiny_config():
     """A one-radius, one-design-a-axis sweep config (fig12's materials and model)."""
-    from ..config import parse_config
-
     return parse_config({
         "name": "warmup",
         "grid": {"radius": {"values": [10], "units": "mm"},

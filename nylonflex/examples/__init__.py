@@ -12,6 +12,8 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
+from ..units import InputError
+
 __all__ = ["DATA", "EXAMPLES", "NEEDS", "example_text", "write_examples"]
 
 #: Example name -> what it is for (the file is ``configs/<name>.yaml``).
@@ -67,8 +69,6 @@ def write_examples(folder, names=None) -> list[Path]:
     nylonflex.units.InputError
         One of the files exists already (nothing is written then), or an unknown name.
     """
-    from ..units import InputError
-
     folder = Path(folder)
     everything = not names
     names = list(EXAMPLES) if everything else list(names)

@@ -15,7 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import yaml
 
+from ..engine.provenance import cube_settings
+from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
 
@@ -82,8 +85,6 @@ def validity_names(ds, bits) -> str:
 def stand_in_note(ds) -> str:
     """One sentence naming the cube's material sets whose values include proposals or
     stand-ins (source tag P, or a description saying "stand-in"), "" when none do."""
-    import yaml
-
     parts = []
     for kind in ("silicone", "nylon"):
         try:
@@ -126,11 +127,6 @@ def design_config(ds, at: dict, placeholders: bool = False) -> str:
     with every field of the cube's resolved sets, so that ``nylonflex sweep`` of it gives
     this design's values of the cube ("copy as config"). With ``placeholders`` each grid
     value is ``'@AXIS@'``, for a page to fill in."""
-    import yaml
-
-    from ..engine.provenance import cube_settings
-    from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
-
     try:
         settings = cube_settings(ds)
     except ValueError as err:

@@ -12,6 +12,7 @@ import html
 
 import numpy as np
 
+from ..fe.verify import fidelity_stats
 from ..variables import label
 from .data import display_unit, to_display_any
 
@@ -37,8 +38,6 @@ def fidelity_rows(ds, fid) -> dict:
 
 def fidelity_summary_html(fid, source: str) -> str:
     """The fidelity part's heading: per model, model/FE over every verified angle."""
-    from ..fe.verify import fidelity_stats
-
     parts = [f"<code>{html.escape(st['model'])}</code> median {st['median']:.3f} "
              f"({st['min']:.3f}-{st['max']:.3f}), {st['within']} of {st['n']} within 10 %"
              for st in fidelity_stats(fid)]

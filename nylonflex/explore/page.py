@@ -31,10 +31,12 @@ from importlib.resources import files
 
 import numpy as np
 
+from ..query import parse_where
 from ..units import InputError
 from ..variables import AXES, label, name_label
 from .data import (design_config, design_variables, display_unit, flag_meanings, snap,
                    stand_in_note, to_display_any, validity_names)
+from .fidelity import fidelity_widgets
 
 #: The most designs a page carries (the rest of a larger cube is left out, and it says so).
 MAX_DESIGNS = 120_000
@@ -54,8 +56,6 @@ _CURVES = {"nylon_force": ("stroke", ("radius", "wall_thickness", "coil_index", 
 
 def _conditions(where):
     """``--where`` texts parsed by the query's parser (Condition objects pass through)."""
-    from ..query import parse_where
-
     return [c for w in (where or ()) for c in (parse_where([w]) if isinstance(w, str)
                                                else [w])]
 
@@ -429,8 +429,6 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
 
     fidelity_box = []
     if fidelity is not None:
-        from .fidelity import fidelity_widgets
-
         fidelity_box = fidelity_widgets(ds, fidelity[0], fidelity[1])
     controls = [variable] + ([Div(text="model variant"), model] if model else []) + \
         [row(map_x, map_y)] + list(sliders.values())

@@ -23,8 +23,12 @@ import math
 
 import numpy as np
 
+from ..materials import silicone_parameters
 from ..physics.calibrated import TERMS
+from ..physics.limits import model_bend_angle
 from ..units import InputError
+from . import ORDER, fe_bend
+from .mesh import REFINEMENT
 from .runs import journaled_runs, plan_silicone
 
 __all__ = ["TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
@@ -53,8 +57,6 @@ def _pressure_at(angle, design, silicone):
     """The pressure [Pa] at which ``lateral_pressure`` bends ``design`` by ``angle`` [rad]."""
     from scipy.optimize import brentq
 
-    from ..physics.limits import model_bend_angle
-
     def gap(p):
         return model_bend_angle(p, design["radius"], design["wall_thickness"],
                                 design["length"], silicone=silicone,
@@ -73,8 +75,6 @@ def training_plan(designs=48, seed=0, mesh="coarse", silicone="tc5005") -> dict:
     """The training runs: ``designs`` sampled designs, each with the pressures of
     :data:`TARGET_ANGLES` (JSON-able; it identifies a run folder)."""
     from scipy.stats import qmc
-
-    from ..materials import silicone_parameters
 
     sil = silicone_parameters(silicone)
     names = tuple(TRAINING_RANGES)
@@ -95,8 +95,6 @@ def training_plan(designs=48, seed=0, mesh="coarse", silicone="tc5005") -> dict:
 
 def _solve(task):
     """One training run: the FE angles on the mesh and the one below it [rad]."""
-    from . import fe_bend
-
     d, sil, mesh = task
     res = fe_bend(d["radius"], d["wall_thickness"], d["length"], d["pressures"],
                   base_thickness=d["base_thickness"],
@@ -115,9 +113,6 @@ def run_training(parts, plan, *, workers=1, scheduler=None, progress=None, log=N
 
 def extrapolated(fine, coarse):
     """Richardson's extrapolation of two mesh levels' angles (ratio 1.5, order 2) [rad]."""
-    from . import ORDER
-    from .mesh import REFINEMENT
-
     fine = np.asarray(fine, float)
     coarse = np.asarray(coarse, float)
     return fine + (fine - coarse) / (REFINEMENT ** ORDER - 1.0)
@@ -127,8 +122,6 @@ def fit_correction(plan, done, *, silicone=None) -> dict:
     """Fit the correction to the journaled runs; returns the coefficients, the per-point
     ratios of calibrated and lateral_pressure angles to FE, and the leave-one-design-out
     ratios (a design's points predicted by the fit to all other designs)."""
-    from ..materials import silicone_parameters
-    from ..physics.limits import model_bend_angle
 
     rows = plan["designs"]
     sil = silicone or plan_silicone(plan["silicone"])

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..units import InputError
+from ..units import InputError, json_text
 
 __all__ = ["journaled_runs", "plan_silicone"]
 
@@ -68,7 +68,6 @@ def journaled_runs(parts, plan, tasks, solve, *, workers=1, scheduler=None, prog
     ``solve`` must be importable (it runs in other processes); its result JSON-able.
     """
     from ..storage.files import write_atomic
-    from ..units import json_text
 
     parts = Path(parts)
     if parts.is_symlink():

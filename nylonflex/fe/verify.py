@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..units import InputError
+from .. import __version__
+from ..units import InputError, json_text
+from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
 from .runs import journaled_runs, plan_silicone
 
@@ -106,8 +108,6 @@ def _plan(ds, attrs, n, seed, mesh):
 
 def _solve(task):
     """One FE run (a task of the executor): the design's angles and error estimates."""
-    from . import fe_bend
-
     d, sil, mesh = task
     silicone = plan_silicone(sil)
     res = fe_bend(d["radius"], d["wall_thickness"], d["length"], d["pressures"],
@@ -150,12 +150,9 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     """
     import xarray as xr
 
-    from .. import __version__
     from ..storage.files import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
-    from ..units import json_text
-    from . import MESH_NAMES, require_felupe
 
     if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
         raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "

@@ -19,8 +19,10 @@ process's own Numba setting is left as it was.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
 import pkgutil
+import sys
 import types
 from contextlib import contextmanager
 from pathlib import Path
@@ -30,6 +32,8 @@ from llvmlite import ir
 from numba.core import types as nb_types
 from numba.extending import intrinsic, overload, register_jitable
 
+from .. import physics
+from ..physics import elementary
 from .cache import cache_dir
 
 
@@ -46,8 +50,6 @@ def _import_numba_arraymath():
     check its integer width) when something that uses them is compiled. Where scipy.linalg
     or arraymath is imported already, nothing is done.
     """
-    import sys
-
     if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
         return
     from numba.np import linalg
@@ -71,8 +73,6 @@ def _blas_probe():
 
 def _scipy_blas_installed() -> bool:
     """Whether ``scipy.linalg.cython_blas`` is installed (found on disk, not imported)."""
-    import importlib.util
-
     spec = importlib.util.find_spec("scipy")
     for folder in (spec.submodule_search_locations or []) if spec else []:
         if any(Path(folder, "linalg").glob("cython_blas*")):
@@ -111,8 +111,6 @@ def is_formula(obj) -> bool:
 
 def _register_formulas():
     """Make every physics ``@formula`` callable from jitted code, by its own name."""
-    from .. import physics
-
     for info in pkgutil.iter_modules(physics.__path__):
         module = importlib.import_module(f"{physics.__name__}.{info.name}")
         for obj in vars(module).values():
@@ -150,8 +148,6 @@ def _bitcast_int_float(typingctx, bits):
 
 def _register_primitives():
     """Compile the physics layer's ``@primitive`` functions (plain Python there) to bit casts."""
-    from ..physics import elementary
-
     def float_bits(x):
         return lambda x: _bitcast_float_int(x)
 

@@ -40,11 +40,14 @@ from ..config.simulate import (  # noqa: F401 - the config layer's names, import
     parse_sim_config,
     top_temperature,
 )
+from ..kernels.records import AngleTables, Control, Muscles, SimOut, Supply
 from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length
 from ..physics.wrap import nylon_force
+from ..storage.files import refuse_special, replacing
+from ..units import InputError
 
 __all__ = [
     "PLANT_TABLE_POINTS",
@@ -211,7 +214,6 @@ def run_simulation(cfg: SimConfig):
     import xarray as xr
 
     from ..kernels.control import closed_loop
-    from ..kernels.records import AngleTables, Control, Muscles, SimOut, Supply
 
     n, m = len(cfg.actuators), cfg.n_steps
     t = np.arange(m) * cfg.step
@@ -333,9 +335,6 @@ def write_simulation(ds, path, inputs=()) -> Path:
     else at ``path`` (a cube, a config, a link, a special file, one of ``inputs``) is
     refused with an InputError.
     """
-    from ..storage.files import refuse_special, replacing
-    from ..units import InputError
-
     path = Path(path)
     refuse_special(path, "--out", inputs)
     if path.exists() and not _is_simulation(path):

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import xarray as xr
 
-from ..units import parse_quantity
+from ..units import InputError, parse_quantity
 from ..variables import VARIABLES, to_display
 
 __all__ = ["CubeAccessor", "VariableAccessor"]
@@ -66,8 +66,6 @@ class CubeAccessor:
         KeyError
             The value is not a grid value (xarray's own error).
         """
-        from ..units import InputError
-
         si = {}
         for name, value in at.items():
             v = VARIABLES.get(name)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import itertools
+import json
 import threading
 import zlib
 from concurrent.futures import ThreadPoolExecutor
@@ -10,6 +12,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+try:
+    from isal import isal_zlib
+except ImportError:  # pragma: no cover - isal is a dependency
+    isal_zlib = None
 
 from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .netcdf4 import NetCDF4File
@@ -69,9 +76,7 @@ def _deflate_encoder():
     level 0 where the ``isal`` package is installed (a base dependency; it releases the
     GIL, so both compression threads run), else the standard library's zlib level 1
     (the same stream format, 8x the CPU, 20 % smaller)."""
-    try:
-        from isal import isal_zlib
-    except ImportError:  # pragma: no cover - isal is a dependency
+    if isal_zlib is None:  # pragma: no cover - isal is a dependency
         return lambda raw: zlib.compress(raw, 1)
     return lambda raw: isal_zlib.compress(raw, ISAL_LEVEL)
 
@@ -213,8 +218,6 @@ class CubeFile:
         """How this file's stored chunks decode: the codec, its filters and each variable's
         dtype and chunk shape (what a journaled slab's digest covers, so that a journal
         whose codec was edited is recomputed, never trusted) [-]."""
-        import json
-
         return json.dumps({"codec": self.codec.name, "filters": self.codec.filters,
                            "shuffle": self.codec.shuffle,
                            "chunks": {name: [list(lay.chunks or ()), lay.dtype.str]
@@ -299,8 +302,6 @@ class CubeFile:
 
     def abandon(self):
         """Close after a failure (a full disk, an error) without raising."""
-        import contextlib
-
         self._pool.shutdown(cancel_futures=True)
         with contextlib.suppress(Exception):
             self.f.h5.close()

@@ -16,6 +16,7 @@ material files, explorer pages, simulations, manifests) goes through this module
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import secrets
 import stat
@@ -189,8 +190,6 @@ class OwnedFiles:
         self.files = self._read()
 
     def _read(self) -> dict:
-        import json
-
         refuse_special(self.path, "--out")
         try:
             raw = self.path.read_bytes()
@@ -240,8 +239,6 @@ class OwnedFiles:
 
     def record(self, paths):
         """Record ``paths`` as written by this owner and save the manifest atomically."""
-        import json
-
         for path in paths:
             path = Path(path)
             self.files[path.name] = {"source": self.owner, "sha256": self._digest(path)}

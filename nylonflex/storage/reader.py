@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from ..variables import AXES, CURVES, DESIGN, UNCERTAIN, is_complete, validate
+from ..variables import (AXES, CURVES, DESIGN, UNCERTAIN, VARIABLES, is_complete, to_display,
+                         validate)
 from .cube import require_filters
 from .journal import Journal
 
@@ -321,8 +322,6 @@ def cube_summary(path) -> list[str]:
     """
     import h5netcdf
     import h5py
-
-    from ..variables import VARIABLES, to_display
 
     path = Path(path)
     a = cube_attrs(path)

@@ -15,13 +15,16 @@ already done can be queried.
 from __future__ import annotations
 
 import errno
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from .. import __version__
 from ..config import ResolvedConfig
-from ..engine.grid import coords, cube_variables, global_arrays, plan_is_implied, plan_slabs
+from ..engine.grid import (bytes_per_radius, coords, cube_variables, global_arrays, plan_is_implied,
+                           plan_slabs)
 from ..engine.provenance import is_complete, provenance, run_attrs
 from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
+from ..kernels import source_digest
 from ..units import InputError
 from .cube import CODECS, CubeFile
 from .journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
@@ -52,8 +55,6 @@ class CubeSink:
     """
 
     def __init__(self, cube: CubeFile, journal: Journal, config_sha: str = ""):
-        from concurrent.futures import ThreadPoolExecutor
-
         self.cube = cube
         self.journal = journal
         self.config_sha = config_sha
@@ -103,8 +104,6 @@ class _Started:
 
 
 def _versions() -> dict:
-    from ..kernels import source_digest
-
     return {"format": JOURNAL_FORMAT, "nylonflex_version": __version__,
             "model_digest": source_digest()}
 
@@ -204,8 +203,6 @@ def _check_resume(cfg, out, journal, resume, log, overwrite=False):
 
 
 def _needed_gigabytes(cfg) -> float:
-    from ..engine.grid import bytes_per_radius
-
     return 2 * bytes_per_radius(cfg) * cfg.shape[0] / 1e9
 
 

@@ -7,9 +7,21 @@ memory with :class:`~nylonflex.engine.slabs.MemorySink`, to a file with the jour
 
 from __future__ import annotations
 
+import itertools
+import time
 from pathlib import Path
 
+import numpy as np
+
 from ..config import ResolvedConfig
+from ..engine.grid import bytes_per_radius, check_physics, compute_slab, global_arrays, plan_slabs
+from ..engine.provenance import provenance, typed_info
+from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
+from ..engine.warmup import warm_up_grid
+from ..variables import VARIABLES
+from .cube import CODECS, _chunks, _encode_chunk
+from .reader import open_cube
+from .run import sweep_to_file
 
 __all__ = ["default_output", "estimate", "prepare", "run_sweep", "sweep_file"]
 
@@ -54,18 +66,13 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
     nylonflex.storage.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
-    from ..engine.grid import check_physics
-
     check_physics(cfg)
     if out is None:
-        from ..engine.slabs import deferred_signals
-
         from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
         with deferred_signals(on_second=_interrupt):
             _warm_up(cfg, workers, scheduler, log)
             return _in_memory(cfg, workers, scheduler, progress)
-    from .reader import open_cube
 
     sweep_file(cfg, out, resume=resume, workers=workers, scheduler=scheduler,
                progress=progress, log=log, overwrite=overwrite)
@@ -79,10 +86,6 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
     The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
     command line uses it: a sweep without charts never imports xarray.
     """
-    from ..engine.grid import check_physics
-    from ..engine.slabs import deferred_signals
-    from .run import sweep_to_file
-
     check_physics(cfg)  # before any file
     # from here on Ctrl-C and SIGTERM are recorded, never raised inside a finaliser (where
     # Python would print and drop them): the slab loop stops on them, before or after a slab
@@ -105,8 +108,6 @@ def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
     keep the start apart (the command line does, with the garbage collector paused).
     Parameters as :func:`run_sweep`'s.
     """
-    from ..engine.grid import check_physics
-
     check_physics(cfg)
     _warm_up(cfg, workers, scheduler, log)
 
@@ -120,8 +121,6 @@ def _warm_up(cfg, workers, scheduler, log):
     """Compile (or load) the local kernel first, so that the run's timings exclude it."""
     if scheduler is not None or (cfg.sha256, workers) in _WARMED:
         return
-    from ..engine.slabs import set_workers
-    from ..engine.warmup import warm_up_grid
 
     set_workers(workers)
     compiled = warm_up_grid(cfg, notice=log)
@@ -131,10 +130,6 @@ def _warm_up(cfg, workers, scheduler, log):
 
 
 def _in_memory(cfg, workers, scheduler, progress):
-    from ..engine.grid import plan_slabs
-    from ..engine.provenance import provenance
-    from ..engine.slabs import LocalExecutor, MemorySink, run_slabs
-
     if scheduler is None:
         executor = LocalExecutor(workers)
     else:
@@ -149,9 +144,6 @@ def _in_memory(cfg, workers, scheduler, progress):
         executor.close()
     if stats.stopped:
         raise KeyboardInterrupt
-    import numpy as np
-
-    from ..engine.provenance import typed_info
 
     return sink.dataset({**provenance(cfg), **typed_info(executor.info()),
                          "complete": np.int8(1)})
@@ -166,10 +158,6 @@ def _resident_bytes() -> int:
 
 def _packed_bytes(value, chunks, codec) -> int:
     """Bytes of ``value`` stored in ``chunks`` with the cube's codec (name)."""
-    import itertools
-
-    from .cube import CODECS, _encode_chunk
-
     codec = CODECS[codec]
     if codec.encode is None:  # lz4: HDF5 compresses; zstd's size is close enough here
         codec = CODECS["zstd"]
@@ -215,18 +203,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         (compute), ``compress_seconds`` [s] and ``seconds`` [s] (estimated wall time,
         compute plus compression; they partly overlap, so a bound), ``compile_seconds`` [s].
     """
-    from ..engine.grid import check_physics
-
     check_physics(cfg)  # what a sweep would refuse, a dry run refuses
-    import time
-
-    import numpy as np
-
-    from ..engine.grid import bytes_per_radius, compute_slab, global_arrays, plan_slabs
-    from ..engine.slabs import set_workers
-    from ..engine.warmup import warm_up_grid
-    from ..variables import VARIABLES
-    from .cube import _chunks
 
     set_workers(workers)
     compiled = warm_up_grid(cfg, notice=notice)
