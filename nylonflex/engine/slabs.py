@@ -197,15 +197,24 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
             # a sink with a first step (CubeSink starts compressing) has the executor run it
             # as soon as a slab is computed
             first = {"prepare": sink.prepare} if hasattr(sink, "prepare") else {}
-            for k, arrays in executor.map_slabs(cfg, slabs, todo, **first):
-                i0, i1 = slabs[k]
-                sink.put(k, i0, i1, arrays)
-                stats.done.add(k)
-                stats.computed += (i1 - i0) * per_radius
-                if progress is not None:
-                    progress((i1 - i0) * per_radius)
-                if seen:
-                    raise _Stop()
+            finished = executor.map_slabs(cfg, slabs, todo, **first)
+            try:
+                for k, arrays in finished:
+                    i0, i1 = slabs[k]
+                    sink.put(k, i0, i1, arrays)
+                    stats.done.add(k)
+                    stats.computed += (i1 - i0) * per_radius
+                    if progress is not None:
+                        progress((i1 - i0) * per_radius)
+                    if seen:
+                        raise _Stop()
+            finally:
+                # an error of the sink (a full disk) would leave the executor's generator
+                # suspended until it is collected: closed here, its slab in flight ends
+                # before the error goes on
+                close = getattr(finished, "close", None)
+                if close is not None:
+                    close()
     except (KeyboardInterrupt, _Stop):
         stats.stopped = True
     finally:

@@ -1,9 +1,9 @@
-"""The engine's threads: one compiled kernel body, split over a pool of Python threads.
+"""The engine's threads: one compiled kernel body, split over Python threads.
 
 Every kernel releases the GIL (``nogil``) and takes the range of items it computes, so a
-slab of the grid or a batch of designs runs as contiguous chunks on :func:`workers` threads
-of one process-wide pool, and a serial run (a Dask worker's slab, a thread that is already
-one of several) is the same compiled body called once. Numba's ``parallel=True`` would
+slab of the grid or a batch of designs runs as contiguous chunks on :func:`workers`
+threads, and a serial run (a Dask worker's slab, a thread that is already one of several)
+is the same compiled body called once. Numba's ``parallel=True`` would
 compile each kernel a second time for its threaded form, about as long again as the first
 on a cold cache (README, Performance), for no gain here: the chunks are independent and
 write disjoint parts of the output, so the numbers do not depend on how they are split.
@@ -12,15 +12,13 @@ write disjoint parts of the output, so the numbers do not depend on how they are
 from __future__ import annotations
 
 import os
-import threading
 from concurrent.futures import ThreadPoolExecutor
 
 from ..units import InputError
 
 __all__ = ["cores", "run_chunks", "set_workers", "workers"]
 
-_LOCK = threading.Lock()
-_STATE = {"workers": None, "pool": None, "size": 0}
+_STATE = {"workers": None}
 
 
 def cores() -> int:
@@ -47,17 +45,6 @@ def workers() -> int:
     return _STATE["workers"] or cores()
 
 
-def _pool(size: int) -> ThreadPoolExecutor:
-    with _LOCK:
-        if _STATE["size"] < size:
-            old = _STATE["pool"]
-            _STATE["pool"] = ThreadPoolExecutor(size, thread_name_prefix="nylonflex-kernel")
-            _STATE["size"] = size
-            if old is not None:
-                old.shutdown(wait=False)
-        return _STATE["pool"]
-
-
 def run_chunks(call, n: int, *, parallel: bool = True) -> None:
     """``call(k0, k1)`` on contiguous chunks of ``range(n)``: one chunk a thread of
     :func:`workers` when ``parallel`` (the calling thread takes the first), else one call.
@@ -67,17 +54,19 @@ def run_chunks(call, n: int, *, parallel: bool = True) -> None:
         call(0, n)
         return
     bounds = [n * j // threads for j in range(threads + 1)]
-    futures = [_pool(threads - 1).submit(call, bounds[j], bounds[j + 1])
-               for j in range(1, threads)]
     error = None
-    try:
-        call(bounds[0], bounds[1])
-    except BaseException as exc:  # noqa: BLE001 - raised below, after the other chunks
-        error = exc
-    for f in futures:
+    # a pool of this call's own: its threads end with it (a pool kept for the process
+    # left a segfault in the interpreter's last collection after a failed sweep)
+    with ThreadPoolExecutor(threads - 1, thread_name_prefix="nylonflex-kernel") as pool:
+        futures = [pool.submit(call, bounds[j], bounds[j + 1]) for j in range(1, threads)]
         try:
-            f.result()
-        except BaseException as exc:  # noqa: BLE001
-            error = error or exc
+            call(bounds[0], bounds[1])
+        except BaseException as exc:  # noqa: BLE001 - raised below, after the other chunks
+            error = exc
+        for f in futures:
+            try:
+                f.result()
+            except BaseException as exc:  # noqa: BLE001
+                error = error or exc
     if error is not None:
         raise error
