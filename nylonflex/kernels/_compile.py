@@ -165,16 +165,15 @@ _register_primitives()
 _register_formulas()
 
 
-def jit_kernel(func=None, *, parallel=False):
-    """``njit`` a kernel (with :data:`JIT_OPTIONS`); it calls physics formulas by name."""
+def jit_kernel(func=None):
+    """``njit`` a kernel (with :data:`JIT_OPTIONS`); it calls physics formulas by name.
+
+    Serial: the engine splits a kernel's range over its own threads
+    (:mod:`nylonflex.engine.threads`), so no kernel needs Numba's ``parallel`` form."""
 
     def wrap(f):
-        if parallel:  # a second dispatcher of the same Python function, cached apart
-            f = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__,
-                                   f.__closure__)
-            f.__qualname__ = f.__qualname__ + "_parallel"
         with _kernel_cache_dir():
-            return numba.njit(parallel=parallel, **JIT_OPTIONS)(f)
+            return numba.njit(**JIT_OPTIONS)(f)
 
     return wrap if func is None else wrap(func)
 
