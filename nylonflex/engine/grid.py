@@ -13,19 +13,17 @@ import weakref
 import numpy as np
 
 from ..config import ResolvedConfig
-from ..kernels.records import CoilTable, GridAxes, GridOut, Muscle, Nodes, Ogden, Options
-from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, FLOAT_DESIGN, N_FLAGS, N_FLOAT_DESIGN
-from ..physics.bending import quadrature_nodes
-from ..physics.chamber import P_ATM, chamber_pressure
+from ..kernels.rows import FLOAT_DESIGN
+from ..physics.chamber import chamber_pressure
 from ..physics.limits import MODELS
 from ..physics.nylon import check_stroke_shape, nylon_force_limit, stroke_max
 from ..physics.thermal import (check_supply_rise, coil_heat_loss_per_length,
                                coil_resistance_per_length)
 from ..physics.wrap import muscle_width, outer_perimeter
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
+from .model_slab import coil_table, model_slab
 from .sampled import slab_statistics, uncertain_variables
 from .tracking import slab_tracking, tracking_variables
-from .threads import run_chunks
 
 __all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
            "cube_variables", "global_arrays", "plan_slabs", "slab_variables"]
@@ -153,18 +151,6 @@ def plan_is_implied(cfg: ResolvedConfig, slabs, chunk) -> bool:
         chunk == min(n, _chunk_cap(bytes_per_radius(cfg))) and n % chunk == 0
 
 
-def coil_table(cfg: ResolvedConfig):
-    """The kernels' per-coil-index table (:class:`~nylonflex.kernels.records.CoilTable`) of
-    ``cfg``'s coil-index axis: s_max [-], force limit [N], muscle width [m], r' [ohm/m] and
-    heat loss per length [W/(K m)], one contiguous float64 column each."""
-    c = cfg.axes["coil_index"]
-    column = lambda x: np.ascontiguousarray(x, dtype=float).reshape(-1)  # noqa: E731
-    return CoilTable(column(stroke_max(c, cfg.nylon)), column(nylon_force_limit(c, cfg.nylon)),
-                     column(muscle_width(c, cfg.nylon)),
-                     column(coil_resistance_per_length(c, cfg.nylon)),
-                     column(coil_heat_loss_per_length(c, cfg.nylon, cfg.cooling)))
-
-
 class ArrayPool:
     """Output arrays handed back once a slab is stored, and handed out again.
 
@@ -231,47 +217,10 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
     return arrays
 
 
-def _muscle(cfg: ResolvedConfig):
-    ny = cfg.nylon
-    one = lambda x: np.array([float(x)])  # noqa: E731
-    return Muscle(one(ny.t_amb), one(ny.t_max), one(ny.gamma), one(ny.beta), one(ny.t_g),
-                  one(ny.sigma_g), one(ny.resistance_per_length),
-                  one(ny.heat_capacity_per_length), one(ny.heat_loss_per_length),
-                  one(ny.thermal_force_coefficient))
-
-
 def _compute_model_slab(cfg, i0, i1, parallel, model, pool=None):
-    from ..kernels import design
-
-    grid = GridAxes(radius=np.ascontiguousarray(cfg.axes["radius"][i0:i1]),
-                    wall=cfg.axes["wall_thickness"], length=cfg.axes["length"],
-                    wrap=cfg.axes["wrap_angle"],
-                    base_thickness=-1.0 if cfg.base_thickness is None
-                    else float(cfg.base_thickness),
-                    stroke=cfg.curves["stroke"], pressure=cfg.curves["pressure"], p_atm=P_ATM)
-    sizes = {k: len(v) for k, v in coords(cfg).items()}
-    sizes["radius"] = i1 - i0
-    shape = lambda name: [sizes[d] for d in CURVES[name].dims]  # noqa: E731
-    design_shape = [sizes[d] for d in DESIGN["limit"].dims]
-    empty = np.empty if pool is None else pool.empty
-    out = GridOut(design=empty((N_FLOAT_DESIGN, *design_shape)),
-                  flags=empty((N_FLAGS, *design_shape), dtype=np.int8),
-                  nylon_force=empty(shape("nylon_force")),
-                  bend_angle=empty(shape("bend_angle")),
-                  tip_force=empty(shape("tip_force")))
-    voltage = -1.0 if cfg.supply_voltage is None else float(cfg.supply_voltage)
-    options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
-    args = (grid, coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
-            _muscle(cfg), options, out)
-    run_chunks(lambda k0, k1: design.design_slab(*args, k0, k1),
-               len(grid.radius) * len(grid.wall), parallel=parallel)
-    # the kernel's rows by name (kernels.rows, the one table both sides read)
-    arrays = {name: out.design[row] for name, row in DESIGN_ROWS.items()}
-    arrays.update({name: out.flags[row] for name, row in FLAG_ROWS.items()})
-    arrays.update(nylon_force=out.nylon_force, bend_angle=out.bend_angle,
-                  tip_force=out.tip_force)
+    arrays = model_slab(cfg, i0, i1, parallel, model, pool)
     if cfg.uncertainty is not None or cfg.requirements:  # docs/uncertainty.md
-        arrays.update(slab_statistics(cfg, i0, i1, arrays, parallel=parallel))
+        arrays.update(slab_statistics(cfg, i0, i1, arrays, model, parallel=parallel))
     if cfg.tracking is not None:  # docs/model.md s. 19
         arrays.update(slab_tracking(cfg, i0, i1, arrays, parallel=parallel))
     return arrays
