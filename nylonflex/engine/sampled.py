@@ -8,9 +8,11 @@ parameters and mixes them by its Cholesky factor). Every design sees the same sa
 (common random numbers), so statistics vary smoothly from design to design and a relaxed
 requirement never loses feasibility.
 
-A slab of designs times S samples is one call of :func:`~.pointwise.evaluate` (in chunks of
-bounded size) with the sample axis last; the samples reduce to quantiles and to the fraction
-of samples meeting every requirement (docs/uncertainty.md).
+Every sample of a slab is a grid of its own (:func:`sample_configs`) through the grid
+kernel (in chunks of bounded size), stacked with the sample axis last; the samples reduce to
+quantiles and to the fraction of samples meeting every requirement (docs/uncertainty.md).
+:func:`perturbed_inputs` gives the same samples as arguments of
+:func:`~.pointwise.evaluate` (scattered designs, the closed loop, sensitivity).
 """
 
 from __future__ import annotations
@@ -21,13 +23,18 @@ from dataclasses import fields, replace
 import numpy as np
 
 from ..config import ResolvedConfig, UncertaintySpec
+from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS
 from ..materials import SILICONE_PARAMETERS
+from ..physics.chamber import chamber_pressure
+from ..physics.nylon import stroke_max
 from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
-from .pointwise import evaluate, serial
+from .model_slab import grid_axes, grid_out, kernel_inputs, run_grid
+from .threads import run_chunks
 
-__all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_statistics",
-           "slab_statistics", "standard_from_unit", "standard_samples", "uncertain_variables"]
+__all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_configs",
+           "sample_statistics", "slab_statistics", "standard_from_unit", "standard_samples",
+           "uncertain_variables"]
 
 #: The design variables that get quantiles (``limit`` is a flag: no quantiles).
 FLOAT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
@@ -194,27 +201,68 @@ def perturbed_configs(cfg: ResolvedConfig, design: dict, z: np.ndarray) -> list:
     S = z.shape[0]
     args = perturbed_inputs({k: np.asarray(design[k], float) for k in AXES}, cfg, z)
     axes = {k: np.broadcast_to(np.asarray(args[k], float).reshape(-1), (S,)) for k in AXES}
+    return [({k: float(axes[k][s]) for k in AXES}, _sample_config(cfg, args, s))
+            for s in range(S)]
+
+
+def sample_configs(cfg: ResolvedConfig, z: np.ndarray, i0: int = 0,
+                   i1: int | None = None) -> list:
+    """Every sample of ``z`` as a plain config of its own: its axes moved as
+    :func:`perturbed_inputs` moves them (the same truncations), radius cut to the indices
+    [i0, i1), and its silicone and nylon.
+
+    Every uncertain parameter moves an axis value by a function of that value alone, or a
+    material field, so each sample's designs are again a grid, which the grid kernel
+    computes as it computes a cube: every sample's curvature solves warm-started along its
+    own pressure curve and shared by every length, wrap angle and coil index that can share
+    them. The configs carry no uncertainty, requirements or tracking.
+
+    Parameters
+    ----------
+    cfg : ResolvedConfig
+        The sampled sweep's config.
+    z : ndarray
+        Standard variables, shape (S, dims), from :func:`standard_samples`.
+    i0, i1 : int
+        The radius indices of the slab.
+
+    Returns
+    -------
+    list of ResolvedConfig
+        S configs.
+    """
+    S = z.shape[0]
+    axes = dict(cfg.axes)
+    axes["radius"] = axes["radius"][i0:i1]
+    args = perturbed_inputs({k: np.asarray(axes[k], float) for k in AXES}, cfg, z)
+    moved = {k: np.broadcast_to(np.asarray(args[k], float), (len(axes[k]), S)) for k in AXES}
+    return [replace(_sample_config(cfg, args, s),
+                    axes={k: np.ascontiguousarray(moved[k][:, s]) for k in AXES},
+                    uncertainty=None, requirements=(), tracking=None)
+            for s in range(S)]
+
+
+def _sample_config(cfg: ResolvedConfig, args: dict, s: int) -> ResolvedConfig:
+    """``cfg`` with sample ``s``'s silicone and nylon of :func:`perturbed_inputs`'s
+    ``args`` (``cfg`` itself where no material is uncertain)."""
     silicone, nylon = args["silicone"], args["nylon"]
-    out = []
-    for s in range(S):
-        c = cfg
-        if silicone is not cfg.silicone:
-            c = replace(c, silicone=replace(cfg.silicone, **{
-                k: tuple(float(x) for x in silicone[k][s]) for k in ("mu", "alpha")}))
-        if nylon is not cfg.nylon:
-            changes = {}
-            for f in fields(cfg.nylon):
-                own = getattr(cfg.nylon, f.name)
-                if f.name not in nylon or not isinstance(own, (int, float, tuple)):
-                    continue
-                v = np.asarray(nylon[f.name], float)
-                if v.ndim > np.ndim(own):  # this field is sampled: the sample's row
-                    v = v[s]
-                changes[f.name] = tuple(float(x) for x in v) if isinstance(own, tuple) \
-                    else float(v)
-            c = replace(c, nylon=replace(cfg.nylon, **changes))
-        out.append(({k: float(axes[k][s]) for k in AXES}, c))
-    return out
+    c = cfg
+    if silicone is not cfg.silicone:
+        c = replace(c, silicone=replace(cfg.silicone, **{
+            k: tuple(float(x) for x in silicone[k][s]) for k in ("mu", "alpha")}))
+    if nylon is not cfg.nylon:
+        changes = {}
+        for f in fields(cfg.nylon):
+            own = getattr(cfg.nylon, f.name)
+            if f.name not in nylon or not isinstance(own, (int, float, tuple)):
+                continue
+            v = np.asarray(nylon[f.name], float)
+            if v.ndim > np.ndim(own):  # this field is sampled: the sample's row
+                v = v[s]
+            changes[f.name] = tuple(float(x) for x in v) if isinstance(own, tuple) \
+                else float(v)
+        c = replace(c, nylon=replace(cfg.nylon, **changes))
+    return c
 
 
 def _axis(nominal, p, z):
@@ -263,17 +311,18 @@ def sample_statistics(out: dict, quantiles, requirements=()) -> dict:
     return stats
 
 
-def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
+def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict, model: int = 0,
                     parallel: bool = True) -> dict:
     """The sampled variables of the radii [i0, i1): quantiles and feasibility.
 
     ``nominal`` is the slab's plain result (grid kernel); without ``uncertainty`` the
-    feasibility is that of the nominal designs (0 or 1). ``parallel=False`` (Dask workers)
-    runs the evaluator on one Numba thread: one level of parallelism.
+    feasibility is that of the nominal designs (0 or 1). With it, every sample is a grid of
+    its own (:func:`sample_configs`) through the grid kernel of ``model`` (an index into
+    :data:`~nylonflex.physics.limits.MODELS`), without the curves a cube stores: a short
+    pressure curve up to the highest full-stroke pressure of the samples starts the
+    curvature solves. The samples are split over the engine's threads when ``parallel``
+    (False: Dask workers, one level of parallelism).
     """
-    if not parallel:
-        with serial():
-            return slab_statistics(cfg, i0, i1, nominal, parallel=True)
     reqs = parse_requirements(list(cfg.requirements))
     if cfg.uncertainty is None:
         ok = np.ones(nominal[FLOAT_NAMES[0]].shape, dtype=bool)
@@ -283,9 +332,9 @@ def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     spec = cfg.uncertainty
     z = standard_samples(spec)
     S = z.shape[0]
-    axes = {k: v for k, v in cfg.axes.items()}
-    axes["radius"] = axes["radius"][i0:i1]
-    shape = tuple(len(axes[k]) for k in AXES)
+    samples = _with_start_curve(sample_configs(cfg, z, i0, i1))
+    inputs = [kernel_inputs(c, model) for c in samples]
+    shape = (i1 - i0, *(len(cfg.axes[k]) for k in AXES[1:]))
     per_radius = int(np.prod(shape[1:])) * S
     step = max(1, _EVALS_PER_CALL // max(per_radius, 1))
     result = {n: np.empty((*shape, len(spec.quantiles))) for n in
@@ -294,10 +343,43 @@ def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
         result["feasibility"] = np.empty(shape)
     for r0 in range(0, shape[0], step):
         r1 = min(shape[0], r0 + step)
-        grid = np.meshgrid(axes["radius"][r0:r1], *(axes[k] for k in AXES[1:]),
-                           indexing="ij", sparse=True)
-        designs = dict(zip(AXES, grid))
-        out = evaluate(**perturbed_inputs(designs, cfg, z))
+        out = _sampled_grids(samples, inputs, r0, r1, parallel)
         for name, arr in sample_statistics(out, spec.quantiles, reqs).items():
             result[name][r0:r1] = arr
     return result
+
+
+#: Points of the pressure curve each sample's grid solves first: its solves start the
+#: full-stroke and stroke-limit solves (the grid kernel's warm starts).
+_START_PRESSURES = 4
+
+
+def _with_start_curve(samples: list) -> list:
+    """The sample configs with no stroke curve and a pressure curve of
+    :data:`_START_PRESSURES` points from 0 to the highest full-stroke pressure p(s_max)
+    of any sample's coil index [Pa] (what starts the kernel's solves; nothing stored)."""
+    s_top = max(float(np.max(stroke_max(c.axes["coil_index"], c.nylon))) for c in samples)
+    p_top = float(chamber_pressure(min(s_top, 0.999)))
+    curves = {"stroke": np.empty(0), "pressure": np.linspace(0.0, p_top, _START_PRESSURES)}
+    return [replace(c, curves=curves) for c in samples]
+
+
+def _sampled_grids(samples: list, inputs: list, r0: int, r1: int, parallel: bool) -> dict:
+    """Every design variable of the radii [r0, r1) of every sample, sample axis last."""
+    S = len(samples)
+    first = grid_out(samples[0], r1 - r0)
+    design = np.empty((S, *first.design.shape))
+    flags = np.empty((S, *first.flags.shape), dtype=np.int8)
+
+    def run(s0, s1):
+        # the curves are scratch (a short pressure curve, no stroke): one set a thread
+        scratch = first if s0 == 0 else grid_out(samples[s0], r1 - r0)
+        for s in range(s0, s1):
+            run_grid(grid_axes(samples[s], r0, r1), inputs[s],
+                     scratch._replace(design=design[s], flags=flags[s]), parallel=False)
+
+    run_chunks(run, S, parallel=parallel)
+    last = lambda a: np.moveaxis(a, 0, -1)  # noqa: E731
+    out = {n: last(design[:, row]) for n, row in DESIGN_ROWS.items()}
+    out.update({n: last(flags[:, row]) for n, row in FLAG_ROWS.items()})
+    return out
