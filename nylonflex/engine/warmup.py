@@ -131,9 +131,9 @@ def _tiny_config():
 #: taking ``notice``). The closed-loop kernels (``simulate``) sit above the engine and are
 #: warmed by ``nylonflex warmup`` itself.
 KERNELS = (
-    ("grid", "sweeps (local threads and Dask workers' slabs)",
+    ("grid", "sweeps and sampled sweeps (local threads and Dask workers' slabs)",
      lambda notice: warm_up_grid(_tiny_config(), parallel=True, notice=notice)),
-    ("pointwise", "nylonflex.evaluate, design, query --at, sampled sweeps",
+    ("pointwise", "nylonflex.evaluate, design, query --at, propagate, sensitivity",
      lambda notice: warm_up_points(notice=notice)),
     ("codec", "the cube writer's byte shuffle", lambda notice: warm_up_codec(notice=notice)),
 )

@@ -41,8 +41,8 @@ class CompileWarning(UserWarning):
 #: What each kernel family computes, as the notice names it.
 FAMILIES = {
     "grid": "the grid kernel (sweeps)",
-    "pointwise": "the pointwise kernel (nylonflex.evaluate, design_limits, sampled sweeps, "
-                 "design, query --at)",
+    "pointwise": "the pointwise kernel (nylonflex.evaluate, design_limits, design, query --at, "
+                 "uncertainty propagate and sensitivity)",
     "control": "the closed-loop kernels (simulate)",
     "tracking": "the tracking kernels (sweeps with tracking:)",
     "codec": "the cube codec's byte shuffle",
