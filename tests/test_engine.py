@@ -99,6 +99,15 @@ def test_one_design_is_its_row_of_a_batch_bit_for_bit_through_one_compiled_body(
                         nylon={"set": "silver_nylon66"})  # a mapping: the general path
     for name in DESIGN:
         np.testing.assert_array_equal(again[name], batch[name][3], err_msg=name)
+    # NumPy scalars, per-design materials (what propagate and sensitivity pass: copies and
+    # views alike), a cooling set: the same compiled body, no compile in between
+    nf.evaluate(*(np.float64(v[5]) for v in d.values()))
+    mu = np.asarray(nf.silicone_parameters("tc5005").mu) * np.array([[1.0], [1.1], [0.9]])
+    nf.evaluate(**{k: v[:3] for k, v in d.items()}, silicone={"set": "tc5005", "mu": mu},
+                nylon={"set": "silver_nylon66", "fibre_diameter": np.array([0.3, 0.31, 0.29])
+                       * 1e-3})
+    nf.evaluate(**{k: v[:3] for k, v in d.items()}, cooling="still_air")
+    nf.evaluate(*(float(v[6]) for v in d.values()), cooling="forced_air")
     assert kernels.design_points.signatures == compiled
 
 

@@ -108,9 +108,13 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     ogden, stretch_max, ny = _materials(silicone, nylon)
     c = check_input("coil_index", coil_index, -np.inf, np.inf)
     table = ny["coil_index_table"]
-    bad = ~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])
-    if bad.any():
+    if c.ndim == 0 and table.ndim == 1:  # one coil index, one table: no array test
+        bad = not table[0] <= float(c) <= table[-1]
+    else:
+        bad = (~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])).any()
+    if bad:
         lo, hi = np.broadcast_arrays(table[..., 0], table[..., -1], c)[:2]
+        bad = ~np.isfinite(c) | (c < table[..., 0]) | (c > table[..., -1])
         j = np.flatnonzero(np.broadcast_to(bad, np.broadcast(lo, c).shape))[0]
         raise ValueError(f"coil_index: must be in [{lo.flat[j]:g}, {hi.flat[j]:g}] (the "
                          f"nylon set's table), got {np.broadcast_to(c, lo.shape).flat[j]:g}")
@@ -124,32 +128,64 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
                          f"together (shapes {[x.shape for x in (a, t, L, c, psi)]}, "
                          f"materials {batch})") from None
     n = math.prod(shape)
+    if shape == () and isinstance(nylon, str) and cooling is None:
+        designs, coil = _one_named_design((a, t, b, L, psi), float(c), ny)
+        muscle = _single_muscle(nylon)
+    else:
+        designs, coil, muscle = _design_arrays((a, t, b, L, psi), c, ny, cooling, shape, n)
+    options = (MODELS.index(model), voltage, stretch_max)
+    out = _run(shape, n, designs, coil, ogden, muscle, options)
+    check_supply_rise(voltage, out["muscle_length"], coil[3].reshape(shape),
+                      coil[4].reshape(shape), "supply_voltage")
+    return out
+
+
+def _design_arrays(section, c, ny, cooling, shape, n) -> tuple:
+    """The kernel's design, coil-table and muscle arrays of designs of ``shape`` (``n``
+    of them): ``section`` the checked (a, t, b, L, psi) [m, rad], ``c`` the coil index [-],
+    ``ny`` the nylon arrays."""
     flat = lambda x: _flat(x, shape, n)  # noqa: E731
     if shape == ():  # one design: its six inputs as the rows of one read-only block
-        block = np.array([a, t, b, L, psi, c], dtype=float).reshape(6, 1)
+        block = np.array([*section, c], dtype=float).reshape(6, 1)
         block.flags.writeable = False
         designs = tuple(block[:5])
         c_flat = block[5]
     else:
-        designs = (flat(a), flat(t), flat(b), flat(L), flat(psi))
+        designs = tuple(flat(x) for x in section)
         c_flat = flat(c)
+    table = ny["coil_index_table"]
     s_max = _interp(c_flat, _rows(table, shape), _rows(ny["stroke_max_table"], shape))
     strength = _interp(c_flat, _rows(table, shape), _rows(ny["tensile_strength_table"], shape))
     d_f = flat(ny["fibre_diameter"])
     force_limit = strength * (np.pi * d_f**2 / 4.0)
     width = d_f * (c_flat + 1.0)
-    muscle = _single_muscle(nylon) if n == 1 and isinstance(nylon, str) else \
-        [flat(ny[k]) for k in _MUSCLE_FIELDS]
+    muscle = [flat(ny[k]) for k in _MUSCLE_FIELDS]
     r_per_len = _coil_resistances(flat(ny["resistance_per_length"]),
                                   flat(ny["resistance_coil_index"]), c_flat)
     loss_per_len = _heat_loss(cooling, d_f, flat(ny["t_max"]), flat(ny["t_amb"]), c_flat,
                               flat(ny["heat_loss_per_length"]))
-    options = (MODELS.index(model), voltage, stretch_max)
-    out = _run(shape, n, designs, (s_max, force_limit, width, r_per_len, loss_per_len), ogden,
-               muscle, options)
-    check_supply_rise(voltage, out["muscle_length"], r_per_len.reshape(shape),
-                      loss_per_len.reshape(shape), "supply_voltage")
-    return out
+    coil = (s_max, force_limit, width, r_per_len, loss_per_len)
+    # a copy is writeable, a view read-only: all read-only, one array type (see _run)
+    return (tuple(map(_frozen, designs)), tuple(map(_frozen, coil)),
+            tuple(map(_frozen, muscle)))
+
+
+def _one_named_design(section, c: float, ny: dict) -> tuple:
+    """:func:`_design_arrays` of one design of a named nylon set without a cooling set,
+    with scalar arithmetic (the same operations, the same bits): the design and coil-table
+    arrays as the rows of one read-only block."""
+    table = ny["coil_index_table"]
+    s_max = np.interp(c, table, ny["stroke_max_table"])
+    strength = np.interp(c, table, ny["tensile_strength_table"])
+    d_f = float(ny["fibre_diameter"])
+    force_limit = strength * (np.pi * d_f**2 / 4.0)
+    width = d_f * (c + 1.0)
+    r_per_len = coil_resistance(float(ny["resistance_per_length"]),
+                                float(ny["resistance_coil_index"]), c)
+    block = np.array([*section, s_max, force_limit, width, r_per_len,
+                      ny["heat_loss_per_length"]], dtype=float).reshape(10, 1)
+    block.flags.writeable = False
+    return tuple(block[:5]), tuple(block[5:])
 
 
 def _coil_resistances(r_ref, c_ref, c) -> np.ndarray:
@@ -157,6 +193,8 @@ def _coil_resistances(r_ref, c_ref, c) -> np.ndarray:
     same bits), computed once per distinct coil index where the set's r'_ref and C_r are the
     same for every design (a batch or a sampled slab repeats a few coil indices: the
     Python-level formula once a design was a fifth of a sampled sweep's time)."""
+    if c.size == 1:  # one design: the formula once, no search for distinct indices
+        return np.array([coil_resistance(r_ref[0], c_ref[0], c[0])], dtype=float)
     if r_ref.size and np.all(r_ref == r_ref[0]) and np.all(c_ref == c_ref[0]):
         values, where = np.unique(c, return_inverse=True)
         one = np.array([coil_resistance(r_ref[0], c_ref[0], x) for x in values], dtype=float)
@@ -258,7 +296,10 @@ def _stretch_max(silicone) -> float:
 def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut) = _kernels()
 
-    mu, alpha = (np.ascontiguousarray(x.reshape(-1, x.shape[-1])) for x in
+    # the Ogden rows writeable, every other record field read-only (_design_arrays): one
+    # array type per field whatever path made the array, as Numba compiles the kernel once
+    # for every new type
+    mu, alpha = (np.require(x.reshape(-1, x.shape[-1]), float, ["C", "W"]) for x in
                  _silicone_rows(ogden, shape))
     out = PointOut(np.empty((N_FLOAT_DESIGN, n)), np.empty((N_FLAGS, n), dtype=np.int8))
     args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
@@ -266,9 +307,18 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     run_chunks(lambda i0, i1: kernels.design_points(*args, i0, i1), n,
                parallel=n >= _PARALLEL_FROM and not getattr(_SERIAL, "on", False))
     # the kernel's rows by name (kernels.rows, the one table both sides read)
-    result = {name: out.design[row].reshape(shape) for name, row in DESIGN_ROWS.items()}
-    result.update({name: out.flags[row].reshape(shape) for name, row in FLAG_ROWS.items()})
-    return {name: result[name] for name in DESIGN}
+    design = out.design.reshape(N_FLOAT_DESIGN, *shape)
+    flags = out.flags.reshape(N_FLAGS, *shape)
+    rows = {name: design[row, ...] for name, row in DESIGN_ROWS.items()}
+    rows.update({name: flags[row, ...] for name, row in FLAG_ROWS.items()})
+    return {name: rows[name] for name in DESIGN}
+
+
+def _frozen(x: np.ndarray) -> np.ndarray:
+    """``x`` (a contiguous float64 array, made here) marked read-only: the one type the
+    pointwise kernel's 1-D record fields are compiled for."""
+    x.flags.writeable = False
+    return x
 
 
 @lru_cache(maxsize=1)

@@ -76,7 +76,7 @@ def check_input(name, value, lo=None, hi=None):
     v = INPUTS[name] if name in INPUTS else VARIABLES[name]
     lo = v.lo if lo is None else lo
     hi = v.hi if hi is None else hi
-    if type(value) is float and lo <= value <= hi and (value > lo or not v.lo_open) \
+    if isinstance(value, float) and lo <= value <= hi and (value > lo or not v.lo_open) \
             and (value < hi or not v.hi_open) and math.isfinite(value):
         return np.asarray(value)  # one design in range: the array test below costs 10 us
     try:
