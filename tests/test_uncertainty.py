@@ -188,6 +188,23 @@ def test_query_where_feasibility(sampled_cube, capsys):
     assert doc["units"]["feasibility"] == "1"
 
 
+def test_query_at_off_the_grid_of_a_sampled_cube_gives_the_exact_design_variables(
+        sampled_cube, capsys):
+    # the exact model computes the design variables, not the sampled ones: the off-grid
+    # row has no feasibility column, and asking for it there is one line, exit 2 (it
+    # raised KeyError: 'feasibility' before)
+    path, cfg = sampled_cube
+    at = "radius=7.7mm,wall_thickness=2mm,length=70mm,coil_index=1.1,wrap_angle=8deg"
+    assert main(["query", str(path), "--at", at, "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)["designs"][0]
+    exact = nf.evaluate(7.7e-3, 2e-3, 70e-3, 1.1, np.radians(8))
+    assert "feasibility" not in row
+    assert row["tip_force_max"] == pytest.approx(float(exact["tip_force_max"]), rel=1e-9)
+    assert main(["query", str(path), "--at", at, "--where", "feasibility >= 0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "feasibility: not computed off the grid" in err and "--interpolate" in err
+
+
 def test_query_feasibility_on_a_plain_cube_is_refused(tmp_path, capsys):
     from helpers import write_cube
 

@@ -385,6 +385,14 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
+    if exact:  # the exact model gives the design variables, not the sampled or tracked ones
+        for name in [c.name for c in conditions] + [sort_name] + list(chosen or ()):
+            if name in OPTIONAL:
+                raise InputError(f"{name}: not computed off the grid (the exact model gives "
+                                 "the design variables; the sweep sampled or simulated "
+                                 f"{name} on the grid): use --interpolate, or grid values "
+                                 f"for {', '.join(off_grid)}")
+        columns = tuple(c for c in columns if c not in OPTIONAL)
     flags = None
     if off_grid and interpolate:  # the flags from the exact model, when it can be had
         try:
