@@ -94,7 +94,32 @@ def test_warm_up_kernels_runs_each_kernel_once_and_reports_progress():
                           progress=lambda done, total, name: seen.append((done, total, name)))
     assert seen == [(1, 2, "pointwise"), (2, 2, "codec")]
     assert set(out) == {"pointwise", "codec"} and all(v >= 0.0 for v in out.values())
-    assert [k[0] for k in KERNELS] == ["grid", "pointwise", "codec"]
+    assert [k[0] for k in KERNELS] == ["grid", "pointwise", "codec", "tracking"]
+
+
+def test_a_tracking_sweep_after_the_warm_up_compiles_nothing():
+    # what `nylonflex warmup` compiles for tracking is what a tracking sweep runs: after
+    # it, another tracking config (a PI controller, a relative reference, the bandwidth
+    # search) on another grid gets no compile notice (Numba's own signal)
+    from pathlib import Path
+
+    import yaml
+
+    from nylonflex.config import parse_config
+    from nylonflex.engine.warmup import warm_up_grid, warm_up_kernels
+
+    warm_up_kernels(["tracking"], notice=lambda line: None)
+    raw = yaml.safe_load((Path(__file__).parents[1] / "configs" /
+                          "fig12_tracking.yaml").read_text())
+    raw["tracking"].update(
+        duration="0.3 s", rms_from="0 s",
+        controller={"kind": "pi", "proportional_band": "10 deg", "integral_time": "20 s"},
+        reference={"kind": "sine", "relative_to": "bend_angle_max", "mean": 0.5,
+                   "amplitude": 0.2, "frequency": "1 Hz"},
+        bandwidth={"error": "2 deg"})
+    seen = []
+    warm_up_grid(parse_config(raw), notice=seen.append)
+    assert seen == []
 
 
 def test_the_warmup_command_names_every_kernel(capsys):
@@ -102,6 +127,6 @@ def test_the_warmup_command_names_every_kernel(capsys):
 
     assert main(["warmup"]) == 0
     out = capsys.readouterr().out
-    for name in ("grid", "pointwise", "codec", "control"):
+    for name in ("grid", "pointwise", "codec", "tracking", "control"):
         assert f" {name} " in out
     assert out.splitlines()[-1].startswith("warm: every kernel")

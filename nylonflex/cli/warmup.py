@@ -9,7 +9,7 @@ HELP = "compile every kernel once, so that later runs start warm"
 DESCRIPTION = """Compile (or load from the cache) every Numba kernel once, with a line per
 kernel: the grid kernel (sweeps and sampled sweeps, on local threads and Dask workers), the
 pointwise kernel (nylonflex.evaluate, design, query --at, propagate, sensitivity), the cube
-codec and the closed-loop kernels (simulate). Compiled code is cached per model version
+codec, the tracking kernels (sweeps with tracking:) and the closed-loop kernels (simulate). Compiled code is cached per model version
 (the Numba cache folder, NUMBA_CACHE_DIR), so this is done once per install: the README's
 first sweep, CI runs and Dask workers then start warm. A warm cache makes this take about
 a second."""

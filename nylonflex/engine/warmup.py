@@ -115,15 +115,31 @@ def warm_up_codec(*, notice=None) -> float:
 
 def _tiny_config():
     """A one-radius, one-design-a-axis sweep config (fig12's materials and model)."""
+    return parse_config(_TINY)
+
+
+_TINY = {
+    "name": "warmup",
+    "grid": {"radius": {"values": [10], "units": "mm"},
+             "wall_thickness": {"values": [2], "units": "mm"},
+             "length": {"values": [90], "units": "mm"},
+             "coil_index": {"values": [1.3]},
+             "wrap_angle": {"values": [8], "units": "deg"}},
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 2},
+               "pressure": {"start": 0, "stop": 25, "num": 2, "units": "kPa"}},
+}
+
+
+def _tiny_tracking_config():
+    """:func:`_tiny_config` with a 12 V supply and a short closed loop to track (a
+    bang-bang controller and the bandwidth search: every tracking kernel)."""
     return parse_config({
-        "name": "warmup",
-        "grid": {"radius": {"values": [10], "units": "mm"},
-                 "wall_thickness": {"values": [2], "units": "mm"},
-                 "length": {"values": [90], "units": "mm"},
-                 "coil_index": {"values": [1.3]},
-                 "wrap_angle": {"values": [8], "units": "deg"}},
-        "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 2},
-                   "pressure": {"start": 0, "stop": 25, "num": 2, "units": "kPa"}},
+        **_TINY, "name": "warmup_tracking", "supply": {"voltage": 12, "units": "V"},
+        "tracking": {"duration": "0.5 s", "step": "10 ms",
+                     "reference": {"kind": "sine", "mean": "20 deg", "amplitude": "5 deg",
+                                   "frequency": "1 Hz"},
+                     "controller": {"kind": "bang_bang", "hysteresis": "0 deg"},
+                     "bandwidth": {"error": "2 deg"}},
     })
 
 
@@ -136,6 +152,8 @@ KERNELS = (
     ("pointwise", "nylonflex.evaluate, design, query --at, propagate, sensitivity",
      lambda notice: warm_up_points(notice=notice)),
     ("codec", "the cube writer's byte shuffle", lambda notice: warm_up_codec(notice=notice)),
+    ("tracking", "sweeps with tracking: (each design's closed loop, its bandwidth)",
+     lambda notice: warm_up_grid(_tiny_tracking_config(), parallel=True, notice=notice)),
 )
 
 

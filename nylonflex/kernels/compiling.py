@@ -48,12 +48,11 @@ FAMILIES = {
     "codec": "the cube codec's byte shuffle",
 }
 
-#: Cold compile times [s] measured on the project's 2-core machine on 2026-12-01 with an
-#: empty cache (NUMBA_CACHE_DIR a new folder): CPU seconds, what an idle machine takes;
-#: the wall time was 3-5 times that with the machine shared (load average 7-8: grid 83 s,
-#: pointwise 77 s, control 37 s). Quoted until this machine has its own figure.
-MEASURED = {"grid": 26.0, "pointwise": 16.0, "control": 8.0, "codec": 1.0,
-            "tracking": 20.0}  # tracking: an estimate, not yet measured cold
+#: Cold compile times [s] measured on the project's 2-core machine on 2026-12-03 with an
+#: empty cache (``nylonflex warmup``, NUMBA_CACHE_DIR a new folder; ``nylonflex bench``
+#: measures them again): CPU seconds, what an idle machine takes; the wall time is several
+#: times that on a shared machine. Quoted until this machine has its own figure.
+MEASURED = {"grid": 17.0, "pointwise": 8.0, "control": 4.0, "codec": 1.0, "tracking": 12.0}
 
 _KERNEL_MODULES = {"nylonflex.kernels.control": "control", "nylonflex.kernels.bytes": "codec",
                    "nylonflex.kernels.tracking": "tracking"}
