@@ -32,6 +32,7 @@ from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.storage import open_cube
 from nylonflex.storage.sweep import run_sweep, sweep_file
 
+from .first_use import cold_compiles, command_costs
 from .yardstick import grid_numpy
 
 #: The checkout's tests/naive.py, the slow reference of the tests.
@@ -100,14 +101,15 @@ def sampled_config(quick: bool = False):
     })
 
 
-def _sampled_seconds(quick: bool) -> tuple[float, int]:
-    """Seconds of a sampled sweep in memory, and its evaluations (designs x samples)."""
+def _sampled_seconds(quick: bool) -> tuple[float, float, int]:
+    """Wall and CPU seconds [s] (every thread of this process) of a sampled sweep in
+    memory, and its evaluations (designs x samples)."""
     cfg = sampled_config(quick)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     ds = run_sweep(cfg)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     ds.close()
-    return seconds, cfg.n_designs * cfg.uncertainty.samples
+    return seconds, cpu, cfg.n_designs * cfg.uncertainty.samples
 
 
 def _reference_design(cfg, a, t, c, psi):
@@ -235,6 +237,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         solves = _solve_count(ds)
         size_mb = (Path(tmp) / "cube.h5").stat().st_size / 2**20
         ds.close()
+        light = command_costs(Path(tmp) / "cube.h5")
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t_numpy, t_kernel_whole = _numpy_yardstick(cfg)
 
@@ -254,7 +257,8 @@ def run_bench(quick: bool = False, log=None) -> dict:
     sim_duration = 60.0 if quick else 3600.0
     t_loop, t_sim = _closed_loop_seconds(sim_duration)
 
-    t_sampled, n_sampled = _sampled_seconds(quick)
+    t_sampled, cpu_sampled, n_sampled = _sampled_seconds(quick)
+    cold = None if quick else cold_compiles()  # a minute of CPU: not in the smoke run
 
     per_design = t_total / cfg.n_designs
     result = {
@@ -287,6 +291,9 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "sampled_s": t_sampled,
         "sampled_evaluations": n_sampled,
         "sampled_evaluations_per_s": n_sampled / t_sampled,
+        "sampled_cpu_us_per_evaluation": cpu_sampled / n_sampled * 1e6,
+        "light_commands": light,
+        "cold_compile": cold,
     }
     say(f"  kernels only               {t_kernel:8.2f} s  {result['kernel_designs_per_s']:>12,.0f}"
         f" designs/s  {result['angle_solves_per_s']:>10,.0f} angle solves/s")
@@ -309,12 +316,23 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f"{result['single_vs_batch']:.1f} x a design of a batch ({cpu_batch * 1e6:.2f} us CPU"
         f" each, same run)")
     say(f"  NumPy matmul (peak)        {gflops:8.1f} GFlop/s (float64, the BLAS threads of "
-        "this process: one under the nylonflex command; the kernel's fraction of peak is "
-        "its flops a design over this)")
+        "this process: one under the nylonflex command; the kernel's fraction of it needs "
+        "a flop count, which hardware counters give where the host has them)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  sampled sweep (uncertainty) {t_sampled:7.2f} s  "
         f"{result['sampled_evaluations_per_s']:>12,.0f} evaluations/s ({n_sampled:,} = "
         f"designs x samples{', quick grid x 16' if quick else ', fig12 grid x 256'})")
+    say(f"  sampled, CPU               {result['sampled_cpu_us_per_evaluation']:8.2f} us CPU "
+        "per evaluation")
     say(f"  peak memory (RSS)          {peak_mb:8.0f} MB")
+    say("  light commands, whole process (CPU s, peak MB; warm cache, the sweep's cube): " +
+        ", ".join(f"{k} {c:.2f} s" + ("" if m is None else f" {m:.0f} MB")
+                  for k, (c, m) in light.items()))
+    if cold is None:
+        say("  cold compile               not measured in --quick (nylonflex warmup, empty cache)")
+    else:
+        say("  cold compile, empty cache  " + ", ".join(
+            f"{k} {w:.1f} s ({c:.1f} CPU-s)" for k, (w, c) in cold["kernels"].items()) +
+            f"; nylonflex warmup's whole process {cold['process_cpu_s']:.1f} CPU-s")
     return result

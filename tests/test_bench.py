@@ -24,14 +24,19 @@ def test_quick_bench_reports_every_figure():
     text = "\n".join(lines)
     for words in ("designs/s", "angle solves/s", "speed-up per design", "peak memory",
                   "closed loop", "evaluations/s", "NumPy yardstick", "kernel vs NumPy",
-                  "one design", "GFlop/s"):
+                  "one design", "GFlop/s", "light commands", "cold compile",
+                  "us CPU per evaluation"):
         assert words in text
     assert result["designs"] == 12 * 6 * 4 * 3 * 4
     assert result["angle_solves"] >= 12 * 6 * (9 + 3)  # curve points + full-stroke solves
     assert all(result[k] > 0 for k in ("kernel_s", "sweep_s", "reference_s_per_design",
                                        "speedup", "peak_rss_mb", "numpy_s",
                                        "kernel_vs_numpy", "single_vs_batch",
-                                       "matmul_gflops"))
+                                       "matmul_gflops", "sampled_cpu_us_per_evaluation"))
+    # every light command ran (exit 0) and was measured as a child process of its own
+    assert set(result["light_commands"]) >= {"info", "query --where", "query --at", "list materials"}
+    assert all(cpu > 0 and (mb is None or mb > 0)
+               for cpu, mb in result["light_commands"].values())
 
 
 def test_the_command_finds_the_benchmarks_beside_the_package_of_a_checkout(tmp_path):
