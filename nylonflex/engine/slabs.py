@@ -28,7 +28,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..config import ResolvedConfig
-from ..units import InputError
 from ..variables import COOLING, COORDS, MODEL, slab_done_attrs
 from . import threads
 from .grid import ArrayPool, compute_slab, coords, cube_variables, global_arrays
