@@ -86,6 +86,13 @@ def test_verify_writes_ratios_and_resumes_only_what_is_missing(cube, monkeypatch
     # another sample in the same folder is refused, not mixed
     with pytest.raises(InputError, match="holds the runs of another verify"):
         verify.run_verify(cube, 6, mesh="coarse")
+    # and so are the runs of another version of the FE model (its constants in the plan)
+    import nylonflex.fe.model as fe_model
+
+    assert fid.attrs["fe_model"] == json.dumps(fe_model.model_settings(), sort_keys=True)
+    monkeypatch.setattr(fe_model, "COMPRESSION_RATIO", 1.0)
+    with pytest.raises(InputError, match="holds the runs of another verify"):
+        verify.run_verify(cube, 5, mesh="coarse")
 
 
 def test_fidelity_map_and_info(cube, monkeypatch, tmp_path):

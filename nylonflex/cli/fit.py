@@ -171,6 +171,7 @@ def run_fe(args) -> int:
                           "mesh": args.mesh, "seed": args.seed,
                           "training_ranges_m": {k: list(v) for k, v in TRAINING_RANGES.items()},
                           "silicone": plan["silicone"],
+                          "fe_model": plan["fe_model"],
                           "target_angles_deg": plan["target_angles_deg"]},
            "fit": {k: v for k, v in res.items() if k != "coefficients"},
            "training": [{**d, "fe_bend_angle": done[k]["bend_angle"],

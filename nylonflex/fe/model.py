@@ -6,7 +6,8 @@
   hexahedra, FElupe's :class:`~felupe.SolidBodyNearlyIncompressible`).
 - **Strain-limiting layer**: a skin of fibres along z in the bottom cell layer, of axial
   stiffness per width ``SKIN_RATIO`` mu0 (a + t + b): it holds y = 0 at its length, the
-  neutral axis of docs/model.md s. 6.
+  neutral axis of docs/model.md s. 6. Like paper or fabric, it gives way in compression
+  (``COMPRESSION_RATIO``).
 - **Wrap**: the muscle's turns smeared into a hoop layer (fibres along the outer contour's
   tangent in the section plane, in the outermost cells of the wall and of the floor's side,
   plus along x in the skin), of hoop stiffness per length ``WRAP_RATIO`` mu0 (a + t): it
@@ -21,10 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import BodyMesh
-from .ogden import OgdenIsochoric
 
-__all__ = ["BULK_RATIO", "SKIN_RATIO", "WRAP_RATIO", "FibreMaterial", "build_model",
-           "element", "felupe_ogden"]
+__all__ = ["BULK_RATIO", "COMPRESSION_RATIO", "SKIN_RATIO", "WRAP_RATIO", "FibreMaterial",
+           "build_model", "element", "felupe_ogden", "model_settings"]
 
 #: Bulk modulus of the volumetric penalty over the initial shear modulus (Poisson's ratio
 #: 0.4999 at 5000).
@@ -36,6 +36,24 @@ BULK_RATIO = 5000.0
 SKIN_RATIO = 100.0
 #: Hoop stiffness per length of the smeared wrap over mu0 (a + t) [-].
 WRAP_RATIO = 100.0
+#: The strain-limiting skin's axial stiffness in compression over its stiffness in
+#: tension [-]. A sheet of paper or fabric holds its length in tension and buckles out of
+#: the way in compression. A skin that carried compression as well was a stiff film on a
+#: soft body, which wrinkled at a wavelength set by the mesh, so that refining the mesh
+#: kept softening large bends (docs/fidelity.md, "Closing the 10 kPa gap"). Zero: the
+#: angle converges to it as the ratio falls (0.1, 0.01 and 0.001 give 13, 3.6 and 0.5 %
+#: less at 10 kPa on the paper's example 2), and the silicone of the skin's cells still
+#: gives a slack skin a tangent. The wrap (and the skin's fibres across) hold their length
+#: both ways: the section's contour, which the paper's balance takes as fixed (plane
+#: strain across the wall).
+COMPRESSION_RATIO = 0.0
+
+
+def model_settings() -> dict:
+    """The FE model's constants (JSON-able): a run folder's plan and a result's provenance
+    hold them, so that runs of another version of the model are never mixed in."""
+    return {"bulk_ratio": BULK_RATIO, "skin_ratio": SKIN_RATIO, "wrap_ratio": WRAP_RATIO,
+            "compression_ratio": COMPRESSION_RATIO}
 
 
 def felupe_ogden(mu, alpha):
@@ -53,13 +71,16 @@ def felupe_ogden(mu, alpha):
 class FibreMaterial:
     """Fibres of one direction per cell: W = k/4 (I4 - 1)^2 with I4 = a.C.a [J/m^3].
 
-    ``stiffness`` k [Pa] per cell (the fibre modulus at small strain is 2 k) and
-    ``direction`` (cells, 3) unit vectors in the reference configuration. Tension and
-    compression alike: the skin and the wrap hold their length (docs/fidelity.md).
-    Implements FElupe's material interface (``gradient``, ``hessian``).
+    ``stiffness`` k [Pa] per cell (the fibre modulus at small strain is 2 k) in tension
+    (I4 > 1), ``compression`` times k in compression (I4 < 1; W and its first derivative
+    are continuous at I4 = 1), and ``direction`` (cells, 3) unit vectors in the reference
+    configuration. Implements FElupe's material interface (``gradient``, ``hessian``).
     """
 
-    def __init__(self, stiffness, direction):
+    def __init__(self, stiffness, direction, compression=1.0):
+        if not 0.0 <= compression <= 1.0:
+            raise ValueError(f"compression must be in [0, 1], got {compression!r}")
+        self.compression = float(compression)
         self.k = np.asarray(stiffness, dtype=float)
         self.a = np.asarray(direction, dtype=float).T[:, None, :]  # (3, 1, cells)
         self.x = [np.eye(3), np.zeros(0)]
@@ -69,11 +90,15 @@ class FibreMaterial:
         i4 = np.einsum("iqc,iqc->qc", fa, fa)
         return fa, i4
 
+    def _stiffness(self, i4):
+        """k where the fibre is stretched, ``compression`` k where it is shortened [Pa]."""
+        return self.k * np.where(i4 < 1.0, self.compression, 1.0)
+
     def gradient(self, x):
         F, statevars = x[0], x[-1]
         fa, i4 = self._parts(F)
         a = np.broadcast_to(self.a, (3,) + F.shape[2:])
-        P = np.einsum("qc,iqc,Jqc->iJqc", self.k * (i4 - 1.0), fa, a)
+        P = np.einsum("qc,iqc,Jqc->iJqc", self._stiffness(i4) * (i4 - 1.0), fa, a)
         return [P, statevars]
 
     def hessian(self, x):
@@ -81,9 +106,9 @@ class FibreMaterial:
         fa, i4 = self._parts(F)
         a = np.broadcast_to(self.a, (3,) + F.shape[2:])
         eye = np.eye(3)
-        A = np.einsum("qc,ik,Jqc,Lqc->iJkLqc", self.k * (i4 - 1.0), eye, a, a)
-        A += np.einsum("qc,iqc,Jqc,kqc,Lqc->iJkLqc", 2.0 * self.k * np.ones_like(i4), fa, a,
-                       fa, a)
+        k = self._stiffness(i4)
+        A = np.einsum("qc,ik,Jqc,Lqc->iJkLqc", k * (i4 - 1.0), eye, a, a)
+        A += np.einsum("qc,iqc,Jqc,kqc,Lqc->iJkLqc", 2.0 * k, fa, a, fa, a)
         return [A]
 
 
@@ -106,6 +131,9 @@ def build_model(body: BodyMesh, mu, alpha):
     """
     import felupe as fem
 
+    from .ogden import OgdenIsochoric  # compiled with Numba: not for the light commands,
+    # which read model_settings() through fe.verify (nylonflex info)
+
     a, t, b = body.radius, body.wall_thickness, body.base_thickness
     mu_f, alpha_f = felupe_ogden(mu, alpha)
     mu0 = float(sum(mu_f))
@@ -119,15 +147,16 @@ def build_model(body: BodyMesh, mu, alpha):
     skin_k = 0.5 * SKIN_RATIO * mu0 * (a + t + b) / body.skin_thickness
     wrap_k = 0.5 * WRAP_RATIO * mu0 * (a + t) / body.wrap_thickness
     n_skin = len(body.skin)
-    for cells, k, direction in (
-            (body.skin, np.full(n_skin, skin_k), np.tile([0.0, 0.0, 1.0], (n_skin, 1))),
+    for cells, k, direction, compression in (
+            (body.skin, np.full(n_skin, skin_k), np.tile([0.0, 0.0, 1.0], (n_skin, 1)),
+             COMPRESSION_RATIO),
             (body.skin, np.full(n_skin, 0.5 * WRAP_RATIO * mu0 * (a + t) / body.skin_thickness),
-             np.tile([1.0, 0.0, 0.0], (n_skin, 1))),
-            (body.wrap, wrap_k, body.wrap_direction)):
+             np.tile([1.0, 0.0, 0.0], (n_skin, 1)), 1.0),
+            (body.wrap, wrap_k, body.wrap_direction, 1.0)):
         sub = fem.Mesh(body.points, body.cells[cells], kind)
         sub_field = fem.FieldContainer([fem.Field(Region(sub), dim=3)])
         sub_field.link(field)
-        items.append(fem.SolidBody(FibreMaterial(k, direction), sub_field))
+        items.append(fem.SolidBody(FibreMaterial(k, direction, compression), sub_field))
     boundary = Boundary(mesh, only_surface=True, mask=body.chamber)
     pressure = fem.SolidBodyPressure(fem.FieldContainer([fem.Field(boundary, dim=3)]))
     pressure.field.link(field)

@@ -20,6 +20,7 @@ from .. import __version__
 from ..units import InputError, json_text
 from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
+from .model import model_settings
 from .runs import journaled_runs, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
@@ -103,6 +104,7 @@ def _plan(ds, attrs, n, seed, mesh):
             "silicone": {"name": getattr(sil, "name", "custom"),
                          "mu": [float(m) for m in sil.mu],
                          "alpha": [float(a) for a in sil.alpha]},
+            "fe_model": model_settings(),
             "cube_config_sha256": str(attrs.get("config_sha256", ""))}
 
 
@@ -217,6 +219,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
                       "nylonflex_version": __version__, "fe_mesh": mesh, "seed": seed,
                       "cube": cube.name, "cube_config_sha256": plan["cube_config_sha256"],
                       "model_of_cube": plan["model"], "silicone": json.dumps(sil),
+                      "fe_model": json.dumps(plan["fe_model"], sort_keys=True),
                       "Conventions": "CF-1.8"})
     path = fidelity_path(cube)
     with replacing(path, what="verify", inputs=(cube,)) as tmp:
