@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import itertools
 import json
+import os
 import threading
 import zlib
 from concurrent.futures import ThreadPoolExecutor
@@ -301,8 +302,16 @@ class CubeFile:
             yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec)
 
     def abandon(self):
-        """Close after a failure (a full disk, an error) without raising."""
+        """Close after a failure (a full disk, an error) without raising.
+
+        A failed run's file is never published (``--resume`` rebuilds it from the journal),
+        so its bytes are dropped first: HDF5's close then has room for what it still has to
+        write. A close that fails partway leaves HDF5 ids half closed, and freeing them
+        later crashed the process (a full 1 MB disk, about one run in six).
+        """
         self._pool.shutdown(cancel_futures=True)
+        with contextlib.suppress(Exception):
+            os.ftruncate(self.f.h5.id.get_vfd_handle(), 0)
         with contextlib.suppress(Exception):
             self.f.h5.close()
 
