@@ -321,5 +321,5 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
 
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
-design_slab = jit_kernel(_design_slab)
-design_points = jit_kernel(_design_points)
+design_slab = jit_kernel(_design_slab, callee_body=True)
+design_points = jit_kernel(_design_points, callee_body=True)
