@@ -291,3 +291,57 @@ def test_each_kernel_writes_every_row_once_by_its_constant(module, function, arr
     for array, table in arrays.items():
         assert sorted(written[array]) == sorted(f"ROW_{n.upper()}"
                                                 for n in getattr(rows, table))
+
+
+def _twice(x):
+    return 2.0 * x
+
+
+def _twice_plus_one(x):
+    return _twice(x) + 1.0
+
+
+def _calls_both(x, out):
+    out[0] = _twice(x) + _twice_plus_one(x)
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="counts Numba's compiles")
+@pytest.mark.parametrize("callee_body, compiles", [(False, 2), (True, 1)])
+def test_a_callee_body_kernel_compiles_each_formula_once(callee_body, compiles, monkeypatch):
+    # a formula called by the kernel itself and through another formula: Numba keys a
+    # callee on its caller's flags, so it compiles twice unless the kernel's body is a
+    # callee too (jit_kernel(callee_body=True))
+    from numba.core import event
+    from numba.extending import register_jitable
+
+    monkeypatch.setitem(_compile.JIT_OPTIONS, "cache", False)
+    for f in (_twice, _twice_plus_one):
+        # fresh copies: Numba's overload cache belongs to the function object
+        globals()[f.__name__] = type(f)(f.__code__, globals(), f.__name__)
+        register_jitable(**_compile.CALLEE_OPTIONS)(globals()[f.__name__])
+    body = type(_calls_both)(_calls_both.__code__, globals(), "_calls_both")
+    kernel = _compile.jit_kernel(body, callee_body=callee_body)
+    assert kernel.py_func.__name__ == "_calls_both"
+    assert kernel.py_func.__code__.co_varnames[:2] == ("x", "out")
+    names = []
+
+    class Count(event.Listener):
+        def on_start(self, ev):
+            names.append(ev.data["dispatcher"].py_func.__name__)
+
+        def on_end(self, ev):
+            pass
+
+    out = np.zeros(1)
+    with event.install_listener("numba:compile", Count()):
+        kernel(3.0, out)
+    assert out[0] == 6.0 + 7.0
+    assert names.count("_twice") == compiles
+
+
+def test_a_callee_body_kernel_takes_plain_positional_parameters():
+    def with_default(x, y=1.0):
+        return x + y
+
+    with pytest.raises(TypeError, match="plain positional parameters"):
+        _compile.jit_kernel(with_default, callee_body=True)
