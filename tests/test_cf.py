@@ -35,7 +35,11 @@ KINDS = {
 #:   air_pressure (its table of names: time, lat, lon, height, depth, altitude, pressure).
 #:   The cube's `pressure` (INTERFACE.md) is the chamber's gauge pressure, which CF's
 #:   air_pressure (absolute, of the atmosphere) is not; renaming the dimension would break
-#:   every user's ds.sel(pressure=...). Nothing else in cf:1.8 reads it as space.
+#:   every user's ds.sel(pressure=...). Nothing else in cf:1.8 reads it as space. The
+#:   table is compliance-checker's issue #1245; its open fix (PR #1353) drops the table but
+#:   asks every vertical coordinate for a standard_name or axis="Z", and CF s. 4.3 makes
+#:   any coordinate in units of pressure a vertical one, so CF has no way to say "a
+#:   pressure that is not a height": the rule stays for whoever owns the interface.
 #: - s. 2.4 (a warning, multi-model cubes): pressure's units make the checker guess it a
 #:   vertical (Z) axis and want the string `model` dimension before it.
 KNOWN = {"§5.1 Independent Latitude, Longitude, Vertical, and Time Axes":
