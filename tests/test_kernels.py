@@ -345,3 +345,9 @@ def test_a_callee_body_kernel_takes_plain_positional_parameters():
 
     with pytest.raises(TypeError, match="plain positional parameters"):
         _compile.jit_kernel(with_default, callee_body=True)
+
+    def keyword_only(x, *, y):
+        return x + y
+
+    with pytest.raises(TypeError, match="plain positional parameters"):
+        _compile.jit_kernel(keyword_only, callee_body=True)

@@ -199,10 +199,10 @@ def _calling(f):
     compiles. Numba's cache files are named by the function's name and line, as before."""
     register_jitable(**CALLEE_OPTIONS)(f)
     code = f.__code__
-    if f.__defaults__ or f.__kwdefaults__ or code.co_flags & (inspect.CO_VARARGS |
-                                                             inspect.CO_VARKEYWORDS):
+    if f.__defaults__ or code.co_kwonlyargcount or code.co_posonlyargcount or \
+            code.co_flags & (inspect.CO_VARARGS | inspect.CO_VARKEYWORDS):
         raise TypeError(f"kernel {f.__name__}: plain positional parameters only")
-    args = ", ".join(code.co_varnames[:code.co_argcount + code.co_kwonlyargcount])
+    args = ", ".join(code.co_varnames[:code.co_argcount])
     source = "\n" * (code.co_firstlineno - 1) + \
         f"def {f.__name__}({args}):\n    return _body({args})\n"
     scope = {"_body": f}
