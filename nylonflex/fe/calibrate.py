@@ -29,8 +29,7 @@ from ..physics.limits import model_bend_angle
 from ..units import InputError
 from . import ORDER, fe_bend
 from .mesh import REFINEMENT
-from .model import model_settings
-from .runs import journaled_runs, plan_silicone
+from .runs import journaled_runs, plan_material, plan_silicone
 
 __all__ = ["TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
            "run_training", "training_plan"]
@@ -89,10 +88,7 @@ def training_plan(designs=48, seed=0, mesh="coarse", silicone="tc5005") -> dict:
         rows.append(d)
     return {"designs": rows, "mesh": mesh, "seed": int(seed),
             "target_angles_deg": [math.degrees(th) for th in TARGET_ANGLES],
-            "silicone": {"name": getattr(sil, "name", "custom"),
-                         "mu": [float(m) for m in sil.mu],
-                         "alpha": [float(a) for a in sil.alpha]},
-            "fe_model": model_settings()}
+            **plan_material(sil)}
 
 
 def _solve(task):

@@ -12,8 +12,20 @@ import json
 from pathlib import Path
 
 from ..units import InputError, json_text
+from .model import model_settings
 
-__all__ = ["journaled_runs", "plan_silicone"]
+__all__ = ["journaled_runs", "plan_material", "plan_silicone"]
+
+
+def plan_material(sil) -> dict:
+    """What a plan records of the material and the FE model: the silicone ``sil`` (its
+    name and Ogden constants, read back by :func:`plan_silicone`) and the model's constants
+    (:func:`~.model.model_settings`), so that runs of another silicone or another version
+    of the model are never mixed in."""
+    return {"silicone": {"name": getattr(sil, "name", "custom"),
+                         "mu": [float(m) for m in sil.mu],
+                         "alpha": [float(a) for a in sil.alpha]},
+            "fe_model": model_settings()}
 
 
 def plan_silicone(sil):

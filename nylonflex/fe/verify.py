@@ -20,8 +20,7 @@ from .. import __version__
 from ..units import InputError, json_text
 from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
-from .model import model_settings
-from .runs import journaled_runs, plan_silicone
+from .runs import journaled_runs, plan_material, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
            "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
@@ -101,10 +100,7 @@ def _plan(ds, attrs, n, seed, mesh):
                      "base_thickness": settings.get("base_thickness")})
     sil = settings["silicone"]
     return {"designs": runs, "mesh": mesh, "seed": int(seed), "model": settings["model"],
-            "silicone": {"name": getattr(sil, "name", "custom"),
-                         "mu": [float(m) for m in sil.mu],
-                         "alpha": [float(a) for a in sil.alpha]},
-            "fe_model": model_settings(),
+            **plan_material(sil),
             "cube_config_sha256": str(attrs.get("config_sha256", ""))}
 
 
