@@ -141,7 +141,7 @@ def test_the_settings_attributes_are_typed(tmp_path, capsys):
     _, ds = _swept(tmp_path, "cooling")
     with h5py.File(tmp_path / "cooling.h5", "r") as f:
         a = f.attrs
-        assert a["nylonflex_cube"] == CUBE_FORMAT == "2"
+        assert a["nylonflex_cube"] == CUBE_FORMAT == "3"
         for key in ("supply_voltage", "base_thickness", "silicone_mu", "silicone_alpha",
                     "silicone_stretch_range", "cooling_speed",
                     *(f"nylon_{n}" for n in NYLON_FIELDS)):

@@ -28,9 +28,11 @@ __all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "
            "typed_info"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format:
-#: "2" stores the settings as typed attributes (:func:`settings_attrs`), "1" (before issue
-#: 28) only as YAML text, which :func:`cube_settings` still reads.
-CUBE_FORMAT = "2"
+#: "3" stores the pressure curves over the dimension ``pressure_point``, with ``pressure``
+#: their auxiliary coordinate (``storage.cube.STORED_DIMS``: CF-clean), "2" over
+#: ``pressure``; both store the settings as typed attributes (:func:`settings_attrs`), "1"
+#: (before issue 28) only as YAML text, which :func:`cube_settings` still reads.
+CUBE_FORMAT = "3"
 #: Attributes that differ between two runs of the same config (timing, host, when).
 VOLATILE_ATTRS = ("created", "run_seconds", "designs_per_second", "scheduler", "workers",
                   "resumed_slabs", "python_version", "hostname", "history")
@@ -140,7 +142,7 @@ NYLON_FIELDS = tuple(f.name for f in dataclasses.fields(Nylon)
 
 
 def settings_attrs(cfg: ResolvedConfig) -> dict:
-    """The settings a cube was computed with, as typed global attributes (cube format 2).
+    """The settings a cube was computed with, as typed global attributes (cube formats 2 and 3).
 
     ``silicone`` and ``nylon`` (the sets' names) with ``<kind>_description`` (text) and
     ``<kind>_<field>`` for every numeric field (:data:`SILICONE_FIELDS`,

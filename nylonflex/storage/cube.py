@@ -22,8 +22,22 @@ except ImportError:  # pragma: no cover - isal is a dependency
 from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .netcdf4 import NetCDF4File
 
-__all__ = ["CODECS", "DEFAULT_CODEC", "Codec", "CubeFile", "MissingPlugin",
-           "require_filters"]
+__all__ = ["CODECS", "DEFAULT_CODEC", "STORED_DIMS", "Codec", "CubeFile", "MissingPlugin",
+           "require_filters", "stored_dims"]
+
+#: Axes a cube stores as an auxiliary coordinate over a dimension of another name (cube
+#: format 3): {axis: its dimension in the file}. compliance-checker (cf:1.8, s. 5.1) asks a
+#: dimension *named* ``pressure`` for ``standard_name = air_pressure``, which the chamber's
+#: gauge pressure is not (CF's air_pressure is the absolute pressure of the air). So the
+#: curves ``bend_angle`` and ``tip_force`` lie over ``pressure_point`` in the file, with
+#: ``coordinates = "pressure"``: every reader still finds the variable ``pressure`` [Pa],
+#: and :func:`nylonflex.open_cube` makes it the dimension again (``ds.sel(pressure=...)``).
+STORED_DIMS = {"pressure": "pressure_point"}
+
+
+def stored_dims(dims) -> tuple:
+    """A variable's dimensions as the file names them (:data:`STORED_DIMS`)."""
+    return tuple(STORED_DIMS.get(d, d) for d in dims)
 
 
 @dataclass(frozen=True)
@@ -188,9 +202,14 @@ class CubeFile:
         # the caller holds the writer's lock on this file (storage.journal.exclusive), so
         # HDF5's own lock, which would conflict with it, is off
         self.f = NetCDF4File(self.path)
-        sizes = {name: len(values) for name, values in coords.items()}
+        sizes = {STORED_DIMS.get(name, name): len(values) for name, values in coords.items()}
         for name, values in coords.items():
-            self.f.coordinate(name, np.asarray(values, float), COORDS[name].attrs())
+            if name in STORED_DIMS:  # an auxiliary coordinate over a dimension of its own
+                self.f.dimension(STORED_DIMS[name], len(values))
+                self.f.variable(name, (STORED_DIMS[name],), "f8", COORDS[name].attrs(),
+                                data=np.asarray(values, float))
+            else:
+                self.f.coordinate(name, np.asarray(values, float), COORDS[name].attrs())
         if len(models) > 1:  # the string dimension of a cube of several model variants
             sizes["model"] = len(models)
             self.f.coordinate("model", np.array(models, dtype=object), MODEL.attrs(),
@@ -205,7 +224,11 @@ class CubeFile:
             variables = {n: (v, v.dims) for n, v in {**DESIGN, **CURVES}.items()}
         for var, dims in variables.values():
             fill = None if var.dtype == "int8" else np.nan
-            self.f.variable(var.name, dims, var.dtype, var.attrs(), fillvalue=fill,
+            dims, var_attrs = stored_dims(dims), var.attrs()
+            aux = [name for name, dim in STORED_DIMS.items() if dim in dims]
+            if aux:
+                var_attrs["coordinates"] = " ".join(aux)
+            self.f.variable(var.name, dims, var.dtype, var_attrs, fillvalue=fill,
                             chunks=_chunks(dims, sizes, radius_chunk), **self.codec.filters)
         self.f.variable("slab_done", ("radius",), "i1", slab_done_attrs())
         self.f.set_attrs({**attrs, "compression": self.codec.name})

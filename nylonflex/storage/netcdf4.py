@@ -1,15 +1,18 @@
 """A netCDF-4 file written through h5py alone, in the layout h5netcdf and netCDF-C write.
 
-The cube needs only fixed-size dimensions, each with its coordinate variable, and
-variables over them. h5netcdf writes those with about 1,300 group and dataset lookups for a
-cube's forty variables (0.1 s of a 1.3 s sweep, with the GIL held); this module makes the
+The cube needs only fixed-size dimensions, each with its coordinate variable or (cube
+format 3's ``pressure_point``) an auxiliary coordinate over it, and variables over them.
+h5netcdf writes those with about 1,300 group and dataset lookups for a cube's forty
+variables (0.1 s of a 1.3 s sweep, with the GIL held); this module makes the
 same HDF5 objects with one call each. What makes an HDF5 file netCDF-4 (NetCDF User Guide,
 "NetCDF-4 Format"; h5netcdf 1.x writes the same):
 
 - the root group tracks the creation order of its links and attributes, and so does every
   variable (``track_order``);
 - a dimension is the dimension scale of its coordinate variable (``CLASS``/``NAME``), with
-  its ``_Netcdf4Dimid`` (0, 1, ... in order of creation);
+  its ``_Netcdf4Dimid`` (0, 1, ... in order of creation); a dimension with no coordinate
+  variable is a scale of its own, an empty ``>f4`` dataset of its name whose ``NAME`` says
+  "This is a netCDF dimension but not a netCDF variable." and its length;
 - every variable has its dimensions' scales attached (``DIMENSION_LIST``) and their ids in
   ``_Netcdf4Coordinates``, and, as netCDF-C writes it, the first one's id in
   ``_Netcdf4Dimid``;
@@ -27,12 +30,15 @@ import numpy as np
 
 from .. import __version__
 
-__all__ = ["HIDDEN_ATTRS", "NetCDF4File"]
+__all__ = ["HIDDEN_ATTRS", "NOT_A_VARIABLE", "NetCDF4File"]
 
 #: Attributes the netCDF-4 layout itself uses; a variable's own attributes may not.
 HIDDEN_ATTRS = frozenset(("REFERENCE_LIST", "CLASS", "DIMENSION_LIST", "NAME",
                           "_Netcdf4Dimid", "_Netcdf4Coordinates", "_nc3_strict",
                           "_NCProperties"))
+#: The start of the ``NAME`` of a dimension scale that is no variable (netCDF-C's words; the
+#: dimension's length follows, in 10 characters).
+NOT_A_VARIABLE = "This is a netCDF dimension but not a netCDF variable."
 
 
 def _set_attrs(attrs, values: dict):
@@ -71,6 +77,7 @@ class NetCDF4File:
         self.datasets: dict = {}
         self.dims: dict = {}
         self._dimid: dict = {}
+        self._scales: dict = {}  # each dimension's scale: its coordinate variable or its own
 
     def set_attrs(self, values: dict, name: str | None = None):
         """Write attributes of the root group, or of variable ``name``."""
@@ -85,21 +92,35 @@ class NetCDF4File:
         ds.attrs["_Netcdf4Coordinates"] = np.array([dimid], np.int32)
         _set_attrs(ds.attrs, attrs)
         self._dimid[name] = dimid
+        self._scales[name] = ds
         self.datasets[name], self.dims[name] = ds, (name,)
         return ds
 
+    def dimension(self, name: str, size: int):
+        """The dimension ``name`` of ``size``, with no coordinate variable: netCDF-4's scale
+        of its own, as netCDF-C and h5netcdf write it (``pressure_point``, over which the
+        auxiliary coordinate ``pressure`` lies)."""
+        ds = self.h5.create_dataset(name, (size,), ">f4", track_order=True)
+        dimid = len(self._dimid)
+        ds.attrs["_Netcdf4Dimid"] = np.int32(dimid)
+        ds.make_scale(NOT_A_VARIABLE + f"{size:10}")
+        self._dimid[name] = dimid
+        self._scales[name] = ds
+        return ds
+
     def variable(self, name: str, dims: tuple, dtype, attrs: dict, *, fillvalue=None,
-                 chunks=None, **filters):
-        """A variable over the dimensions ``dims`` (made by :meth:`coordinate`).
+                 chunks=None, data=None, **filters):
+        """A variable over the dimensions ``dims`` (made by :meth:`coordinate` or
+        :meth:`dimension`), holding ``data`` if given.
 
         ``fillvalue`` None leaves HDF5's default (zero) and writes no ``_FillValue``;
         ``filters`` are h5py's dataset options (compression, compression_opts, shuffle).
         """
-        shape = tuple(self.datasets[d].shape[0] for d in dims)
-        ds = self.h5.create_dataset(name, shape, dtype, chunks=chunks, fillvalue=fillvalue,
-                                    track_order=True, **filters)
+        shape = tuple(self._scales[d].shape[0] for d in dims)
+        ds = self.h5.create_dataset(name, shape, dtype, data=data, chunks=chunks,
+                                    fillvalue=fillvalue, track_order=True, **filters)
         for axis, dim in enumerate(dims):
-            ds.dims[axis].attach_scale(self.datasets[dim])
+            ds.dims[axis].attach_scale(self._scales[dim])
         if dims:
             ids = np.array([self._dimid[d] for d in dims], np.int32)
             ds.attrs["_Netcdf4Coordinates"] = ids

@@ -10,11 +10,11 @@ import numpy as np
 from ..units import InputError
 from ..variables import (AXES, CURVES, DESIGN, UNCERTAIN, VARIABLES, is_complete, to_display,
                          validate)
-from .cube import require_filters
+from .cube import STORED_DIMS, require_filters
 from .journal import Journal
 
 __all__ = ["MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_cube", "check_chunk_sizes",
-           "cube_attrs", "cube_summary", "open_cube"]
+           "cube_attrs", "cube_summary", "logical_dims", "open_cube"]
 
 #: The largest chunk of a cube read [bytes]: a chunk is decoded whole, and nylonflex writes
 #: chunks of about 2 MB (a crafted 2^29-element chunk made ``info`` allocate 4 GiB).
@@ -96,7 +96,7 @@ def open_cube(path, *, quiet: bool = False):
                          "written by 'nylonflex sweep')")
     check_chunk_sizes(path)
     require_filters(attrs.get("compression"))  # zstd and lz4 need a filter plugin
-    ds = xr.open_dataset(path, engine="h5netcdf")
+    ds = logical_dims(xr.open_dataset(path, engine="h5netcdf"))
     for var in ds.variables.values():
         var.encoding = portable_encoding(var.encoding)
     try:
@@ -113,6 +113,16 @@ def open_cube(path, *, quiet: bool = False):
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
+
+
+def logical_dims(ds):
+    """``ds`` (a cube as xarray reads the file) with each axis of :data:`STORED_DIMS`
+    its dimension again: ``bend_angle`` and ``tip_force`` over ``pressure``, as the
+    registry has them, whatever the cube's format (format 3 stores them over
+    ``pressure_point``; earlier formats over ``pressure`` itself)."""
+    swap = {dim: name for name, dim in STORED_DIMS.items()
+            if dim in ds.dims and name in ds.coords and ds[name].dims == (dim,)}
+    return ds.swap_dims(swap) if swap else ds
 
 
 #: Encoding keys of codecs only HDF5 filter plugins know: h5py's filter id and options, and
