@@ -295,6 +295,12 @@ def test_the_pressure_curves_lie_over_pressure_point_and_open_over_pressure(tmp_
         assert f["bend_angle"].attrs["coordinates"] == "pressure"
         assert f["bend_angle"].dims[3][0].name == "/pressure_point"
         assert f["pressure_point"].attrs["NAME"].startswith(b"This is a netCDF dimension")
+    from nylonflex.storage import cube_summary
+
+    lines = cube_summary(path)  # info: the dimensions open_cube gives, and the file's
+    assert any(l.split()[0] == "bend_angle" and "length, pressure)" in l for l in lines)
+    assert any(l.split()[0] == "pressure" and "over the dimension pressure_point" in l
+               for l in lines)
     old = Path(__file__).parent / "data" / "reference_cube.h5"  # format 1, over pressure
     with nf.open_cube(old) as ds:
         assert ds["bend_angle"].dims[-1] == "pressure" and ds.sel(pressure=0.0).sizes

@@ -378,13 +378,18 @@ def cube_summary(path) -> list[str]:
             v = VARIABLES[name]
             vals = to_display(name, np.asarray(h5[name][...]))
             unit = "" if v.display == "1" else f" {v.display}"
-            out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} ({len(vals)})")
+            over = h5[name].dims[0][0].name.lstrip("/") if h5[name].dims[0] else name
+            where = f"; in the file over the dimension {over}" if over != name else ""
+            out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} "
+                       f"({len(vals)}{where})")
         out.append("variables")
+        logical = {dim: name for name, dim in STORED_DIMS.items()}
         for name in _data_vars(f):
             if name == "slab_done":
                 continue
             var = f.variables[name]
-            out.append(f"  {name:<18} ({', '.join(var.dimensions)}) "
+            dims = [logical.get(d, d) for d in var.dimensions]  # as open_cube gives them
+            out.append(f"  {name:<18} ({', '.join(dims)}) "
                        f"[{_attr(var.attrs.get('units'))}] {_attr(var.attrs.get('long_name'))}")
     out.append("provenance")
     for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
