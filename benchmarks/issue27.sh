@@ -3,7 +3,7 @@
 # (user + system, /usr/bin/time) and peak memory, ratios measured side by side in this run.
 #
 #   benchmarks/issue27.sh                 # this checkout
-#   BASE=/work/main benchmarks/issue27.sh # ... and the same figures of another checkout
+#   BASE=../base benchmarks/issue27.sh    # ... and the same figures of another checkout
 #                                         # (its .venv/bin/nylonflex) beside them
 #   RUNS=5 COLD_RUNS=3 BIG=/tmp/big.h5 benchmarks/issue27.sh
 #   SKIP_BENCH=1 SKIP_SAMPLED=1 ...       # leave out section 6 (the full nylonflex bench)
