@@ -51,3 +51,21 @@ def fitted_thermal_file(folder, lam=0.05, cap=0.45, lm=0.3, v=5.0, r_meas=40.0):
                                                             for a, b in zip(t, temp)))
     fit = fit_thermal(str(csv), v, lm, resistance=r_meas)
     return write_material_file(fit, Path(folder) / "n.yaml")
+
+
+#: The shipped fitted silicone (nylonflex fit silicone of tests/data/ecoflex_0050.csv,
+#: ogden2 to stretch 4): its mu_2 = 9.1 +- 17.9 Pa is too loose for from_fit.
+SHIPPED_FIT = Path(__file__).resolve().parents[1] / "configs" / "fits" / \
+    "ecoflex_0050_ogden2.yaml"
+
+
+def tight_fit_file(folder, scale=0.01):
+    """The shipped ogden2 fit with its covariance times ``scale`` (standard deviations
+    times sqrt(scale): mu_2's 1.97x its value becomes 0.2x, which from_fit samples with no
+    truncation); return its path. A made-up file for the sampling tests, not a measurement."""
+    doc = yaml.safe_load(SHIPPED_FIT.read_text())
+    doc["covariance"] = [[scale * float(x) for x in row] for row in doc["covariance"]]
+    path = Path(folder) / "ecoflex_0050_ogden2_tight.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    return path
+

@@ -21,6 +21,8 @@ from nylonflex.config import parse_config
 from nylonflex.uncertainty import propagate, sobol_indices, standard_samples
 from nylonflex.units import InputError
 
+from helpers import SHIPPED_FIT, tight_fit_file
+
 REPO = Path(__file__).resolve().parents[1]
 
 SMALL = {
@@ -96,8 +98,8 @@ def test_standard_samples_are_seeded_and_standard():
     assert u.std() == pytest.approx(1, abs=0.01)
 
 
-def test_from_fit_samples_carry_the_files_covariance():
-    fit = str(REPO / "configs" / "fits" / "ecoflex_0050_ogden2.yaml")
+def test_from_fit_samples_carry_the_files_covariance(tmp_path):
+    fit = str(tight_fit_file(tmp_path))  # no draw of it reaches the truncation
     cfg = config({"samples": 4096, "parameters": {"silicone": {"from_fit": True}}},
                  silicone={"file": fit})
     from nylonflex.uncertainty import perturbed_inputs
@@ -108,6 +110,33 @@ def test_from_fit_samples_carry_the_files_covariance():
     cov = np.asarray(cfg.uncertainty.parameters[0].covariance)
     np.testing.assert_allclose(np.cov(x.T), cov, rtol=0.1, atol=1e-3 * np.abs(cov).max())
     assert propagate(cfg, EXAMPLE_2)["tip_force_max_quantile"].shape == (3,)
+
+
+def test_a_fit_too_loose_to_sample_is_refused_and_a_fit_sampled_keeps_its_signs(tmp_path):
+    # the shipped ogden2 fit leaves mu_2 = 9.1 +- 17.9 Pa: a third of its draws would turn
+    # the term negative (mu_i alpha_i < 0), and its sampled bend angles reached 1e121 rad
+    with pytest.raises(InputError, match=r"silicone.from_fit: .* fits mu_2 = 9.088 Pa with "
+                       r"a standard deviation of 17.9 Pa: 32 % of normal draws .* give "
+                       r"silicone.mu a rel_sd"):
+        config({"parameters": {"silicone": {"from_fit": True}}},
+               silicone={"file": str(SHIPPED_FIT)})
+    # mu_2's sd at 0.39x its value: accepted, 0.8 % of normal draws truncated at 1/20 of
+    # it, so no sample crosses zero; at 0.43x (1.4 %) refused
+    from nylonflex.config.uncertainty import MIN_FACTOR
+    from nylonflex.uncertainty import perturbed_inputs
+
+    with pytest.raises(InputError, match=r"fits mu_2 .* 1 % of normal draws"):
+        config({"parameters": {"silicone": {"from_fit": True}}},
+               silicone={"file": str(tight_fit_file(tmp_path, scale=0.048))})
+    cfg = config({"samples": 4096, "parameters": {"silicone": {"from_fit": True}}},
+                 silicone={"file": str(tight_fit_file(tmp_path, scale=0.04))})
+    z = standard_samples(cfg.uncertainty)
+    args = perturbed_inputs({k: np.asarray(v) for k, v in EXAMPLE_2.items()}, cfg, z)
+    mu_2 = args["silicone"]["mu"][:, 1]
+    floor = MIN_FACTOR * 9.088126273661937
+    assert np.all(mu_2 >= floor * (1 - 1e-12))
+    assert 0.004 < np.mean(np.isclose(mu_2, floor, rtol=1e-12)) < 0.012
+    assert np.all(np.isfinite(propagate(cfg, EXAMPLE_2)["bend_angle_max_quantile"]))
 
 
 # ---------------------------------------------------------------------------- feasibility

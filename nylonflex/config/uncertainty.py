@@ -9,6 +9,7 @@ from typing import Literal
 
 import numpy as np
 
+from ..materials import FIELD_UNITS
 from ..units import InputError, parse_quantity, to_si
 from ..variables import AXES, VARIABLES
 from .base import Number, _Strict, range_error
@@ -37,6 +38,18 @@ class Uncertainty(_Strict):
 
 
 _MAX_SAMPLES = 65536
+
+#: Lowest factor a sampled material field may scale its nominal value by [-]: a normal
+#: tail reaching a negative modulus (``rel_sd``), or a fitted parameter crossing zero
+#: (``from_fit``), is truncated here, keeping the field's sign.
+MIN_FACTOR = 0.05
+#: The largest share of draws [-] in which ``from_fit`` may truncate a fitted parameter at
+#: :data:`MIN_FACTOR`: a fit whose standard deviation is a large part of a value does not
+#: pin that value down, and propagating it would mostly measure the truncation. The ogden2
+#: fit of the shipped Ecoflex 00-50 test to stretch 4 has mu_2 = 9.1 +- 17.9 Pa: a third of
+#: its draws flip the term's sign (mu_i alpha_i < 0, a silicone softening without bound),
+#: and before this rule the sampled bend angles reached 1e121 rad.
+MAX_TRUNCATED = 0.01
 #: Aliases of material table fields in ``uncertainty.parameters``.
 _FIELD_ALIASES = {"stroke_max": "stroke_max_table", "tensile_strength": "tensile_strength_table",
                   "coil_index": "coil_index_table"}
@@ -128,6 +141,23 @@ def _fit_parameter(name, dist, path, raw_material, material):
     if dist.distribution != "normal" or dist.sd is not None or dist.rel_sd is not None:
         raise InputError(f"{path}: from_fit takes the fit's multivariate normal; give no "
                          "sd, rel_sd or distribution")
+    for p, sd in zip(order, np.sqrt(np.maximum(np.diag(cov), 0.0))):
+        field_name, _, idx = str(p).rpartition("_")
+        listed = field_name in numeric and isinstance(numeric[field_name], list)
+        value = numeric[field_name][int(idx) - 1] if listed else numeric[p]
+        unit = FIELD_UNITS.get(field_name if listed else str(p), "1")
+        unit = "" if unit == "1" else f" {unit}"
+        # the share of normal draws below MIN_FACTOR times the value (truncated there)
+        share = 0.5 * math.erfc((1.0 - MIN_FACTOR) * abs(value) / (sd * math.sqrt(2.0))) \
+            if sd > 0 else 0.0
+        if not share <= MAX_TRUNCATED:
+            raise InputError(
+                f"{path}.from_fit: {raw_material['file']} fits {p} = {value:.4g}{unit} with "
+                f"a standard deviation of {sd:.3g}{unit}: {100 * share:.0f} % of normal "
+                f"draws would cross zero or nearly (at most {100 * MAX_TRUNCATED:g} % "
+                f"accepted): the fit does not pin it down; give "
+                f"{name}.{field_name if listed else p} a rel_sd (a batch's spread) instead, "
+                "or fit with fewer terms or to a test that determines it")
     return UncertainParameter(name, name, "normal", fields=tuple(str(p) for p in order),
                               covariance=tuple(tuple(float(x) for x in row) for row in cov))
 

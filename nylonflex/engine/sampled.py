@@ -23,6 +23,7 @@ from dataclasses import fields, replace
 import numpy as np
 
 from ..config import ResolvedConfig, UncertaintySpec
+from ..config.uncertainty import MIN_FACTOR
 from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS
 from ..materials import SILICONE_PARAMETERS
 from ..physics.chamber import chamber_pressure
@@ -41,9 +42,6 @@ FLOAT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
 #: Evaluations (designs x samples) computed before they reduce to statistics: bounds the
 #: memory of a slab's samples (fig12 x 256 samples: 0.32 GB peak at 2^18, 0.57 GB at 2^20).
 _EVALS_PER_CALL = 2**18
-#: Lowest factor a relative perturbation may scale a material field by (a normal tail
-#: reaching a negative modulus is truncated here).
-_MIN_FACTOR = 0.05
 
 
 def uncertain_variables(cfg: ResolvedConfig) -> dict:
@@ -99,7 +97,14 @@ def _scaled(nominal, p, z):
     z = z.reshape(z.shape + (1,) * nominal.ndim)
     if p.sd is not None:
         return nominal + p.sd * z
-    return nominal * np.maximum(1.0 + p.rel_sd * z, _MIN_FACTOR)
+    return nominal * np.maximum(1.0 + p.rel_sd * z, MIN_FACTOR)
+
+
+def _kept_sign(nominal, delta):
+    """A fitted parameter's samples ``nominal + delta``, truncated at MIN_FACTOR times the
+    nominal value so that none crosses zero (config refuses a fit where this bites in
+    over ``MAX_TRUNCATED`` of the draws)."""
+    return nominal * np.maximum(1.0 + delta / nominal, MIN_FACTOR)
 
 
 def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
@@ -140,18 +145,19 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
         kind, _, fld = p.target.partition(".")
         table = silicone if kind == "silicone" else nylon
         touched.add(kind)
-        if p.fields:  # a fit's multivariate normal: nominal + L z
-            cov = np.asarray(p.covariance, float)
+        if p.fields:  # a fit's multivariate normal: nominal + L z, each kept on its side
+            cov = np.asarray(p.covariance, float)  # of zero (at least MIN_FACTOR of it)
             delta = zj @ _cholesky(cov).T
             for k, name in enumerate(p.fields):
                 field, _, idx = name.rpartition("_")
                 if field in table and idx.isdigit():
                     arr = np.atleast_1d(np.asarray(table[field], float))
                     col = np.broadcast_to(arr, (S, arr.shape[-1])).copy()
-                    col[:, int(idx) - 1] += delta[:, k]
+                    i = int(idx) - 1  # col[:, i] is still the nominal value
+                    col[:, i] = _kept_sign(col[:, i], delta[:, k])
                     table[field] = col
                 else:
-                    table[name] = np.asarray(table[name], float) + delta[:, k]
+                    table[name] = _kept_sign(np.asarray(table[name], float), delta[:, k])
             continue
         table[fld] = _scaled(table[fld], p, zj[:, 0])
     if "silicone" in touched:
