@@ -103,7 +103,11 @@ def _scaled(nominal, p, z):
 def _kept_sign(nominal, delta):
     """A fitted parameter's samples ``nominal + delta``, truncated at MIN_FACTOR times the
     nominal value so that none crosses zero (config refuses a fit where this bites in
-    over ``MAX_TRUNCATED`` of the draws)."""
+    over ``MAX_TRUNCATED`` of the draws; a zero value, which config passes only with no
+    spread, stays as drawn)."""
+    nominal = np.asarray(nominal, float)
+    if not np.all(nominal != 0.0):
+        return nominal + delta
     return nominal * np.maximum(1.0 + delta / nominal, MIN_FACTOR)
 
 
