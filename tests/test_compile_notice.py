@@ -78,6 +78,7 @@ def test_each_kernel_family_is_known():
     from nylonflex.kernels import control, design
 
     assert compiling.family(design.design_slab) == "grid"
+    assert compiling.family(design.design_slab_paper) == "grid"
     assert compiling.family(design.design_points) == "pointwise"
     assert compiling.family(control.closed_loop) == "control"
     assert compiling.family(codec._shuffle_bytes_jit) == "codec"
@@ -94,7 +95,8 @@ def test_warm_up_kernels_runs_each_kernel_once_and_reports_progress():
                           progress=lambda done, total, name: seen.append((done, total, name)))
     assert seen == [(1, 2, "pointwise"), (2, 2, "codec")]
     assert set(out) == {"pointwise", "codec"} and all(v >= 0.0 for v in out.values())
-    assert [k[0] for k in KERNELS] == ["grid", "pointwise", "codec", "tracking"]
+    assert [k[0] for k in KERNELS] == ["grid", "grid_variants", "pointwise", "codec",
+                                       "tracking"]
 
 
 def test_a_tracking_sweep_after_the_warm_up_compiles_nothing():
@@ -122,11 +124,27 @@ def test_a_tracking_sweep_after_the_warm_up_compiles_nothing():
     assert seen == []
 
 
+def test_after_the_grid_warm_ups_no_sweep_compiles_its_grid_kernel():
+    # a sweep of the paper's model alone without a supply runs design_slab_paper, any other
+    # sweep design_slab: 'grid' and 'grid_variants' warm the two, and no sweep of either
+    # kind compiles after them (Numba's own signal)
+    from nylonflex.config import parse_config
+    from nylonflex.engine.warmup import _TINY, warm_up_grid, warm_up_kernels
+
+    warm_up_kernels(["grid", "grid_variants"], notice=lambda line: None)
+    seen = []
+    for extra in ({}, {"model": ["paper", "lateral_pressure"]},
+                  {"supply": {"voltage": 9, "units": "V"}},
+                  {"base_thickness": {"value": 3, "units": "mm"}}):
+        warm_up_grid(parse_config({**_TINY, **extra}), notice=seen.append)
+    assert seen == []
+
+
 def test_the_warmup_command_names_every_kernel(capsys):
     from nylonflex.cli import main
 
     assert main(["warmup"]) == 0
     out = capsys.readouterr().out
-    for name in ("grid", "pointwise", "codec", "tracking", "control"):
+    for name in ("grid", "grid_variants", "pointwise", "codec", "tracking", "control"):
         assert f" {name} " in out
     assert out.splitlines()[-1].startswith("warm: every kernel")

@@ -351,3 +351,34 @@ def test_a_callee_body_kernel_takes_plain_positional_parameters():
 
     with pytest.raises(TypeError, match="plain positional parameters"):
         _compile.jit_kernel(keyword_only, callee_body=True)
+
+
+@pytest.mark.parametrize("base", ["wall", "fixed"])
+def test_the_paper_kernel_gives_the_general_kernels_bits(base):
+    # design_slab_paper is design_slab's source with the variants' and the supply's
+    # branches pruned at compile time (a shorter first compile): on the paper's model
+    # without a supply both write the same bits into every output
+    from nylonflex.engine.model_slab import grid_axes, grid_out, kernel_inputs
+    from nylonflex.kernels import design
+
+    raw = dict(IRREGULAR)
+    if base == "fixed":
+        raw["base_thickness"] = {"value": 1.7, "units": "mm"}
+    cfg = parse_config(raw)
+    n = len(cfg.axes["radius"])
+    grid, inputs = grid_axes(cfg, 0, n), kernel_inputs(cfg, 0)
+    assert design.grid_kernel(inputs[-1].model, inputs[-1].voltage) is \
+        design.design_slab_paper
+    outs = []
+    for kernel in (design.design_slab, design.design_slab_paper):
+        out = grid_out(cfg, n)
+        for array in out:
+            array.fill(-7)  # every output is written
+        kernel(grid, *inputs, out, 0, n * len(cfg.axes["wall_thickness"]))
+        outs.append(out)
+    for a, b, name in zip(*outs, type(outs[0])._fields):
+        assert not np.any(b == -7), name
+        np.testing.assert_array_equal(a.view(np.uint8), b.view(np.uint8), err_msg=name)
+    # a variant or a supply runs the general kernel
+    assert design.grid_kernel(1, -1.0) is design.design_slab
+    assert design.grid_kernel(0, 12.0) is design.design_slab

@@ -45,12 +45,13 @@ def run(args) -> int:
     steps = [(name, what, warm) for name, what, warm in KERNELS]
     steps.append(("control", "simulate's closed loop", _control))
     t_all = time.perf_counter()
+    width = max(len(name) for name, _, _ in steps)
     for k, (name, what, warm) in enumerate(steps, 1):
         t0, c0 = time.perf_counter(), time.process_time()
         compiled = warm(notice)
         seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
         state = (f"compiled in {compiled:.1f} s" if compiled else "cached in "
                  f"{seconds:.1f} s") + f" ({cpu:.1f} CPU-s)"
-        say(f"[{k}/{len(steps)}] {name:<12} {state:<32} {what}")
+        say(f"[{k}/{len(steps)}] {name:<{width}} {state:<32} {what}")
     say(f"warm: every kernel compiled or loaded in {time.perf_counter() - t_all:.1f} s")
     return 0

@@ -23,7 +23,7 @@ from ..variables import CURVES, DESIGN
 from .threads import run_chunks
 
 __all__ = ["coil_table", "grid_axes", "grid_out", "kernel_inputs", "model_slab", "muscle_record",
-           "named_rows", "run_grid"]
+           "named_rows", "paper_kernel", "run_grid"]
 
 
 def coil_table(cfg: ResolvedConfig):
@@ -78,13 +78,27 @@ def kernel_inputs(cfg: ResolvedConfig, model: int) -> tuple:
             muscle_record(cfg), options)
 
 
-def run_grid(grid: GridAxes, inputs: tuple, out: GridOut, parallel: bool) -> None:
+def paper_kernel(cfg: ResolvedConfig) -> bool:
+    """Whether ``cfg``'s sweep runs the grid kernel of the paper's model without a supply
+    (:data:`~nylonflex.kernels.design.design_slab_paper`, a shorter first compile): one
+    model, ``paper``, and no supply. A sweep of several models runs the general kernel for
+    each, so that its first run compiles one grid kernel, not two."""
+    return tuple(cfg.models) == ("paper",) and cfg.supply_voltage is None
+
+
+def run_grid(grid: GridAxes, inputs: tuple, out: GridOut, parallel: bool, *,
+             paper: bool = False) -> None:
     """The grid kernel on ``grid`` with ``inputs`` (:func:`kernel_inputs`) into ``out``,
-    split over the engine's threads by (radius, wall) pair when ``parallel``."""
+    split over the engine's threads by (radius, wall) pair when ``parallel``; ``paper``
+    (:func:`paper_kernel`) runs the paper's kernel where the slab's model and supply allow
+    it (the same bits)."""
     from ..kernels import design
 
     args = (grid, *inputs, out)
-    run_chunks(lambda k0, k1: design.design_slab(*args, k0, k1),
+    options = inputs[-1]
+    kernel = design.grid_kernel(options.model, options.voltage) if paper else \
+        design.design_slab
+    run_chunks(lambda k0, k1: kernel(*args, k0, k1),
                len(grid.radius) * len(grid.wall), parallel=parallel)
 
 
@@ -108,7 +122,8 @@ def model_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool, model: int
     registry's names of the kernel's rows and curves (views of the output).
     """
     out = grid_out(cfg, i1 - i0, pool)
-    run_grid(grid_axes(cfg, i0, i1), kernel_inputs(cfg, model), out, parallel)
+    run_grid(grid_axes(cfg, i0, i1), kernel_inputs(cfg, model), out, parallel,
+             paper=paper_kernel(cfg))
     return named_rows(out)
 
 

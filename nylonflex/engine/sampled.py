@@ -30,7 +30,7 @@ from ..physics.chamber import chamber_pressure
 from ..physics.nylon import stroke_max
 from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
-from .model_slab import grid_axes, grid_out, kernel_inputs, run_grid
+from .model_slab import grid_axes, grid_out, kernel_inputs, paper_kernel, run_grid
 from .threads import run_chunks
 
 __all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_configs",
@@ -387,7 +387,8 @@ def _sampled_grids(samples: list, inputs: list, r0: int, r1: int, parallel: bool
         scratch = first if s0 == 0 else grid_out(samples[s0], r1 - r0)
         for s in range(s0, s1):
             run_grid(grid_axes(samples[s], r0, r1), inputs[s],
-                     scratch._replace(design=design[s], flags=flags[s]), parallel=False)
+                     scratch._replace(design=design[s], flags=flags[s]), parallel=False,
+                     paper=paper_kernel(samples[s]))
 
     run_chunks(run, S, parallel=parallel)
     last = lambda a: np.moveaxis(a, 0, -1)  # noqa: E731

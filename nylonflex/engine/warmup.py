@@ -130,6 +130,13 @@ _TINY = {
 }
 
 
+def _tiny_variant_config():
+    """:func:`_tiny_config` with a 12 V supply: the general grid kernel, which every model
+    variant and every supply runs (the paper's model without a supply has its own)."""
+    return parse_config({**_TINY, "name": "warmup_variants",
+                         "supply": {"voltage": 12, "units": "V"}})
+
+
 def _tiny_tracking_config():
     """:func:`_tiny_config` with a 12 V supply and a short closed loop to track (a
     bang-bang controller and the bandwidth search: every tracking kernel)."""
@@ -147,8 +154,10 @@ def _tiny_tracking_config():
 #: taking ``notice``). The closed-loop kernels (``simulate``) sit above the engine and are
 #: warmed by ``nylonflex warmup`` itself.
 KERNELS = (
-    ("grid", "sweeps and sampled sweeps (local threads and Dask workers' slabs)",
+    ("grid", "sweeps and sampled sweeps of the paper's model alone, without a supply",
      lambda notice: warm_up_grid(_tiny_config(), parallel=True, notice=notice)),
+    ("grid_variants", "sweeps of the model variants, several models or a supply",
+     lambda notice: warm_up_grid(_tiny_variant_config(), parallel=True, notice=notice)),
     ("pointwise", "nylonflex.evaluate, design, query --at, propagate, sensitivity",
      lambda notice: warm_up_points(notice=notice)),
     ("codec", "the cube writer's byte shuffle", lambda notice: warm_up_codec(notice=notice)),

@@ -23,6 +23,7 @@ nothing is computed twice that a design axis does not change:
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
@@ -85,7 +86,10 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
     force_coeff = muscle.force_coeff[0]
     shape = StrokeShape(t_amb, t_max, gamma, beta, t_g, sigma_g)
     ogden = Ogden(mu, alpha)
-    default = model == PAPER and voltage <= 0.0
+    # _PAPER_ONLY is a compile-time constant: design_slab_paper runs only the paper's
+    # model without a supply, and Numba prunes every branch below that tests it, with the
+    # variants' formulas it would call, before typing (a shorter first compile)
+    default = _PAPER_ONLY or (model == PAPER and voltage <= 0.0)
     cauchy = model == CAUCHY_MOMENT
     top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
     b_fixed = grid.base_thickness
@@ -101,7 +105,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
     stroke_hoop = np.empty(ns)
     for js in range(ns):
         stroke_pressure[js] = _gauge_pressure(stroke[js], p_atm)
-        if model == PAPER_EQ10:
+        if not _PAPER_ONLY and model == PAPER_EQ10:
             stroke_hoop[js] = _equibiaxial_stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
         else:
             stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
@@ -125,9 +129,12 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
         kappa_curve = np.empty(npr)
         rate_curve = np.empty(npr)
         rate2_curve = np.empty(npr)
-        lever_p = _model_moment(model, 1.0, a, t, b)  # dM/dp: linear in p in every model
+        # dM/dp: linear in p in every model (the paper's: M_P itself, bit for bit)
+        lever_p = _pressure_moment(1.0, a, b) if _PAPER_ONLY else \
+            _model_moment(model, 1.0, a, t, b)
         for jp in range(npr):
-            moment = _model_moment(model, pressure[jp], a, t, b)
+            moment = _pressure_moment(pressure[jp], a, b) if _PAPER_ONLY else \
+                _model_moment(model, pressure[jp], a, t, b)
             kappa, dm, d2m = _curvature_solve(
                 moment, y_nodes, wy_nodes, wyy_nodes, work, mu, alpha,
                 _curvature_start(pressure[jp], pressure, kappa_curve, rate_curve, rate2_curve,
@@ -135,13 +142,15 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
             kappa_curve[jp] = kappa
             rate_curve[jp], rate2_curve[jp] = _curvature_rates(lever_p, dm, d2m)
             for il in range(nl):
-                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * _curve_factor(
+                factor = 1.0 if _PAPER_ONLY else _curve_factor(
                     model, pressure[jp], a, t, length[il], mu, alpha)
+                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * factor
                 out_tip[ia, it, il, jp] = moment / length[il]
         curve = SolvedCurve(pressure, kappa_curve, rate_curve, rate2_curve)
         # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
         n_curve = npr if not cauchy else 0
-        solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
+        solid = _solid_fraction(a, t, b) if not _PAPER_ONLY and \
+            model == INCOMPRESSIBLE_WALL else 0.0
         for ic in range(nc):
             s_max = coil_s_max[ic]
             f_lim = coil_force_limit[ic]
@@ -184,7 +193,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
                 # while the working temperatures stay
                 cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                 for il in range(nl):
-                    if not default and (il == 0 or voltage > 0.0):
+                    if not _PAPER_ONLY and not default and (il == 0 or voltage > 0.0):
                         t_reach, s_free, limited = _reach(coil_row, length[il], pitch, section,
                                                           wrap[ip], voltage, shape)
                         ms = _model_state_nodes(
@@ -197,7 +206,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
                         cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free
-                    lf = _length_factor(model, a, length[il])
+                    lf = 1.0 if _PAPER_ONLY else _length_factor(model, a, length[il])
                     (usable_stroke, limit, pressure_max, torque_max, tip_force_max,
                      bend_angle_max, range_fraction, nylon_force_max,
                      nylon_use) = _design_values(st[0], st[1], st[2], st[3], st[4] * lf,
@@ -221,10 +230,14 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
                     out_design[ROW_HEATING_VOLTAGE, ia, it, il, ic, ip] = heating_voltage
                     out_design[ROW_COOLING_TIME, ia, it, il, ic, ip] = cooling_time
                     out_design[ROW_HEATING_TIME, ia, it, il, ic, ip] = heating_time
-                    (cycle_time, cycle_rate, heating_energy, mechanical_work,
-                     efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid,
-                                                   ogden, p_atm, thermal, voltage, temps, t_amb,
-                                                   tau)
+                    if _PAPER_ONLY:  # no supply: NaN, as _dynamic_values gives
+                        cycle_time = cycle_rate = heating_energy = math.nan
+                        mechanical_work = efficiency = math.nan
+                    else:
+                        (cycle_time, cycle_rate, heating_energy, mechanical_work,
+                         efficiency) = _dynamic_values(model, usable_stroke, section, lever,
+                                                       solid, ogden, p_atm, thermal, voltage,
+                                                       temps, t_amb, tau)
                     out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
                     out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
                     out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
@@ -234,7 +247,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
                         bend_angle_max, st[4] * lf, section, stretch_max, length[il] / pitch,
                         closes, efficiency)
                 for js in range(ns):
-                    if model == INCOMPRESSIBLE_WALL:
+                    if not _PAPER_ONLY and model == INCOMPRESSIBLE_WALL:
                         f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
                                                alpha, p_atm)[0]
                         out_force[ia, it, ic, ip, js] = f if f < math.inf else math.nan
@@ -319,7 +332,35 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
                                                length[i] / pitch, st[7], efficiency)
 
 
+#: Whether the grid kernel's body runs the paper's model without a supply only: a constant
+#: Numba compiles in (False here; True in :data:`design_slab_paper`'s copy of the body).
+_PAPER_ONLY = False
+
+
+def _paper_only(f):
+    """A copy of the kernel body ``f`` named ``<name>_paper``, whose ``_PAPER_ONLY`` is
+    True: Numba prunes the branches of the model variants and the supply before typing,
+    so it compiles none of their formulas. Its own name gives it its own cache files."""
+    scope = {**f.__globals__, "_PAPER_ONLY": True}
+    name = f"{f.__name__}_paper"
+    copy = types.FunctionType(f.__code__.replace(co_name=name, co_qualname=name), scope,
+                              name)
+    copy.__module__, copy.__qualname__, copy.__doc__ = f.__module__, name, f.__doc__
+    return copy
+
+
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
 design_slab = jit_kernel(_design_slab, callee_body=True)
 design_points = jit_kernel(_design_points, callee_body=True)
+#: The grid kernel of the paper's model without a supply (the main job, figure 12): the
+#: same source as :data:`design_slab`, the same numbers bit for bit, about a third less to
+#: compile (:func:`grid_kernel` chooses).
+design_slab_paper = jit_kernel(_paper_only(_design_slab), callee_body=True)
+
+
+def grid_kernel(model: int, voltage: float):
+    """The grid kernel for a model code and supply voltage [V] (<= 0: none):
+    :data:`design_slab_paper` for the paper's model without a supply, else
+    :data:`design_slab`."""
+    return design_slab_paper if model == PAPER and not voltage > 0.0 else design_slab
