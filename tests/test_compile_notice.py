@@ -77,7 +77,7 @@ def test_each_kernel_family_is_known():
     from nylonflex.kernels import bytes as codec
     from nylonflex.kernels import control, design
 
-    assert compiling.family(design.design_slab) == "grid"
+    assert compiling.family(design.design_slab) == "grid_variants"
     assert compiling.family(design.design_slab_paper) == "grid"
     assert compiling.family(design.design_points) == "pointwise"
     assert compiling.family(control.closed_loop) == "control"
