@@ -354,7 +354,7 @@ def _paper_only(f):
 design_slab = jit_kernel(_design_slab, callee_body=True)
 design_points = jit_kernel(_design_points, callee_body=True)
 #: The grid kernel of the paper's model without a supply (the main job, figure 12): the
-#: same source as :data:`design_slab`, the same numbers bit for bit, about a third less to
+#: same source as :data:`design_slab`, the same numbers bit for bit, about 30 % less to
 #: compile (:func:`grid_kernel` chooses).
 design_slab_paper = jit_kernel(_paper_only(_design_slab), callee_body=True)
 
@@ -363,4 +363,4 @@ def grid_kernel(model: int, voltage: float):
     """The grid kernel for a model code and supply voltage [V] (<= 0: none):
     :data:`design_slab_paper` for the paper's model without a supply, else
     :data:`design_slab`."""
-    return design_slab_paper if model == PAPER and not voltage > 0.0 else design_slab
+    return design_slab_paper if model == PAPER and voltage <= 0.0 else design_slab
