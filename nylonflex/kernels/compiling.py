@@ -111,8 +111,11 @@ def notice_text(name) -> str:
     """The notice of family ``name``, with its estimate: this machine's last compile time,
     or :data:`MEASURED`'s."""
     here = _recorded().get(name)
-    estimate = (f"it took {here:.0f} s here last time" if here is not None else
-                f"about {MEASURED[name]:.0f} s on an idle machine, minutes on a busy one")
+    if here is None:
+        estimate = f"about {MEASURED[name]:.0f} s on an idle machine, minutes on a busy one"
+    else:  # a short compile reads "under a second", not "0 s"
+        took = "under a second" if here < 0.95 else f"{here:.0f} s"
+        estimate = f"it took {took} here last time"
     return (f"compiling {FAMILIES[name]} (first run here, or the model changed; cached for "
             f"later runs): {estimate}...")
 
