@@ -110,6 +110,19 @@ def _material_numeric(kind, material) -> dict:
             if k != "name" and isinstance(v, (int, float, list, tuple))}
 
 
+def _fitted_field(p, numeric):
+    """A fit's parameter name as a field of the material's numbers ``numeric``: ``mu_2``
+    -> ("mu", the second term's value), a scalar field ``t_g`` -> ("t_g", its value), or
+    None where it names no field."""
+    field_name, _, idx = str(p).rpartition("_")
+    if field_name in numeric and idx.isdigit() and isinstance(numeric[field_name], list) \
+            and 1 <= int(idx) <= len(numeric[field_name]):
+        return field_name, numeric[field_name][int(idx) - 1]
+    if p in numeric and not isinstance(numeric[p], list):
+        return str(p), numeric[p]
+    return None
+
+
 def _fit_parameter(name, dist, path, raw_material, material):
     from .material_files import read_material_file
 
@@ -126,12 +139,9 @@ def _fit_parameter(name, dist, path, raw_material, material):
         raise InputError(f"{path}.from_fit: {raw_material['file']} has no 'covariance' of "
                          "its 'parameter_order'")
     numeric = _material_numeric(name, material)
-    for p in order:
-        field_name, _, idx = str(p).rpartition("_")
-        ok = (field_name in numeric and idx.isdigit() and isinstance(numeric[field_name], list)
-              and 1 <= int(idx) <= len(numeric[field_name])) or \
-            (p in numeric and not isinstance(numeric[p], list))
-        if not ok:
+    fields = [_fitted_field(p, numeric) for p in order]
+    for p, found in zip(order, fields):
+        if found is None:
             raise InputError(f"{path}.from_fit: the fitted parameter {p!r} of "
                              f"{raw_material['file']} is not a field of the {name} set")
     if not np.allclose(cov, cov.T) or np.any(np.linalg.eigvalsh(cov) < -1e-12 *
@@ -141,11 +151,9 @@ def _fit_parameter(name, dist, path, raw_material, material):
     if dist.distribution != "normal" or dist.sd is not None or dist.rel_sd is not None:
         raise InputError(f"{path}: from_fit takes the fit's multivariate normal; give no "
                          "sd, rel_sd or distribution")
-    for p, sd in zip(order, np.sqrt(np.maximum(np.diag(cov), 0.0))):
-        field_name, _, idx = str(p).rpartition("_")
-        listed = field_name in numeric and isinstance(numeric[field_name], list)
-        value = numeric[field_name][int(idx) - 1] if listed else numeric[p]
-        unit = FIELD_UNITS.get(field_name if listed else str(p), "1")
+    for p, (field_name, value), sd in zip(order, fields,
+                                          np.sqrt(np.maximum(np.diag(cov), 0.0))):
+        unit = FIELD_UNITS.get(field_name, "1")
         unit = "" if unit == "1" else f" {unit}"
         # the share of normal draws below MIN_FACTOR times the value (truncated there)
         share = 0.5 * math.erfc((1.0 - MIN_FACTOR) * abs(value) / (sd * math.sqrt(2.0))) \
@@ -156,7 +164,7 @@ def _fit_parameter(name, dist, path, raw_material, material):
                 f"a standard deviation of {sd:.3g}{unit}: {100 * share:.0f} % of normal "
                 f"draws would cross zero or nearly (at most {100 * MAX_TRUNCATED:g} % "
                 f"accepted): the fit does not pin it down; give "
-                f"{name}.{field_name if listed else p} a rel_sd (a batch's spread) instead, "
+                f"{name}.{field_name} a rel_sd (a batch's spread) instead, "
                 "or fit with fewer terms or to a test that determines it")
     return UncertainParameter(name, name, "normal", fields=tuple(str(p) for p in order),
                               covariance=tuple(tuple(float(x) for x in row) for row in cov))
