@@ -378,7 +378,7 @@ def cube_summary(path) -> list[str]:
             v = VARIABLES[name]
             vals = to_display(name, np.asarray(h5[name][...]))
             unit = "" if v.display == "1" else f" {v.display}"
-            over = h5[name].dims[0][0].name.lstrip("/") if h5[name].dims[0] else name
+            over = f.variables[name].dimensions[0]
             where = f"; in the file over the dimension {over}" if over != name else ""
             out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} "
                        f"({len(vals)}{where})")
