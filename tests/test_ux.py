@@ -53,6 +53,21 @@ def test_estimate_sizes_match_the_written_cube(tmp_path):
     assert e["disk_bytes"] < path.stat().st_size + e["raw_bytes"]
 
 
+def test_a_dry_run_of_a_sampled_sweep_estimates_its_quantile_variables(tmp_path, capsys):
+    # the estimate sizes each variable's chunks from the cube's coordinates: a sampled
+    # sweep's <variable>_quantile lie over quantile (a KeyError before, exit 1)
+    from nylonflex.storage.sweep import estimate
+
+    raw = {**TINY, "uncertainty": {"samples": 8, "seed": 1,
+                                   "parameters": {"silicone.mu": {"rel_sd": 0.1}}}}
+    config = tmp_path / "sampled.yaml"
+    config.write_text(yaml.safe_dump(raw))
+    rc, text, _ = run(capsys, "sweep", config, "--out", tmp_path / "cube.h5", "--dry-run")
+    assert rc == 0 and "on disk" in text and not (tmp_path / "cube.h5").exists()
+    e = estimate(parse_config(raw))
+    assert e["raw_bytes"] > estimate(parse_config(TINY))["raw_bytes"]  # the quantiles too
+
+
 def test_warm_up_notices_only_when_numba_compiles(monkeypatch):
     # a warm cache: however long the call takes, nothing compiles and nothing is said
     import time

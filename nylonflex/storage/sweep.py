@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from ..config import ResolvedConfig
-from ..engine.grid import bytes_per_radius, check_physics, compute_slab, global_arrays, plan_slabs
+from ..engine.grid import (bytes_per_radius, check_physics, compute_slab, coords,
+                           global_arrays, plan_slabs)
 from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
 from ..engine.warmup import warm_up_grid
@@ -215,7 +216,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
     groups = 1 if k >= n_radius else min(4, k)
     size = -(-k // groups)
     starts = np.unique(np.linspace(0, n_radius - size, groups).round().astype(int))
-    sizes = {name: len(v) for name, v in (*cfg.axes.items(), *cfg.curves.items())}
+    sizes = {name: len(v) for name, v in coords(cfg).items()}  # as the cube file has them
     compute = compress = 0.0
     raw = packed = 0
     for i in starts:
