@@ -181,6 +181,43 @@ def test_shuffle_is_hdf5s_byte_transpose(itemsize, n):
         np.testing.assert_array_equal(out, src.T)
 
 
+@pytest.mark.parametrize("codec", ["gzip", "zstd"])
+@pytest.mark.parametrize("dtype", ["f8", "f4", "i2", "i1"])
+def test_numpy_and_compiled_shuffles_store_the_same_bytes(codec, dtype):
+    # a small cube's chunks are shuffled by NumPy (nothing to compile), a large one's by the
+    # compiled loops: the stored chunk must be the same either way, padded chunks included
+    from nylonflex.storage.cube import CODECS, _encode_chunk
+
+    if CODECS[codec].plugin:
+        pytest.importorskip("zstandard")
+    rng = np.random.default_rng(3)
+    block = (rng.random((3, 5, 7)) * 100).astype(dtype)
+    for chunks in ((3, 5, 7), (4, 5, 8)):
+        assert _encode_chunk(block, chunks, CODECS[codec], True) == \
+            _encode_chunk(block, chunks, CODECS[codec], False)
+
+
+def test_a_small_cube_compiles_no_shuffle(tmp_path):
+    # the README's main job is far below COMPILED_SHUFFLE_BYTES: its writer must not ask
+    # for the compiled shuffle (a first compile of 0.4-0.6 s), a large cube's must
+    from nylonflex.storage.cube import COMPILED_SHUFFLE_BYTES, CubeFile
+
+    coords = {"radius": np.linspace(5e-3, 10e-3, 4), "wall_thickness": [2e-3],
+              "length": [0.09], "coil_index": [1.3], "wrap_angle": [0.1],
+              "stroke": [0.0, 0.1], "pressure": [0.0, 2e4]}
+    cube = CubeFile(tmp_path / "c.h5", coords, {}, radius_chunk=2)
+    try:
+        assert not cube._compiled_shuffle
+    finally:
+        cube.close()
+    big = dict(coords, radius=np.linspace(5e-3, 10e-3, COMPILED_SHUFFLE_BYTES // 8 // 20))
+    cube = CubeFile(tmp_path / "big.h5", big, {}, radius_chunk=1024)
+    try:
+        assert cube._compiled_shuffle
+    finally:
+        cube.close()
+
+
 # ------------------------------------------------------ readers without a plugin (issue 24)
 def _reference_raw():
     from pathlib import Path

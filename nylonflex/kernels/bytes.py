@@ -1,10 +1,12 @@
 """Byte-level loops of the storage layer: HDF5's shuffle filter, compiled.
 
-NumPy's strided transpose does the shuffle at about 0.25 GB/s, slower than zstd itself
-compresses. These loops release the GIL, so the compression threads shuffle in parallel:
-the byte-by-byte loop runs at 2.5-3.3 GB/s; for 8-byte elements (every float variable of
-the cube) the word loop transposes 8 x 8-byte blocks in registers at about 14 GB/s on a
-chunk in cache.
+NumPy's strided copy of the transpose (``np.copyto(out, src.T)``) does the shuffle at
+about 2 GB/s, about deflate's own speed. These loops release the GIL, so the compression
+threads shuffle in parallel: the byte-by-byte loop runs at 2.5-3.3 GB/s; for 8-byte
+elements (every float variable of the cube) the word loop transposes 8 x 8-byte blocks in
+registers at 9-14 GB/s on a chunk in cache. They are compiled the first time a large cube
+is written (:data:`nylonflex.storage.cube.COMPILED_SHUFFLE_BYTES`); a small one is
+shuffled by NumPy, with the same bytes.
 """
 
 from __future__ import annotations

@@ -69,6 +69,13 @@ ZSTD_LEVEL = -1
 #: 8x slower (78.3 MB), libdeflate level 1 3.3x slower and holds the GIL (78.9 MB).
 ISAL_LEVEL = 0
 
+#: Uncompressed bytes [B] of the float variables from which a cube's chunks are shuffled by
+#: the compiled loop (:mod:`nylonflex.kernels.bytes`, about 10 GB/s) instead of NumPy's
+#: strided copy (about 2 GB/s): below it, NumPy's extra time (under 30 ms) is less than the
+#: compiled loop's first compile (0.4-0.6 s with an empty cache), which the README's main
+#: job (3.6 MB) would otherwise pay. Both give the same bytes.
+COMPILED_SHUFFLE_BYTES = 64 * 2**20
+
 #: Each compression thread's own zstd compressor and shuffle buffer.
 _per_thread = threading.local()
 
@@ -236,6 +243,9 @@ class CubeFile:
         # 0.1 ms with the GIL held, several a variable a slab)
         self._layout = {name: _Layout(ds, self.f.dims[name], ds.chunks, ds.shape, ds.dtype)
                         for name, ds in self.f.datasets.items()}
+        shuffled = sum(lay.dset.size * lay.dtype.itemsize for lay in self._layout.values()
+                       if lay.dtype.itemsize > 1)
+        self._compiled_shuffle = shuffled >= COMPILED_SHUFFLE_BYTES
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def decoding(self) -> str:
@@ -322,7 +332,8 @@ class CubeFile:
         for corner in itertools.product(*starts):
             block = data[tuple(slice(c, c + n) for c, n in zip(corner, chunks))]
             offset = (i0 + corner[0], *corner[1:])
-            yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec)
+            yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec,
+                                            self._compiled_shuffle)
 
     def abandon(self):
         """Close after a failure (a full disk, an error) without raising.
@@ -346,8 +357,10 @@ class CubeFile:
         self.f.close()
 
 
-def _encode_chunk(block, chunks, codec: Codec):
-    """One chunk as the codec's HDF5 filter pipeline stores it (padded to the chunk shape)."""
+def _encode_chunk(block, chunks, codec: Codec, compiled: bool = False):
+    """One chunk as the codec's HDF5 filter pipeline stores it (padded to the chunk shape),
+    shuffled by the compiled loop (``compiled``, a large cube) or by NumPy (the same bytes,
+    nothing to compile; :data:`COMPILED_SHUFFLE_BYTES`)."""
     if block.shape != tuple(chunks):
         full = np.zeros(chunks, dtype=block.dtype)
         full[tuple(slice(0, n) for n in block.shape)] = block
@@ -355,11 +368,14 @@ def _encode_chunk(block, chunks, codec: Codec):
     raw = np.ascontiguousarray(block).reshape(-1).view(np.uint8)
     size = block.dtype.itemsize
     if codec.shuffle and size > 1:  # byte k of every element together, as H5Z_FILTER_SHUFFLE
-        from ..kernels.bytes import shuffle_bytes
-
         src = raw.reshape(-1, size)
         raw = _shuffle_buffer(raw.size).reshape(size, src.shape[0])
-        shuffle_bytes(src, raw)
+        if compiled:
+            from ..kernels.bytes import shuffle_bytes
+
+            shuffle_bytes(src, raw)
+        else:
+            np.copyto(raw, src.T)
     # a 1-D byte view (no copy); every codec returns new bytes, so the buffer is free after
     return codec.encode(raw.reshape(-1).data)
 
