@@ -23,9 +23,9 @@ nothing is computed twice that a design axis does not change:
 from __future__ import annotations
 
 import math
-import types
 
 import numpy as np
+from ..physics import specialised
 from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
                                _curvature_rates, _curvature_solve, _curvature_start,
                                _node_count, _pressure_moment, _section_nodes)
@@ -337,18 +337,6 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
 _PAPER_ONLY = False
 
 
-def _paper_only(f):
-    """A copy of the kernel body ``f`` named ``<name>_paper``, whose ``_PAPER_ONLY`` is
-    True: Numba prunes the branches of the model variants and the supply before typing,
-    so it compiles none of their formulas. Its own name gives it its own cache files."""
-    scope = {**f.__globals__, "_PAPER_ONLY": True}
-    name = f"{f.__name__}_paper"
-    copy = types.FunctionType(f.__code__.replace(co_name=name, co_qualname=name), scope,
-                              name)
-    copy.__module__, copy.__qualname__, copy.__doc__ = f.__module__, name, f.__doc__
-    return copy
-
-
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
 design_slab = jit_kernel(_design_slab, callee_body=True)
@@ -356,7 +344,8 @@ design_points = jit_kernel(_design_points, callee_body=True)
 #: The grid kernel of the paper's model without a supply (the main job, figure 12): the
 #: same source as :data:`design_slab`, the same numbers bit for bit, about 30 % less to
 #: compile (:func:`grid_kernel` chooses).
-design_slab_paper = jit_kernel(_paper_only(_design_slab), callee_body=True)
+design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper", _PAPER_ONLY=True),
+                               callee_body=True)
 
 
 def grid_kernel(model: int, voltage: float):

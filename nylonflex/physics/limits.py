@@ -14,7 +14,7 @@ import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
 from ._formula import (check, check_input, check_section, check_wrap_angle, formula,
-                       scalar_or_array)
+                       scalar_or_array, specialised)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
                       _taylor_start, quadrature_nodes)
@@ -92,20 +92,14 @@ def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, 
 
 
 @formula
-def _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu, alpha, p_atm, rtol):
-    """Usable stroke s*, the limit flag (0 stroke, 1 strength) and F_n(s*) [N].
+def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever, solid, mu,
+                        alpha, p_atm, rtol):
+    """Usable stroke s*, the limit flag (0 stroke, 1 strength) and F_n(s*) [N] of a model
+    variant's F_n (``solid`` = A_s/A_out, wall variant only), below the stroke ``s_max``.
 
     s_lim solves F_n(s) = F_lim on (0, s_max) by Newton from s_max, safeguarded by
     bisection; F_n is increasing with F_n(0) = 0.
     """
-    return _stroke_limit_model(PAPER, force_limit, s_max, radius, wall_thickness, lever, 0.0,
-                               mu, alpha, p_atm, rtol)
-
-
-@formula
-def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever, solid, mu,
-                        alpha, p_atm, rtol):
-    """:func:`_stroke_limit` for a model variant's F_n, below the stroke ``s_max``."""
     f, df = _nylon_force_model(model, s_max, radius, wall_thickness, lever, solid, mu, alpha,
                                p_atm)
     if f <= force_limit:
@@ -131,6 +125,20 @@ def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever
     f, df = _nylon_force_model(model, s, radius, wall_thickness, lever, solid, mu, alpha,
                                p_atm)
     return s, 1, f
+
+
+@formula
+def _paper_force(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
+    """:func:`_nylon_force_model` of the paper's model: F_n(s) and dF_n/ds [N] (``model``
+    and ``solid`` unused)."""
+    return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
+
+
+#: :func:`_stroke_limit_model` of the paper's F_n alone (its calls of ``_nylon_force_model``
+#: call :func:`_paper_force`): the kernels' stroke limit of the paper's model compiles none
+#: of the variants' forces.
+_stroke_limit = specialised(_stroke_limit_model, "_stroke_limit",
+                            _nylon_force_model=_paper_force)
 
 
 @formula
@@ -517,8 +525,8 @@ def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, c
             _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, False)
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
-    s, limit, force = _stroke_limit(force_limit, s_max, radius, wall_thickness, lever, mu,
-                                    alpha, p_atm, STROKE_RTOL)
+    s, limit, force = _stroke_limit(PAPER, force_limit, s_max, radius, wall_thickness, lever,
+                                    0.0, mu, alpha, p_atm, STROKE_RTOL)
     p = _gauge_pressure(s, p_atm)
     moment = _pressure_moment(p, radius, base_thickness)
     if limit == 0:
