@@ -374,7 +374,8 @@ def test_the_paper_kernel_gives_the_general_kernels_bits(base):
         out = grid_out(cfg, n)
         for array in out:
             array.fill(-7)  # every output is written
-        kernel(grid, *inputs, out, 0, n * len(cfg.axes["wall_thickness"]))
+        kernel(grid, *inputs, out, design.grid_scratch(grid, inputs[2]), 0,
+               n * len(cfg.axes["wall_thickness"]))
         outs.append(out)
     for a, b, name in zip(*outs, type(outs[0])._fields):
         assert not np.any(b == -7), name

@@ -98,7 +98,8 @@ def run_grid(grid: GridAxes, inputs: tuple, out: GridOut, parallel: bool, *,
     options = inputs[-1]
     kernel = design.grid_kernel(options.model, options.voltage) if paper else \
         design.design_slab
-    run_chunks(lambda k0, k1: kernel(*args, k0, k1),
+    nodes = inputs[2]
+    run_chunks(lambda k0, k1: kernel(*args, design.grid_scratch(grid, nodes), k0, k1),
                len(grid.radius) * len(grid.wall), parallel=parallel)
 
 

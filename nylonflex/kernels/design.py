@@ -42,6 +42,7 @@ from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
 from ._compile import jit_kernel
+from .records import GridScratch
 from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYCLE_TIME,
                    ROW_EFFICIENCY, ROW_HEATING_ENERGY, ROW_HEATING_POWER, ROW_HEATING_TIME,
                    ROW_HEATING_VOLTAGE, ROW_LIMIT, ROW_MECHANICAL_WORK, ROW_MUSCLE_LENGTH,
@@ -50,7 +51,7 @@ from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYC
                    ROW_VALIDITY)
 
 
-def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
+def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0, k1):
     """Fill ``out`` (a :class:`~.records.GridOut`) for the radii ``grid.radius``: the
     (radius, wall) pairs k0 <= k < k1, k = radius index x walls + wall index (a thread's
     chunk, :func:`nylonflex.engine.threads.run_chunks`).
@@ -59,7 +60,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
     :class:`~.records.CoilTable` with one entry a coil index of the axis, ``silicone`` an
     :class:`~.records.Ogden` of 1-D arrays, ``nodes`` the quadrature's
     :class:`~.records.Nodes`, ``muscle`` a :class:`~.records.Muscle` of one entry and
-    ``options`` the :class:`~.records.Options` (model code, supply, fitted stretch).
+    ``options`` the :class:`~.records.Options` (model code, supply, fitted stretch);
+    ``scratch`` its working arrays (a :class:`~.records.GridScratch`, :func:`grid_scratch`).
     ``out.design[ROW_<NAME>]`` holds each float variable, ``out.flags`` ``limit`` and
     ``validity`` (the rows of :mod:`.rows`); shapes (na, nt, nl, nc, npsi), curves as the
     registry says.
@@ -101,34 +103,28 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, k0, k1):
     ns = stroke.shape[0]
     npr = pressure.shape[0]
     # p(s) and S_theta(s) depend on the stroke only: once per stroke, not per design
-    stroke_pressure = np.empty(ns)
-    stroke_hoop = np.empty(ns)
+    stroke_pressure = scratch.stroke_pressure
+    stroke_hoop = scratch.stroke_hoop
     for js in range(ns):
         stroke_pressure[js] = _gauge_pressure(stroke[js], p_atm)
         if not _PAPER_ONLY and model == PAPER_EQ10:
             stroke_hoop[js] = _equibiaxial_stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
         else:
             stroke_hoop[js] = _stress_and_slope(1.0 - stroke[js], mu, alpha)[0]
-    n_nodes = _node_count(x_base, w_phi)
+    y_nodes, wy_nodes, wyy_nodes, work = scratch.y, scratch.wy, scratch.wyy, scratch.work
+    kappa_curve, rate_curve, rate2_curve = scratch.kappa, scratch.rate, scratch.rate2
     for k in range(k0, k1):
         ia = k // nt
         it = k % nt
         a = radius[ia]
         t = wall[it]
         b = t if b_fixed <= 0.0 else b_fixed
-        y_nodes = np.empty(n_nodes)
-        wy_nodes = np.empty(n_nodes)
-        wyy_nodes = np.empty(n_nodes)
-        work = np.empty((MOMENT_WORK_ROWS, n_nodes))
         _section_nodes(a, t, b, x_base, w_base, phi_trig, w_phi, y_nodes, wy_nodes, wyy_nodes)
         section = Section(a, t, b)
         table = NodeTable(y_nodes, wy_nodes, wyy_nodes, work)
         perimeter = _outer_perimeter(a, t, b)
         # the bend-angle curve first, with dkappa/dp and d2kappa/dp2: each solve starts from
         # the previous ones, and they start the coil loop's solves
-        kappa_curve = np.empty(npr)
-        rate_curve = np.empty(npr)
-        rate2_curve = np.empty(npr)
         # dM/dp: linear in p in every model (the paper's: M_P itself, bit for bit)
         lever_p = _pressure_moment(1.0, a, b) if _PAPER_ONLY else \
             _model_moment(model, 1.0, a, t, b)
@@ -346,6 +342,17 @@ design_points = jit_kernel(_design_points, callee_body=True)
 #: compile (:func:`grid_kernel` chooses).
 design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper", _PAPER_ONLY=True),
                                callee_body=True)
+
+
+def grid_scratch(grid, nodes):
+    """The grid kernel's working arrays for a call on ``grid`` (a :class:`~.records.GridAxes`)
+    with the quadrature ``nodes`` (a :class:`~.records.Nodes`): a
+    :class:`~.records.GridScratch`, one a thread (each call fills what it reads)."""
+    n = _node_count(nodes.x_base, nodes.w_phi)
+    npr, ns = len(grid.pressure), len(grid.stroke)
+    return GridScratch(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)),
+                       np.empty(npr), np.empty(npr), np.empty(npr), np.empty(ns),
+                       np.empty(ns))
 
 
 def grid_kernel(model: int, voltage: float):

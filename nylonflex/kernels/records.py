@@ -37,6 +37,16 @@ CoilTable = namedtuple("CoilTable", "s_max force_limit width r_per_len loss_per_
 #: ``bend_angle``, ``tip_force`` (the registry's dims).
 GridOut = namedtuple("GridOut", "design flags nylon_force bend_angle tip_force")
 
+#: The grid kernel's working arrays, one set a call (a thread's chunk), reused for every
+#: (radius, wall) pair of it (:func:`~.design.grid_scratch`): the section's node table
+#: ``y`` [m], ``wy`` [m^3], ``wyy`` [m^4] and ``work`` (MOMENT_WORK_ROWS, nodes); the
+#: bend-angle curve's ``kappa`` [1/m], ``rate`` [1/(m Pa)] and ``rate2`` [1/(m Pa^2)] a
+#: pressure; p(s) ``stroke_pressure`` [Pa] and S_theta(s) ``stroke_hoop`` [Pa] a stroke.
+#: Made by the caller, so that the compiled kernel allocates nothing (NumPy's allocation
+#: was 0.15 s of its first compile).
+GridScratch = namedtuple("GridScratch", "y wy wyy work kappa rate rate2 stroke_pressure "
+                                        "stroke_hoop")
+
 #: The muscle's thermal and eq. (1)-(2) constants, float64 arrays of one entry (the grid
 #: kernel) or one a design (the pointwise kernel): ``t_amb``, ``t_max``, ``t_g`` [K],
 #: ``gamma`` [1/K], ``beta`` [-], ``sigma_g`` [K], ``r_per_len`` r' [ohm/m], ``c_per_len``
