@@ -33,6 +33,7 @@ from nylonflex.storage import open_cube
 from nylonflex.storage.sweep import run_sweep, sweep_file
 
 from .first_use import cold_compiles, command_costs
+from .flops import kernel_flops_per_design
 from .yardstick import grid_numpy
 
 #: The checkout's tests/naive.py, the slow reference of the tests.
@@ -156,17 +157,19 @@ def _single_vs_batch_cpu(n: int = 20_000, calls: int = 2000) -> tuple[float, flo
     return (time.process_time() - t0) / calls, batch
 
 
-def _matmul_gflops(n: int = 1024) -> float:
-    """The machine's practical floating-point peak [GFlop/s]: NumPy's matmul of two
-    n x n float64 matrices (2 n^3 flops), best of 3, on the BLAS threads it has."""
+def _matmul_gflops(n: int = 1024) -> tuple[float, float]:
+    """The machine's practical floating-point peak: NumPy's matmul of two n x n float64
+    matrices (2 n^3 flops), best of 3, on the BLAS threads it has: [GFlop/s] of wall time
+    and [GFlop per CPU-s] (a core's peak, whatever the number of BLAS threads)."""
     a = np.random.default_rng(0).random((n, n))
     a @ a
-    best = math.inf
+    best, best_cpu = math.inf, math.inf
     for _ in range(3):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         a @ a
         best = min(best, time.perf_counter() - t0)
-    return 2.0 * n**3 / best / 1e9
+        best_cpu = min(best_cpu, time.process_time() - c0)
+    return 2.0 * n**3 / best / 1e9, 2.0 * n**3 / best_cpu / 1e9
 
 
 def _closed_loop_seconds(duration: float) -> tuple[float, float]:
@@ -224,10 +227,13 @@ def run_bench(quick: bool = False, log=None) -> dict:
     say(f"  compile or load cache      {t_compile:8.2f} s")
 
     slabs, _ = plan_slabs(cfg)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for i0, i1 in slabs:
         compute_slab(cfg, i0, i1)
     t_kernel = time.perf_counter() - t0
+    cpu_kernel = time.process_time() - c0
+    flops = kernel_flops_per_design(cfg, pairs=2 if quick else 4)
+    kernel_gflops = flops * cfg.n_designs / cpu_kernel / 1e9
 
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
@@ -252,7 +258,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
     t_point, t_loop_py, n_point = _pointwise_seconds(sizes["pointwise_designs"])
     cpu_single, cpu_batch = _single_vs_batch_cpu(2000 if quick else 20_000,
                                                  200 if quick else 2000)
-    gflops = _matmul_gflops(256 if quick else 1024)
+    gflops, gflops_cpu = _matmul_gflops(256 if quick else 1024)
 
     sim_duration = 60.0 if quick else 3600.0
     t_loop, t_sim = _closed_loop_seconds(sim_duration)
@@ -288,6 +294,11 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "batch_design_cpu_s": cpu_batch,
         "single_vs_batch": cpu_single / cpu_batch,
         "matmul_gflops": gflops,
+        "matmul_gflops_per_cpu_s": gflops_cpu,
+        "kernel_cpu_s": cpu_kernel,
+        "kernel_flops_per_design": flops,
+        "kernel_gflops_per_cpu_s": kernel_gflops,
+        "kernel_peak_fraction": kernel_gflops / gflops_cpu,
         "sampled_s": t_sampled,
         "sampled_evaluations": n_sampled,
         "sampled_evaluations_per_s": n_sampled / t_sampled,
@@ -316,8 +327,11 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f"{result['single_vs_batch']:.1f} x a design of a batch ({cpu_batch * 1e6:.2f} us CPU"
         f" each, same run)")
     say(f"  NumPy matmul (peak)        {gflops:8.1f} GFlop/s (float64, the BLAS threads of "
-        "this process: one under the nylonflex command; the kernel's fraction of it needs "
-        "a flop count, which hardware counters give where the host has them)")
+        f"this process: one under the nylonflex command), {gflops_cpu:.1f} GFlop per CPU-s")
+    say(f"  kernel flops               {flops:8.0f} flop per design (counted in its own "
+        f"source, benchmarks/flops.py), {kernel_gflops:.2f} GFlop per CPU-s: "
+        f"{100 * result['kernel_peak_fraction']:.1f} % of the matmul's (same run; "
+        f"{cpu_kernel:.2f} CPU-s for the kernels)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  sampled sweep (uncertainty) {t_sampled:7.2f} s  "

@@ -24,7 +24,7 @@ def test_quick_bench_reports_every_figure():
     text = "\n".join(lines)
     for words in ("designs/s", "angle solves/s", "speed-up per design", "peak memory",
                   "closed loop", "evaluations/s", "NumPy yardstick", "kernel vs NumPy",
-                  "one design", "GFlop/s", "light commands", "cold compile",
+                  "one design", "GFlop/s", "flop per design", "% of the matmul's", "light commands", "cold compile",
                   "us CPU per evaluation"):
         assert words in text
     assert result["designs"] == 12 * 6 * 4 * 3 * 4
@@ -37,6 +37,46 @@ def test_quick_bench_reports_every_figure():
     assert set(result["light_commands"]) >= {"info", "query --where", "query --at", "list materials"}
     assert all(cpu > 0 and (mb is None or mb > 0)
                for cpu, mb in result["light_commands"].values())
+
+
+def test_the_flop_count_counts_each_operation_once_and_runs_the_kernels_own_numbers():
+    # benchmarks/flops.py counts the kernel's work by running its source on counting floats:
+    # p(s) = P_atm ((1 - s)^-2 - 1) is five operations; the counted run of the paper's grid
+    # kernel on one (radius, wall) pair writes the compiled kernel's numbers, bit for bit
+    # (the Python source is what ran); and the count is a few hundred to a few thousand
+    # operations a design of the quick grid (about 1 kflop on the 2 M grid)
+    import importlib
+
+    import numpy as np
+
+    from nylonflex.engine.model_slab import grid_axes, grid_out, kernel_inputs
+    from nylonflex.kernels import design
+    from nylonflex.physics import specialised
+    from nylonflex.physics.chamber import _gauge_pressure
+
+    suite = load_suite(benchmarks_folder(ROOT))
+    flops = importlib.import_module(suite.__package__ + ".flops")
+    with flops.counting() as count:
+        p = _gauge_pressure(flops.Flop(0.1), flops.Flop(101325.0))
+        assert count() == 5 and isinstance(p, flops.Flop)
+
+    cfg = suite.bench_config(suite.QUICK)
+    body = specialised(design._design_slab, "_design_slab_counted", _PAPER_ONLY=True)
+    grid, inputs = grid_axes(cfg, 3, 4), kernel_inputs(cfg, 0)
+    out, scratch = grid_out(cfg, 1), design.grid_scratch(grid, inputs[2])
+    counted = type(out)(*(np.empty(a.shape, dtype=object) for a in out))
+    work = type(scratch)(*(np.empty(a.shape, dtype=object) for a in scratch))
+    with flops.counting(body) as count:
+        body(flops._flops_of(grid), *(flops._flops_of(v) for v in inputs), counted, work, 2, 3)
+        n = count()
+    design.design_slab_paper(grid, *inputs, out, scratch, 2, 3)
+    for name, a, b in zip(out._fields, out, counted):
+        pair = (slice(None), 0, 2) if name in ("design", "flags") else (0, 2)
+        np.testing.assert_array_equal(b[pair].astype(a.dtype).view(np.uint8),
+                                      a[pair].view(np.uint8), err_msg=name)
+    per_design = n / np.prod(out.design.shape[3:])
+    assert 300 < per_design < 20_000
+    assert flops.kernel_flops_per_design(cfg, pairs=2) > 300
 
 
 def test_the_command_finds_the_benchmarks_beside_the_package_of_a_checkout(tmp_path):
