@@ -69,11 +69,12 @@ ZSTD_LEVEL = -1
 #: 8x slower (78.3 MB), libdeflate level 1 3.3x slower and holds the GIL (78.9 MB).
 ISAL_LEVEL = 0
 
-#: Uncompressed bytes [B] of the float variables from which a cube's chunks are shuffled by
-#: the compiled loop (:mod:`nylonflex.kernels.bytes`, about 10 GB/s) instead of NumPy's
-#: strided copy (about 2 GB/s): below it, NumPy's extra time (under 30 ms) is less than the
-#: compiled loop's first compile (0.4-0.6 s with an empty cache), which the README's main
-#: job (3.6 MB) would otherwise pay. Both give the same bytes.
+#: Uncompressed bytes [B] of a cube's multi-byte variables from which its chunks are
+#: shuffled by the compiled loop (:mod:`nylonflex.kernels.bytes`, about 10 GB/s) instead of
+#: NumPy's strided copy (about 2 GB/s): below it, NumPy's extra time (under 30 ms) is less
+#: than the compiled loop's first compile (0.4-0.6 s with an empty cache), which the
+#: README's main job (3.3 MB) would otherwise pay. Both give the same bytes. The dry run's
+#: estimate shuffles its sample the way the cube will be.
 COMPILED_SHUFFLE_BYTES = 64 * 2**20
 
 #: Each compression thread's own zstd compressor and shuffle buffer.

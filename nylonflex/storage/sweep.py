@@ -18,9 +18,9 @@ from ..engine.grid import (bytes_per_radius, check_physics, compute_slab, coords
                            global_arrays, plan_slabs)
 from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
-from ..engine.warmup import warm_up_grid
+from ..engine.warmup import warm_up_codec, warm_up_grid
 from ..variables import VARIABLES
-from .cube import CODECS, _chunks, _encode_chunk
+from .cube import CODECS, COMPILED_SHUFFLE_BYTES, _chunks, _encode_chunk
 from .reader import open_cube
 from .run import sweep_to_file
 
@@ -157,8 +157,9 @@ def _resident_bytes() -> int:
     return int(psutil.Process().memory_info().rss)
 
 
-def _packed_bytes(value, chunks, codec) -> int:
-    """Bytes of ``value`` stored in ``chunks`` with the cube's codec (name)."""
+def _packed_bytes(value, chunks, codec, compiled: bool) -> int:
+    """Bytes of ``value`` stored in ``chunks`` with the cube's codec (name), shuffled by the
+    compiled loop or by NumPy (``compiled``), as the cube will be."""
     codec = CODECS[codec]
     if codec.encode is None:  # lz4: HDF5 compresses; zstd's size is close enough here
         codec = CODECS["zstd"]
@@ -168,7 +169,7 @@ def _packed_bytes(value, chunks, codec) -> int:
     total = 0
     for corner in itertools.product(*starts):
         block = value[tuple(slice(i, i + c) for i, c in zip(corner, chunks))]
-        total += len(_encode_chunk(block, chunks, codec))
+        total += len(_encode_chunk(block, chunks, codec, compiled))
     return total
 
 
@@ -217,6 +218,14 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
     size = -(-k // groups)
     starts = np.unique(np.linspace(0, n_radius - size, groups).round().astype(int))
     sizes = {name: len(v) for name, v in coords(cfg).items()}  # as the cube file has them
+    globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
+    axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
+    raw_total = n_radius * bytes_per_radius(cfg) + globals_bytes + axes_bytes
+    # the sample is shuffled as the cube will be (storage.cube.COMPILED_SHUFFLE_BYTES), and
+    # a compiled shuffle is compiled before the timing, as the kernel is
+    shuffle_compiled = raw_total >= COMPILED_SHUFFLE_BYTES
+    if shuffle_compiled:
+        compiled += warm_up_codec(notice=notice)
     compute = compress = 0.0
     raw = packed = 0
     for i in starts:
@@ -227,15 +236,13 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         for name, value in arrays.items():
             raw += value.nbytes
             packed += _packed_bytes(value, _chunks(VARIABLES[name].dims, sizes,
-                                                   min(radius_chunk, size)), cfg.compression)
+                                                   min(radius_chunk, size)), cfg.compression,
+                                  shuffle_compiled)
         compress += time.perf_counter() - t0
     picks = range(len(starts) * size)
     sample = len(picks) * per_radius
     ratio = packed / raw if raw else 1.0
     per_slab = max(i1 - i0 for i0, i1 in slabs) * bytes_per_radius(cfg)
-    globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
-    axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
-    raw_total = n_radius * bytes_per_radius(cfg) + globals_bytes + axes_bytes
     rate = sample / compute if compute > 0 else float("inf")
     compress_seconds = compress * cfg.n_designs / sample
     return {
