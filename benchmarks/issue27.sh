@@ -6,7 +6,7 @@
 #   BASE=../base benchmarks/issue27.sh    # ... and the same figures of another checkout
 #                                         # (its .venv/bin/nylonflex) beside them
 #   RUNS=5 COLD_RUNS=3 BIG=/tmp/big.h5 benchmarks/issue27.sh
-#   SKIP_BENCH=1 SKIP_SAMPLED=1 ...       # leave out section 6 (the full nylonflex bench)
+#   SKIP_BENCH=1 SKIP_SAMPLED=1 ...       # leave out section 7 (the full nylonflex bench)
 #                                         # or 5 (three 3 M-evaluation sampled sweeps each)
 #
 # Cold runs point NUMBA_CACHE_DIR at a new empty folder each time (every kernel compiles).
@@ -45,8 +45,8 @@ echo "issue 27 figures: $(git rev-parse --short HEAD) on $(nproc) cores, load $(
 
 echo "== 1. first use: the README's main job and an off-grid query --at, cold / warm (CPU s)"
 "$NF" warmup --quiet
-read -r warm _ < <(median "$RUNS" "$NF" sweep configs/fig12.yaml --out "$WORK/fig12/cube.h5")
-read -r coldc _ < <(median "$COLD_RUNS" "$COLD" "$NF" sweep configs/fig12.yaml --out "$WORK/fig12c/cube.h5")
+read -r warm _ < <(median "$RUNS" "$NF" sweep configs/fig12.yaml --out "$WORK/fig12/cube.h5" --overwrite)
+read -r coldc _ < <(median "$COLD_RUNS" "$COLD" "$NF" sweep configs/fig12.yaml --out "$WORK/fig12c/cube.h5" --overwrite)
 echo "sweep configs/fig12.yaml   warm $warm  cold $coldc  cold/warm $(ratio "$coldc" "$warm") (target <= 2.5)"
 AT="radius=7.3mm,wall_thickness=2.2mm,length=80mm,coil_index=1.37,wrap_angle=9deg"
 read -r warm _ < <(median "$RUNS" "$NF" query "$WORK/fig12/cube.h5" --at "$AT")
@@ -99,15 +99,25 @@ done | sort -n | awk '{r[NR]=$0} END {split(r[int((NR+1)/2)], x, " ");
 if [ -z "${SKIP_SAMPLED:-}" ]; then
 echo "== 5. the sampled path: fig12 x 256 samples (CPU-us per evaluation)"
 EVALS=$((41 * 6 * 3 * 4 * 4 * 256))
-read -r cpu _ < <(median "$RUNS" "$NF" sweep configs/fig12_uncertain.yaml --out "$WORK/unc/cube.h5" --no-charts --quiet)
+read -r cpu _ < <(median "$RUNS" "$NF" sweep configs/fig12_uncertain.yaml --out "$WORK/unc/cube.h5" --no-charts --quiet --overwrite)
 echo "sampled (this)  $cpu s for $EVALS evaluations: $(awk -v c="$cpu" -v n="$EVALS" 'BEGIN {printf "%.2f", c / n * 1e6}') CPU-us each"
 if [ -n "${BASE:-}" ]; then
-    read -r bcpu _ < <(median "$RUNS" "$BASE/.venv/bin/nylonflex" sweep configs/fig12_uncertain.yaml --out "$WORK/unc_base/cube.h5" --no-charts --quiet)
+    read -r bcpu _ < <(median "$RUNS" "$BASE/.venv/bin/nylonflex" sweep configs/fig12_uncertain.yaml --out "$WORK/unc_base/cube.h5" --no-charts --quiet --overwrite)
     echo "sampled (base)  $bcpu s: this/base $(ratio "$cpu" "$bcpu") (target <= 0.5)"
 fi
 fi
 
+echo "== 6. whole sweeps against the kernel's own CPU on the same grid (CPU s)"
+"$PY" -c "import sys, yaml; sys.path.insert(0, '.'); from benchmarks.suite import bench_config, FULL
+print(yaml.safe_dump(dict(bench_config(FULL).raw)))" > "$WORK/bench2m.yaml"
+for pair in "2 M bench grid:$WORK/bench2m.yaml:2" "20 M cube:configs/big20m.yaml:1.2"; do
+    IFS=: read -r label cfg target <<< "$pair"
+    read -r sweep _ < <(median "$RUNS" "$NF" sweep "$cfg" --out "$WORK/whole/cube.h5" --no-charts --quiet --overwrite)
+    kernel=$(for _ in $(seq "$RUNS"); do "$PY" benchmarks/kernel_cpu.py "$cfg"; done | sort -n | awk '{c[NR] = $1} END {print c[int((NR + 1) / 2)]}')
+    echo "$label: whole sweep $sweep, kernel $kernel: $(ratio "$sweep" "$kernel")x (target <= $target)"
+done
+
 if [ -z "${SKIP_BENCH:-}" ]; then
-    echo "== 6. kernel headroom: nylonflex bench (one process, side by side)"
+    echo "== 7. kernel headroom: nylonflex bench (one process, side by side)"
     "$NF" bench | sed 's/^/  /'
 fi
