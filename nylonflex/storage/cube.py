@@ -23,7 +23,7 @@ from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .netcdf4 import NetCDF4File
 
 __all__ = ["CODECS", "DEFAULT_CODEC", "STORED_DIMS", "Codec", "CubeFile", "MissingPlugin",
-           "require_filters", "stored_dims"]
+           "compiled_shuffle", "require_filters", "stored_dims"]
 
 #: Axes a cube stores as an auxiliary coordinate over a dimension of another name (cube
 #: format 3): {axis: its dimension in the file}. compliance-checker (cf:1.8, s. 5.1) asks a
@@ -69,13 +69,19 @@ ZSTD_LEVEL = -1
 #: 8x slower (78.3 MB), libdeflate level 1 3.3x slower and holds the GIL (78.9 MB).
 ISAL_LEVEL = 0
 
-#: Uncompressed bytes [B] of a cube's multi-byte variables from which its chunks are
-#: shuffled by the compiled loop (:mod:`nylonflex.kernels.bytes`, about 10 GB/s) instead of
-#: NumPy's strided copy (about 2 GB/s): below it, NumPy's extra time (under 30 ms) is less
-#: than the compiled loop's first compile (0.4-0.6 s with an empty cache), which the
-#: README's main job (3.3 MB) would otherwise pay. Both give the same bytes. The dry run's
-#: estimate shuffles its sample the way the cube will be.
+#: Uncompressed bytes [B] of a cube from which its chunks are shuffled by the compiled loop
+#: (:mod:`nylonflex.kernels.bytes`, about 10 GB/s) instead of NumPy's strided copy (about
+#: 2 GB/s): below it, NumPy's extra time (under 30 ms) is less than the compiled loop's
+#: first compile (0.4-0.6 s with an empty cache), which the README's main job (3.5 MB)
+#: would otherwise pay. Both give the same bytes (:func:`compiled_shuffle` decides, for the
+#: cube and for the dry run's sample alike).
 COMPILED_SHUFFLE_BYTES = 64 * 2**20
+
+
+def compiled_shuffle(raw_bytes: int) -> bool:
+    """Whether a cube of ``raw_bytes`` [B] uncompressed is shuffled by the compiled loop
+    (else by NumPy, the same bytes): :data:`COMPILED_SHUFFLE_BYTES`."""
+    return raw_bytes >= COMPILED_SHUFFLE_BYTES
 
 #: Each compression thread's own zstd compressor and shuffle buffer.
 _per_thread = threading.local()
@@ -244,9 +250,8 @@ class CubeFile:
         # 0.1 ms with the GIL held, several a variable a slab)
         self._layout = {name: _Layout(ds, self.f.dims[name], ds.chunks, ds.shape, ds.dtype)
                         for name, ds in self.f.datasets.items()}
-        shuffled = sum(lay.dset.size * lay.dtype.itemsize for lay in self._layout.values()
-                       if lay.dtype.itemsize > 1)
-        self._compiled_shuffle = shuffled >= COMPILED_SHUFFLE_BYTES
+        self._compiled_shuffle = compiled_shuffle(
+            sum(lay.dset.size * lay.dtype.itemsize for lay in self._layout.values()))
         self._pool = ThreadPoolExecutor(2, thread_name_prefix="nylonflex-deflate")
 
     def decoding(self) -> str:

@@ -20,7 +20,7 @@ from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
 from ..engine.warmup import warm_up_codec, warm_up_grid
 from ..variables import VARIABLES
-from .cube import CODECS, COMPILED_SHUFFLE_BYTES, _chunks, _encode_chunk
+from .cube import CODECS, _chunks, _encode_chunk, compiled_shuffle
 from .reader import open_cube
 from .run import sweep_to_file
 
@@ -221,9 +221,9 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
     globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
     axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
     raw_total = n_radius * bytes_per_radius(cfg) + globals_bytes + axes_bytes
-    # the sample is shuffled as the cube will be (storage.cube.COMPILED_SHUFFLE_BYTES), and
-    # a compiled shuffle is compiled before the timing, as the kernel is
-    shuffle_compiled = raw_total >= COMPILED_SHUFFLE_BYTES
+    # the sample is shuffled as the cube will be, and a compiled shuffle is compiled before
+    # the timing, as the kernel is
+    shuffle_compiled = compiled_shuffle(raw_total)
     if shuffle_compiled:
         compiled += warm_up_codec(notice=notice)
     compute = compress = 0.0
