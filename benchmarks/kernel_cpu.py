@@ -3,7 +3,6 @@ costs beyond the kernel is measured against this (issue 27: at most 2x on the 2 
 grid, 1.2x on the 20 M cube).
 
     python benchmarks/kernel_cpu.py CONFIG.yaml     # prints "kernel_cpu_s wall_s designs"
-    python benchmarks/kernel_cpu.py --bench         # the 2 M grid of nylonflex bench
 
 The kernel is compiled (or loaded) first, then every slab of the sweep's plan is computed
 in this process on the engine's threads, as a local sweep computes it, with nothing
@@ -29,24 +28,15 @@ def kernel_seconds(cfg) -> tuple[float, float]:
 
 
 def main(argv) -> int:
-    if argv == ["--bench"]:
-        from pathlib import Path
-
-        sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-        from benchmarks.suite import FULL, bench_config
-
-        cfg = bench_config(FULL)
-    elif len(argv) == 1:
-        from nylonflex.config import load_config
-
-        cfg = load_config(argv[0])
-    else:
-        print(__doc__.strip().splitlines()[3].strip(), file=sys.stderr)
+    if len(argv) != 1:
+        print("usage: python benchmarks/kernel_cpu.py CONFIG.yaml", file=sys.stderr)
         return 2
+    from nylonflex.config import load_config
+
+    cfg = load_config(argv[0])
     cpu, wall = kernel_seconds(cfg)
     print(f"{cpu:.3f} {wall:.3f} {cfg.n_designs}")
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))

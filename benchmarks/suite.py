@@ -26,7 +26,7 @@ import numpy as np
 
 from nylonflex.config import parse_config
 from nylonflex.engine import evaluate
-from nylonflex.engine.grid import compute_slab, plan_slabs
+from nylonflex.engine.grid import compute_slab
 from nylonflex.physics import design_limits as python_loop
 from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.storage import open_cube
@@ -34,6 +34,7 @@ from nylonflex.storage.sweep import run_sweep, sweep_file
 
 from .first_use import cold_compiles, command_costs
 from .flops import kernel_flops_per_design
+from .kernel_cpu import kernel_seconds
 from .yardstick import grid_numpy
 
 #: The checkout's tests/naive.py, the slow reference of the tests.
@@ -226,12 +227,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
     t_compile = time.perf_counter() - t0
     say(f"  compile or load cache      {t_compile:8.2f} s")
 
-    slabs, _ = plan_slabs(cfg)
-    t0, c0 = time.perf_counter(), time.process_time()
-    for i0, i1 in slabs:
-        compute_slab(cfg, i0, i1)
-    t_kernel = time.perf_counter() - t0
-    cpu_kernel = time.process_time() - c0
+    cpu_kernel, t_kernel = kernel_seconds(cfg)
     flops = kernel_flops_per_design(cfg, pairs=2 if quick else 4)
     kernel_gflops = flops * cfg.n_designs / cpu_kernel / 1e9
 
