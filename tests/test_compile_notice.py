@@ -6,18 +6,25 @@ test compiles for real in well under a second.
 """
 
 import json
+import os
+import signal
+import sys
+import threading
 import warnings
 
 import numba
 import pytest
 
 import nylonflex as nf
-from nylonflex.kernels import compiling
+from nylonflex.engine.warmup import grid_families, warm_up_aside
+from nylonflex.kernels import cache, compiling
 
 
 @pytest.fixture
 def fresh(monkeypatch, tmp_path):
-    """No family noticed yet in this process, and the estimates in a temporary file."""
+    """No family noticed yet in this process, and the estimates and the marks of compiled
+    families in temporary files."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setattr(compiling, "_NOTICED", set())
     monkeypatch.setattr(compiling, "_SECONDS", {})
     monkeypatch.setattr(compiling, "_record_path", lambda: str(tmp_path / "seconds.json"))
@@ -43,6 +50,7 @@ def test_a_real_compile_notices_once_with_an_estimate_and_records_it(fresh):
     assert f"about {compiling.MEASURED['control']:.0f} s" in seen[0]  # nothing recorded yet
     recorded = json.loads(fresh.read_text())["control"]
     assert recorded >= 0 and compiling.compile_seconds()["control"] > 0
+    assert cache.was_compiled("control") and not cache.was_compiled("grid")
     compiling._NOTICED.clear()
     with compiling.notices_to(seen.append):
         _kernel()(4)
@@ -150,3 +158,115 @@ def test_the_warmup_command_names_every_kernel(capsys):
     for name in ("grid", "grid_variants", "pointwise", "codec", "tracking", "control"):
         assert f" {name} " in out
     assert out.splitlines()[-1].startswith("warm: every kernel")
+
+
+# --- a kernel compiled in a second process while this one goes on (warm_up_aside)
+
+linux_only = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork: Linux")
+
+
+@pytest.fixture
+def empty_cache(monkeypatch, tmp_path):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.delenv("NYLONFLEX_NO_CACHE", raising=False)
+    return tmp_path
+
+
+def _child_compiles(folder, mark=True):
+    """A stand-in for a kernel's compile: what the child did, in a file, and the family's
+    mark, as a compile leaves it."""
+    def warm():
+        (folder / "child.txt").write_text(str(os.getpid()))
+        if mark:
+            cache.mark_compiled("grid")
+    return warm
+
+
+@linux_only
+def test_an_uncompiled_kernel_compiles_in_a_child_while_this_process_goes_on(empty_cache):
+    here = []
+    seconds = warm_up_aside(_child_compiles(empty_cache), {"grid"},
+                            lambda: here.append(os.getpid()))
+    child = int((empty_cache / "child.txt").read_text())
+    assert here == [os.getpid()] and child != os.getpid()
+    assert seconds > 0 and cache.was_compiled("grid")
+
+
+@linux_only
+def test_a_compiled_kernel_forks_nothing(empty_cache):
+    cache.mark_compiled("grid")
+    here = []
+    assert warm_up_aside(_child_compiles(empty_cache), {"grid"}, lambda: here.append(1)) == 0.0
+    assert here == [1] and not (empty_cache / "child.txt").exists()
+
+
+@linux_only
+def test_a_family_left_uncompiled_forks(empty_cache):
+    cache.mark_compiled("grid")
+    warm_up_aside(_child_compiles(empty_cache), {"grid", "tracking"}, lambda: None)
+    assert (empty_cache / "child.txt").exists()
+
+
+@linux_only
+def test_a_failed_child_leaves_the_compile_to_this_process(empty_cache):
+    def fails():
+        raise RuntimeError("no compiler")
+
+    here = []
+    assert warm_up_aside(fails, {"grid"}, lambda: here.append(1)) == 0.0
+    assert here == [1] and not cache.was_compiled("grid")
+    # a child that exits without the compile having left its mark: the same
+    assert warm_up_aside(_child_compiles(empty_cache, mark=False), {"grid"}, lambda: None) == 0.0
+
+
+@linux_only
+def test_ctrl_c_stopping_the_child_stops_this_process(empty_cache):
+    with pytest.raises(KeyboardInterrupt):
+        warm_up_aside(lambda: os.kill(os.getpid(), signal.SIGINT), {"grid"}, lambda: None)
+
+
+def test_no_fork_without_a_cache_or_beside_other_threads(empty_cache, monkeypatch):
+    here = []
+    monkeypatch.setenv("NYLONFLEX_NO_CACHE", "1")
+    assert warm_up_aside(_child_compiles(empty_cache), {"grid"}, lambda: here.append(1)) == 0.0
+    monkeypatch.delenv("NYLONFLEX_NO_CACHE")
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        assert warm_up_aside(_child_compiles(empty_cache), {"grid"},
+                             lambda: here.append(2)) == 0.0
+    finally:
+        stop.set()
+        other.join()
+    assert here == [1, 2] and not (empty_cache / "child.txt").exists()
+
+
+def test_a_meanwhile_that_fails_still_reaps_the_child(empty_cache):
+    def broken():
+        raise ImportError("no matplotlib")
+
+    with pytest.raises(ImportError):
+        warm_up_aside(_child_compiles(empty_cache), {"grid"}, broken)
+    with pytest.raises(ChildProcessError):
+        os.waitpid(-1, os.WNOHANG)  # no child left behind
+
+
+def test_the_families_a_sweep_warms_up():
+    from nylonflex.config import parse_config
+
+    one = {"values": [1.3]}
+    raw = {"name": "a", "grid": {"radius": {"values": [10], "units": "mm"},
+                                 "wall_thickness": {"values": [2], "units": "mm"},
+                                 "length": {"values": [90], "units": "mm"},
+                                 "coil_index": one, "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 2},
+                      "pressure": {"start": 0, "stop": 25, "num": 2, "units": "kPa"}}}
+    assert grid_families(parse_config(raw)) == {"grid"}
+    supplied = {**raw, "supply": {"voltage": 12, "units": "V"}}
+    assert grid_families(parse_config(supplied)) == {"grid_variants"}
+    tracked = {**supplied, "tracking": {
+        "duration": "0.5 s", "step": "10 ms", "controller": {"kind": "bang_bang"},
+        "reference": {"kind": "sine", "mean": "20 deg", "amplitude": "5 deg",
+                      "frequency": "1 Hz"}}}
+    assert grid_families(parse_config(tracked)) == {"grid_variants", "tracking"}

@@ -1,6 +1,11 @@
 """The charts a sweep draws beside its cube (drawn by the sweep's own process, after the
 sweep), and the sweep command's start."""
 
+import os
+from pathlib import Path
+
+import pytest
+
 from nylonflex.cli import main
 
 SMALL = {
@@ -52,3 +57,32 @@ def test_the_sweep_command_leaves_the_garbage_collector_running(tmp_path):
                  "--no-charts"]) == 0
     assert gc.isenabled() and gc.get_freeze_count() > 0
     gc.unfreeze()
+
+
+@pytest.mark.slow
+def test_a_first_sweep_compiles_aside_and_makes_the_same_cube(tmp_path):
+    # an empty cache: the kernel compiles in a forked child while the command imports the
+    # chart libraries, then loads it; the cube is the one a warm process makes, bit for bit
+    import subprocess
+    import sys
+
+    import xarray as xr
+    import yaml
+
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml.safe_dump({**SMALL, "charts": ["fig4"]}))
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "MPLBACKEND": "Agg"}
+    env.pop("NYLONFLEX_NO_CACHE", None)
+    cold = subprocess.run([sys.executable, "-m", "nylonflex", "sweep", str(cfg), "--out",
+                           str(tmp_path / "cold" / "cube.h5")], env=env, capture_output=True,
+                          text=True, timeout=600)
+    assert cold.returncode == 0, cold.stderr
+    assert cold.stderr.count("compiling the grid kernel") == 1  # by the child, once
+    assert "compiled in" in cold.stderr and "in a second process" in cold.stderr and (tmp_path / "cold" / "fig4.png").exists()
+    assert list(Path(env["NUMBA_CACHE_DIR"]).glob("*/grid.compiled"))
+    assert main(["sweep", str(cfg), "--out", str(tmp_path / "warm" / "cube.h5"), "--quiet",
+                 "--no-charts"]) == 0
+    with xr.open_dataset(tmp_path / "cold" / "cube.h5") as a, \
+            xr.open_dataset(tmp_path / "warm" / "cube.h5") as b:
+        for name in b.data_vars:
+            assert a[name].equals(b[name]), name

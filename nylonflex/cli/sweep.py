@@ -81,7 +81,10 @@ def _run(args, charts: bool) -> int:
                 return _dry_run(cfg, out, args, log)
             signals.enter_context(deferred_signals(on_second=_stop_at_once, earlier=EARLY_SIGNALS))
             unchanged = _up_to_date(cfg, out, args)
-            prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log)
+            # the chart libraries load while the kernel compiles, when it has to
+            prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log,
+                    meanwhile=_chart_libraries if charts and cfg.charts and not unchanged
+                    else None)
         with _progress(cfg.n_designs, args.quiet) as bar:
             sweep_file(cfg, out, resume=args.resume, workers=args.workers,
                        scheduler=args.scheduler, progress=bar.update, log=log,
@@ -105,6 +108,17 @@ def _run(args, charts: bool) -> int:
     for path in paths:
         print(path)
     return 0
+
+
+def _chart_libraries():
+    """Import what drawing the charts needs (matplotlib, xarray); a failure is left to the
+    drawing, which reports it."""
+    try:
+        from ..charts import warm_up
+
+        warm_up()
+    except Exception:  # noqa: BLE001, S110 - the drawing imports again and says why
+        pass
 
 
 def _draw(out, names, skip, progress) -> list:

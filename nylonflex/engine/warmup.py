@@ -13,17 +13,23 @@ notice is a callback: the engine never prints.
 from __future__ import annotations
 
 import dataclasses
+import os
+import signal
+import sys
+import threading
 import time
 from contextlib import nullcontext
 
 import numpy as np
 
 from ..config import ResolvedConfig, parse_config
+from ..kernels import cache
 from .grid import compute_slab
+from .model_slab import paper_kernel
 from .pointwise import evaluate
 
-__all__ = ["COMPILE_NOTICE", "KERNELS", "timed", "warm_up_codec", "warm_up_grid", "warm_up_kernels",
-           "warm_up_points"]
+__all__ = ["COMPILE_NOTICE", "KERNELS", "grid_families", "timed", "warm_up_aside",
+           "warm_up_codec", "warm_up_grid", "warm_up_kernels", "warm_up_points"]
 
 #: How every compile notice begins (the rest names the kernel and its estimate).
 COMPILE_NOTICE = "compiling "
@@ -71,6 +77,98 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
         cfg, axes={k: v[:1] for k, v in cfg.axes.items()},
         curves={k: v[:2] for k, v in cfg.curves.items()})
     return timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
+
+
+def grid_families(cfg: ResolvedConfig) -> set:
+    """The kernel families (:data:`~nylonflex.kernels.compiling.FAMILIES`) that
+    :func:`warm_up_grid` of ``cfg`` compiles or loads."""
+    names = {"grid" if paper_kernel(cfg) else "grid_variants"}
+    if cfg.tracking is not None:
+        names.add("tracking")
+    return names
+
+
+def warm_up_aside(warm, families, meanwhile) -> float:
+    """Run ``meanwhile()`` here while ``warm()`` compiles kernels in a second process.
+
+    A kernel compiles on one core for seconds, and nothing else in the process can use the
+    other one: the compile holds the GIL half of its time, so a thread that imports beside it
+    only slows it down. When some of ``families`` have not compiled into the cache folder
+    yet (:func:`~nylonflex.kernels.cache.was_compiled`), this process forks; the child runs
+    ``warm()``, which compiles them into Numba's cache, and exits, while this process runs
+    ``meanwhile()`` (work the caller needs next: importing the chart libraries); then this
+    process waits for the child, and its own warm-up loads the kernels from the cache. The
+    same bits: the child compiles the very kernels this process would.
+
+    Otherwise (every family compiled before, caching off, Windows or macOS, or other
+    threads running, which a fork would not carry over) ``meanwhile()`` simply runs first.
+    A child that fails leaves the kernels to this process's own warm-up, which compiles them
+    and reports what went wrong.
+
+    Parameters
+    ----------
+    warm : callable
+        Compiles (or loads) the kernels; run in the child only.
+    families : iterable of str
+        The kernel families ``warm`` compiles.
+    meanwhile : callable
+        Run in this process, in either case.
+
+    Returns
+    -------
+    float
+        Seconds [s] from the fork until the child had compiled, else 0.0 (no child, or it
+        failed).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        The child was stopped by Ctrl-C or SIGTERM (the terminal stops both processes).
+    """
+    if not _can_fork() or not cache.caching() or \
+            all(cache.was_compiled(name) for name in families):
+        meanwhile()
+        return 0.0
+    # Numba and the kernels are imported before the fork: the child compiles with them and
+    # this process loads the compiled code with them afterwards (0.3 s, not twice)
+    from ..kernels import design  # noqa: F401
+
+    t0 = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child (coverage does not follow a fork)
+        _child(warm)
+    try:
+        meanwhile()
+    finally:
+        _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status) and os.WTERMSIG(status) in (signal.SIGINT, signal.SIGTERM):
+        raise KeyboardInterrupt
+    compiled = os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0 and \
+        all(cache.was_compiled(name) for name in families)
+    return time.perf_counter() - t0 if compiled else 0.0
+
+
+def _can_fork() -> bool:
+    """Whether this process may fork now: Linux (fork is its own way; the charts fork too),
+    and no other thread, whose locks a child would inherit held."""
+    return sys.platform.startswith("linux") and hasattr(os, "fork") and \
+        threading.active_count() == 1
+
+
+def _child(warm):  # pragma: no cover - runs in the forked child only
+    """The forked child: ``warm()``, then exit at once (no atexit handlers, no buffers of
+    the parent flushed twice); Ctrl-C and SIGTERM stop it at once."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    status = 1
+    try:
+        warm()
+        status = 0
+    except BaseException:  # noqa: BLE001 - the parent's own warm-up reports it
+        pass
+    finally:
+        sys.stderr.flush()
+        os._exit(status)
 
 
 def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:

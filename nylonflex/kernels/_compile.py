@@ -21,7 +21,6 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
-import os
 import pkgutil
 import sys
 import types
@@ -35,7 +34,7 @@ from numba.extending import intrinsic, overload, register_jitable
 
 from .. import physics
 from ..physics import elementary
-from .cache import cache_dir
+from .cache import cache_dir, caching
 
 
 def _import_numba_arraymath():
@@ -86,7 +85,7 @@ _import_numba_arraymath()
 #: Options of every kernel. ``cache`` writes compiled code to a folder keyed on the model
 #: sources so a second run starts warm; ``fastmath`` stays off: the kernels must match the
 #: physics to 1e-9 and the sweep must be bit-reproducible.
-JIT_OPTIONS = {"cache": os.environ.get("NYLONFLEX_NO_CACHE") is None, "nogil": True,
+JIT_OPTIONS = {"cache": caching(), "nogil": True,
                "error_model": "numpy", "fastmath": False}
 
 #: Options of what a kernel calls: every formula, and a kernel's own body where

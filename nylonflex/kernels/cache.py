@@ -13,7 +13,7 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["cache_dir", "source_digest"]
+__all__ = ["cache_dir", "caching", "mark_compiled", "source_digest", "was_compiled"]
 
 
 @lru_cache(maxsize=1)
@@ -29,6 +29,12 @@ def source_digest() -> str:
     return digest.hexdigest()[:16]
 
 
+def caching() -> bool:
+    """Whether the kernels keep their compiled code in :func:`cache_dir` (unless
+    ``$NYLONFLEX_NO_CACHE`` is set, when each process compiles them again)."""
+    return os.environ.get("NYLONFLEX_NO_CACHE") is None
+
+
 def cache_dir() -> str:
     """The kernels' Numba cache folder: ``$NUMBA_CACHE_DIR`` (default
     ``~/.cache/nylonflex/numba``) / the :func:`source_digest` of the model sources."""
@@ -36,3 +42,26 @@ def cache_dir() -> str:
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
         "nylonflex", "numba")
     return os.path.join(base, source_digest())
+
+
+def _mark_path(family: str) -> str:
+    return os.path.join(cache_dir(), f"{family}.compiled")
+
+
+def mark_compiled(family: str) -> None:
+    """Record that kernel ``family`` (:data:`~.compiling.FAMILIES`) compiled into this
+    cache folder: an empty file beside Numba's, which goes when the folder goes. Nothing
+    when the folder cannot be written (the kernel then compiles in each process anyway)."""
+    try:
+        os.makedirs(cache_dir(), exist_ok=True)
+        with open(_mark_path(family), "a", encoding="utf-8"):
+            pass
+    except OSError:
+        pass
+
+
+def was_compiled(family: str) -> bool:
+    """Whether kernel ``family`` compiled into this cache folder before (:func:`mark_compiled`),
+    so that a process can expect to load it, not compile it. A hint: a cache emptied by hand
+    or made on another CPU still compiles where the kernel is first called."""
+    return os.path.exists(_mark_path(family))

@@ -27,7 +27,7 @@ from contextlib import contextmanager
 import numba
 from numba.core import event
 
-from .cache import cache_dir
+from .cache import cache_dir, mark_compiled
 
 __all__ = ["FAMILIES", "MEASURED", "CompileWarning", "compile_seconds", "family",
            "notice_text", "notices_to"]
@@ -157,6 +157,9 @@ class _Listener(event.Listener):
             _SECONDS[name] = _SECONDS.get(name, 0.0) + time.perf_counter() - _STATE.t0
             seconds = _SECONDS[name]
         _record(name, seconds)
+        # marked even after a failure (Numba 0.68's Event.is_failed reads the wrong way
+        # round): the next process then compiles the kernel itself, as it would unmarked
+        mark_compiled(name)
 
 
 def compile_seconds() -> dict:

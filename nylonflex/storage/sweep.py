@@ -18,7 +18,7 @@ from ..engine.grid import (bytes_per_radius, check_physics, compute_slab, coords
                            global_arrays, plan_slabs)
 from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
-from ..engine.warmup import warm_up_codec, warm_up_grid
+from ..engine.warmup import grid_families, warm_up_aside, warm_up_codec, warm_up_grid
 from ..variables import VARIABLES
 from .cube import CODECS, _chunks, _encode_chunk, compiled_shuffle
 from .reader import open_cube
@@ -102,15 +102,18 @@ def _interrupt():
     raise KeyboardInterrupt
 
 
-def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
+def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None, meanwhile=None):
     """Import and load (or compile) what a sweep of ``cfg`` runs: the kernel.
 
     :func:`sweep_file` and :func:`run_sweep` do it themselves; a caller may do it first to
     keep the start apart (the command line does, with the garbage collector paused).
-    Parameters as :func:`run_sweep`'s.
+    Parameters as :func:`run_sweep`'s; ``meanwhile`` (a callable), the caller's next work
+    that needs no kernel, runs while the kernel compiles in a second process when it has
+    to compile (:func:`~nylonflex.engine.warmup.warm_up_aside`), else first: the command
+    line imports the chart libraries so.
     """
     check_physics(cfg)
-    _warm_up(cfg, workers, scheduler, log)
+    _warm_up(cfg, workers, scheduler, log, meanwhile)
 
 
 #: The (config hash, workers) whose kernel this process has warmed up: :func:`prepare`
@@ -118,16 +121,24 @@ def prepare(cfg: ResolvedConfig, *, workers=None, scheduler=None, log=None):
 _WARMED: set = set()
 
 
-def _warm_up(cfg, workers, scheduler, log):
-    """Compile (or load) the local kernel first, so that the run's timings exclude it."""
+def _warm_up(cfg, workers, scheduler, log, meanwhile=None):
+    """Compile (or load) the local kernel first, so that the run's timings exclude it;
+    ``meanwhile`` as :func:`prepare`'s."""
     if scheduler is not None or (cfg.sha256, workers) in _WARMED:
+        if meanwhile is not None:
+            meanwhile()
         return
 
     set_workers(workers)
+    aside = 0.0
+    if meanwhile is not None:
+        aside = warm_up_aside(lambda: warm_up_grid(cfg, notice=log), grid_families(cfg),
+                              meanwhile)
     compiled = warm_up_grid(cfg, notice=log)
     _WARMED.add((cfg.sha256, workers))
-    if compiled and log is not None:
-        log(f"kernels compiled in {compiled:.1f} s (not counted below)")
+    if (compiled or aside) and log is not None:
+        where = "" if compiled else " in a second process"
+        log(f"kernels compiled in {compiled or aside:.1f} s{where} (not counted below)")
 
 
 def _in_memory(cfg, workers, scheduler, progress):
