@@ -246,10 +246,16 @@ def test_a_meanwhile_that_fails_still_reaps_the_child(empty_cache):
     def broken():
         raise ImportError("no matplotlib")
 
+    def slow(folder=empty_cache):
+        import time
+        time.sleep(30)  # stopped long before: the caller stops, so does the child
+        (folder / "child.txt").write_text("finished")
+
     with pytest.raises(ImportError):
-        warm_up_aside(_child_compiles(empty_cache), {"grid"}, broken)
+        warm_up_aside(slow, {"grid"}, broken)
     with pytest.raises(ChildProcessError):
         os.waitpid(-1, os.WNOHANG)  # no child left behind
+    assert not (empty_cache / "child.txt").exists()
 
 
 def test_the_families_a_sweep_warms_up():
@@ -270,3 +276,11 @@ def test_the_families_a_sweep_warms_up():
         "reference": {"kind": "sine", "mean": "20 deg", "amplitude": "5 deg",
                       "frequency": "1 Hz"}}}
     assert grid_families(parse_config(tracked)) == {"grid_variants", "tracking"}
+
+
+def test_a_mark_is_never_written_through_a_link(empty_cache):
+    target = empty_cache / "someone_elses"
+    os.makedirs(cache.cache_dir())
+    os.symlink(target, os.path.join(cache.cache_dir(), "grid.compiled"))
+    cache.mark_compiled("grid")
+    assert not target.exists()

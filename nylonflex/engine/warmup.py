@@ -124,6 +124,7 @@ def warm_up_aside(warm, families, meanwhile) -> float:
     ------
     KeyboardInterrupt
         The child was stopped by Ctrl-C or SIGTERM (the terminal stops both processes).
+        Whatever ``meanwhile()`` raises is raised, after the child is stopped and reaped.
     """
     if not _can_fork() or not cache.caching() or \
             all(cache.was_compiled(name) for name in families):
@@ -139,8 +140,11 @@ def warm_up_aside(warm, families, meanwhile) -> float:
         _child(warm)
     try:
         meanwhile()
-    finally:
         _, status = os.waitpid(pid, 0)
+    except BaseException:  # the caller stops here (a second Ctrl-C): so does the child
+        os.kill(pid, signal.SIGTERM)
+        os.waitpid(pid, 0)
+        raise
     if os.WIFSIGNALED(status) and os.WTERMSIG(status) in (signal.SIGINT, signal.SIGTERM):
         raise KeyboardInterrupt
     compiled = os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0 and \

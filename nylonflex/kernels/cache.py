@@ -54,8 +54,8 @@ def mark_compiled(family: str) -> None:
     when the folder cannot be written (the kernel then compiles in each process anyway)."""
     try:
         os.makedirs(cache_dir(), exist_ok=True)
-        with open(_mark_path(family), "a", encoding="utf-8"):
-            pass
+        # never through a link: a mark is ours, and only ever an empty file
+        os.close(os.open(_mark_path(family), os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o644))
     except OSError:
         pass
 
