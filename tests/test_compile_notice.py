@@ -227,19 +227,29 @@ def test_ctrl_c_stopping_the_child_stops_this_process(empty_cache):
 
 def test_no_fork_without_a_cache_or_beside_other_threads(empty_cache, monkeypatch):
     here = []
+
+    def aside():
+        return warm_up_aside(_child_compiles(empty_cache), {"grid"},
+                             lambda: here.append(len(here)))
+
     monkeypatch.setenv("NYLONFLEX_NO_CACHE", "1")
-    assert warm_up_aside(_child_compiles(empty_cache), {"grid"}, lambda: here.append(1)) == 0.0
+    assert aside() == 0.0
     monkeypatch.delenv("NYLONFLEX_NO_CACHE")
+    # a cache folder that cannot be made: the parent would compile again after the child
+    (empty_cache / "a_file").write_text("")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(empty_cache / "a_file" / "cache"))
+    assert not cache.writable() and aside() == 0.0
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(empty_cache / "cache"))
     stop = threading.Event()
     other = threading.Thread(target=stop.wait)
     other.start()
     try:
-        assert warm_up_aside(_child_compiles(empty_cache), {"grid"},
-                             lambda: here.append(2)) == 0.0
+        assert aside() == 0.0
     finally:
         stop.set()
         other.join()
-    assert here == [1, 2] and not (empty_cache / "child.txt").exists()
+    # meanwhile ran each time, here; no child ever ran
+    assert here == [0, 1, 2] and not (empty_cache / "child.txt").exists()
 
 
 def test_a_meanwhile_that_fails_still_reaps_the_child(empty_cache):

@@ -100,8 +100,9 @@ def warm_up_aside(warm, families, meanwhile) -> float:
     process waits for the child, and its own warm-up loads the kernels from the cache. The
     same bits: the child compiles the very kernels this process would.
 
-    Otherwise (every family compiled before, caching off, Windows or macOS, or other
-    threads running, which a fork would not carry over) ``meanwhile()`` simply runs first.
+    Otherwise (every family compiled before, caching off or its folder unwritable, so that
+    the parent would compile again, Windows or macOS, or other threads running, which a
+    fork would not carry over) ``meanwhile()`` simply runs first.
     A child that fails leaves the kernels to this process's own warm-up, which compiles them
     and reports what went wrong.
 
@@ -126,7 +127,7 @@ def warm_up_aside(warm, families, meanwhile) -> float:
         The child was stopped by Ctrl-C or SIGTERM (the terminal stops both processes).
         Whatever ``meanwhile()`` raises is raised, after the child is stopped and reaped.
     """
-    if not _can_fork() or not cache.caching() or \
+    if not _can_fork() or not cache.caching() or not cache.writable() or \
             all(cache.was_compiled(name) for name in families):
         meanwhile()
         return 0.0

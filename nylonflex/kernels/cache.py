@@ -13,7 +13,8 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["cache_dir", "caching", "mark_compiled", "source_digest", "was_compiled"]
+__all__ = ["cache_dir", "caching", "mark_compiled", "source_digest", "was_compiled",
+           "writable"]
 
 
 @lru_cache(maxsize=1)
@@ -42,6 +43,16 @@ def cache_dir() -> str:
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
         "nylonflex", "numba")
     return os.path.join(base, source_digest())
+
+
+def writable() -> bool:
+    """Whether :func:`cache_dir` can be written (it is made if missing): where it cannot,
+    Numba keeps compiled code elsewhere or nowhere, and no mark can be left."""
+    try:
+        os.makedirs(cache_dir(), exist_ok=True)
+    except OSError:
+        return False
+    return os.access(cache_dir(), os.W_OK)
 
 
 def _mark_path(family: str) -> str:
