@@ -160,10 +160,10 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
             kappa_full = 0.0
             if default:
                 p_full = _gauge_pressure(s_max, p_atm)
-                kappa_full = _curvature_nodes(
+                kappa_full = _curvature_solve(
                     _pressure_moment(p_full, a, b), y_nodes, wy_nodes, wyy_nodes, work, mu,
                     alpha, _curvature_start(p_full, pressure, kappa_curve, rate_curve,
-                                            rate2_curve, n_curve), NEWTON_RTOL, False)
+                                            rate2_curve, n_curve), NEWTON_RTOL, False)[0]
                 # the working temperatures of a stroke-limited design (s* = s_max) depend
                 # on the coil index only: once per C, not per wrap angle
                 temps_full = _working_temperatures(model, s_max, t_max, scale, shape)

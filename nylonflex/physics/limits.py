@@ -539,8 +539,8 @@ def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, c
             guess = _taylor_start(p, p_full, kappa_full, rate_full, rate2_full)
         if not guess > 0.0:
             guess = kappa_full * p / p_full
-        kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
-                                 False)
+        kappa = _curvature_solve(moment, y, wy, wyy, work, mu, alpha, guess, NEWTON_RTOL,
+                                 False)[0]
     return s, limit, p, moment, kappa, force, kappa_full
 
 
