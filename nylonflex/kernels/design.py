@@ -26,9 +26,9 @@ import math
 
 import numpy as np
 from ..physics import specialised
-from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_nodes,
-                               _curvature_rates, _curvature_solve, _curvature_start,
-                               _node_count, _pressure_moment, _section_nodes)
+from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_rates,
+                               _curvature_solve, _curvature_start, _node_count,
+                               _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _curve_factor, _design_state, _design_values, _dynamic_values,
