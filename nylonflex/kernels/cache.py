@@ -13,6 +13,8 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
+from ..storage.files import create_new
+
 __all__ = ["cache_dir", "caching", "mark_compiled", "source_digest", "was_compiled",
            "writable"]
 
@@ -65,9 +67,8 @@ def mark_compiled(family: str) -> None:
     when the folder cannot be written (the kernel then compiles in each process anyway)."""
     try:
         os.makedirs(cache_dir(), exist_ok=True)
-        # never through a link: a mark is ours, and only ever an empty file
-        os.close(os.open(_mark_path(family), os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o644))
-    except OSError:
+        os.close(create_new(_mark_path(family), 0o644))  # never through a link
+    except OSError:  # marked already (FileExistsError), or an unwritable folder
         pass
 
 
