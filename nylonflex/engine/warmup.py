@@ -127,8 +127,8 @@ def warm_up_aside(warm, families, meanwhile) -> float:
         The child was stopped by Ctrl-C or SIGTERM (the terminal stops both processes).
         Whatever ``meanwhile()`` raises is raised, after the child is stopped and reaped.
     """
-    if not _can_fork() or not cache.caching() or not cache.writable() or \
-            all(cache.was_compiled(name) for name in families):
+    if all(cache.was_compiled(name) for name in families) or not _can_fork() or \
+            not cache.caching() or not cache.writable():
         meanwhile()
         return 0.0
     # Numba and the kernels are imported before the fork: the child compiles with them and
