@@ -144,29 +144,36 @@ def _flops_of(x):
     return x
 
 
-def kernel_flops_per_design(cfg, pairs: int = 4) -> float:
-    """Floating-point operations [flop] the paper's grid kernel does per design of ``cfg``
-    (a sweep of the paper's model without a supply), counted on ``pairs`` (radius, wall)
-    pairs spread over the grid, each with all its lengths, coil indices and wrap angles
-    (and its curves)."""
+def counted_kernel(cfg, ia: int, it: int) -> tuple[int, tuple]:
+    """The paper's grid kernel run as Python on counting floats for the (radius, wall) pair
+    (``ia``, ``it``) of ``cfg``, with all its lengths, coil indices and wrap angles (and its
+    curves): the operations [flop] it did, and its outputs (a ``GridOut`` of object arrays
+    of one radius, the pair's wall filled)."""
     from nylonflex.engine.model_slab import grid_axes, grid_out, kernel_inputs
     from nylonflex.kernels import design
     from nylonflex.physics import specialised
 
     body = specialised(design._design_slab, "_design_slab_counted", _PAPER_ONLY=True)
+    grid, inputs = grid_axes(cfg, ia, ia + 1), kernel_inputs(cfg, 0)
+    out = grid_out(cfg, 1)
+    out = type(out)(*(np.empty(a.shape, dtype=object) for a in out))
+    scratch = design.grid_scratch(grid, inputs[2])
+    scratch = type(scratch)(*(np.empty(a.shape, dtype=object) for a in scratch))
+    with counting(body) as count:
+        body(_flops_of(grid), *(_flops_of(v) for v in inputs), out, scratch, it, it + 1)
+        return count(), out
+
+
+def kernel_flops_per_design(cfg, pairs: int = 4) -> float:
+    """Floating-point operations [flop] the paper's grid kernel does per design of ``cfg``
+    (a sweep of the paper's model without a supply), counted on ``pairs`` (radius, wall)
+    pairs spread over the grid (:func:`counted_kernel`)."""
     na, nt = len(cfg.axes["radius"]), len(cfg.axes["wall_thickness"])
     total, designs = 0, 0
-    with counting(body) as count:
-        for j in range(pairs):
-            ia = (na - 1) * j // max(pairs - 1, 1)
-            it = (nt - 1) * (pairs - 1 - j) // max(pairs - 1, 1)
-            grid, inputs = grid_axes(cfg, ia, ia + 1), kernel_inputs(cfg, 0)
-            out = grid_out(cfg, 1)
-            out = type(out)(*(np.empty(a.shape, dtype=object) for a in out))
-            scratch = design.grid_scratch(grid, inputs[2])
-            scratch = type(scratch)(*(np.empty(a.shape, dtype=object) for a in scratch))
-            before = count()
-            body(_flops_of(grid), *(_flops_of(v) for v in inputs), out, scratch, it, it + 1)
-            total += count() - before
-            designs += int(np.prod(out.design.shape[3:]))  # (rows, 1, walls, L, C, psi)
+    for j in range(pairs):
+        ia = (na - 1) * j // max(pairs - 1, 1)
+        it = (nt - 1) * (pairs - 1 - j) // max(pairs - 1, 1)
+        n, out = counted_kernel(cfg, ia, it)
+        total += n
+        designs += int(np.prod(out.design.shape[3:]))  # (rows, 1, walls, L, C, psi)
     return total / designs

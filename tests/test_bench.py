@@ -51,7 +51,6 @@ def test_the_flop_count_counts_each_operation_once_and_runs_the_kernels_own_numb
 
     from nylonflex.engine.model_slab import grid_axes, grid_out, kernel_inputs
     from nylonflex.kernels import design
-    from nylonflex.physics import specialised
     from nylonflex.physics.chamber import _gauge_pressure
 
     suite = load_suite(benchmarks_folder(ROOT))
@@ -61,15 +60,10 @@ def test_the_flop_count_counts_each_operation_once_and_runs_the_kernels_own_numb
         assert count() == 5 and isinstance(p, flops.Flop)
 
     cfg = suite.bench_config(suite.QUICK)
-    body = specialised(design._design_slab, "_design_slab_counted", _PAPER_ONLY=True)
+    n, counted = flops.counted_kernel(cfg, 3, 2)
     grid, inputs = grid_axes(cfg, 3, 4), kernel_inputs(cfg, 0)
-    out, scratch = grid_out(cfg, 1), design.grid_scratch(grid, inputs[2])
-    counted = type(out)(*(np.empty(a.shape, dtype=object) for a in out))
-    work = type(scratch)(*(np.empty(a.shape, dtype=object) for a in scratch))
-    with flops.counting(body) as count:
-        body(flops._flops_of(grid), *(flops._flops_of(v) for v in inputs), counted, work, 2, 3)
-        n = count()
-    design.design_slab_paper(grid, *inputs, out, scratch, 2, 3)
+    out = grid_out(cfg, 1)
+    design.design_slab_paper(grid, *inputs, out, design.grid_scratch(grid, inputs[2]), 2, 3)
     for name, a, b in zip(out._fields, out, counted):
         pair = (slice(None), 0, 2) if name in ("design", "flags") else (0, 2)
         np.testing.assert_array_equal(b[pair].astype(a.dtype).view(np.uint8),
