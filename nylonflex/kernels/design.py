@@ -335,13 +335,13 @@ _PAPER_ONLY = False
 
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
-design_slab = jit_kernel(_design_slab, callee_body=True)
+design_slab = jit_kernel(_design_slab, callee_body=True, borrows=True)
 design_points = jit_kernel(_design_points, callee_body=True)
 #: The grid kernel of the paper's model without a supply (the main job, figure 12): the
 #: same source as :data:`design_slab`, the same numbers bit for bit, about 30 % less to
 #: compile (:func:`grid_kernel` chooses).
 design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper", _PAPER_ONLY=True),
-                               callee_body=True)
+                               callee_body=True, borrows=True)
 
 
 def grid_scratch(grid, nodes):
