@@ -302,9 +302,11 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     mu, alpha = (np.require(x.reshape(-1, x.shape[-1]), float, ["C", "W"]) for x in
                  _silicone_rows(ogden, shape))
     out = PointOut(np.empty((N_FLOAT_DESIGN, n)), np.empty((N_FLAGS, n), dtype=np.int8))
-    args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha),
-            Nodes(*quadrature_nodes()), Muscle(*muscle), Options(*options), P_ATM, out)
-    run_chunks(lambda i0, i1: kernels.design_points(*args, i0, i1), n,
+    nodes = Nodes(*quadrature_nodes())
+    args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha), nodes,
+            Muscle(*muscle), Options(*options), P_ATM, out)
+    run_chunks(lambda i0, i1: kernels.design_points(*args, kernels.point_scratch(nodes), i0,
+                                                    i1), n,
                parallel=n >= _PARALLEL_FROM and not getattr(_SERIAL, "on", False))
     # the kernel's rows by name (kernels.rows, the one table both sides read)
     design = out.design.reshape(N_FLOAT_DESIGN, *shape)

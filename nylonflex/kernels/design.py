@@ -31,7 +31,8 @@ from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_rates,
                                _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _curve_factor, _design_state, _design_values, _dynamic_values,
+                              _curve_factor, _design_state_nodes, _design_values,
+                              _dynamic_values,
                               _length_factor, _model_moment, _model_state_nodes,
                               _nylon_force_model, _reach,
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
@@ -252,14 +253,16 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                             stroke_pressure[js], stroke_hoop[js], a, t, lever)
 
 
-def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, i0, i1):
+def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, table, i0,
+                   i1):
     """Every design variable of the scattered designs i0 <= i < i1 (a thread's chunk).
 
     ``designs`` is a :class:`~.records.PointDesigns`, ``coil`` a
     :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
     design. ``silicone`` holds 2-D arrays (row, term) with one row for all designs or one
-    row a design. The loop body is the one :func:`nylonflex.physics.design_limits` runs, so
-    both give the same numbers.
+    row a design. ``table`` is the thread's node table and scratch (:func:`point_scratch`).
+    The loop body is the one :func:`nylonflex.physics.design_limits` runs, so both give the
+    same numbers.
     """
     radius, wall, base, length, wrap = designs
     s_max_all, f_lim_all, width_all, r_all, loss_all = coil
@@ -289,8 +292,8 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         section = Section(a, t, b)
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
-        st = _design_state(model, voltage, section, length[i], psi, pitch, lever, coil_row,
-                           shape, ogden, nodes, p_atm)
+        st = _design_state_nodes(model, voltage, section, length[i], psi, pitch, lever,
+                                 coil_row, shape, ogden, nodes, table, p_atm)
         (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
          range_fraction, nylon_force_max, nylon_use) = _design_values(
             st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
@@ -336,7 +339,7 @@ _PAPER_ONLY = False
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
 design_slab = jit_kernel(_design_slab, callee_body=True, borrows=True)
-design_points = jit_kernel(_design_points, callee_body=True)
+design_points = jit_kernel(_design_points, callee_body=True, borrows=True)
 #: The grid kernel of the paper's model without a supply (the main job, figure 12): the
 #: same source as :data:`design_slab`, the same numbers bit for bit, about 30 % less to
 #: compile (:func:`grid_kernel` chooses).
@@ -353,6 +356,14 @@ def grid_scratch(grid, nodes):
     return GridScratch(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)),
                        np.empty(npr), np.empty(npr), np.empty(npr), np.empty(ns),
                        np.empty(ns))
+
+
+def point_scratch(nodes):
+    """The pointwise kernel's node table and scratch for the quadrature ``nodes`` (a
+    :class:`~.records.Nodes`): a :class:`~nylonflex.physics.records.NodeTable`, one a
+    thread (each design overwrites it)."""
+    n = _node_count(nodes.x_base, nodes.w_phi)
+    return NodeTable(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)))
 
 
 def grid_kernel(model: int, voltage: float):

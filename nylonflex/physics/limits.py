@@ -17,7 +17,7 @@ from ._formula import (check, check_input, check_section, check_wrap_angle, form
                        scalar_or_array, specialised)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
-                      _taylor_start, quadrature_nodes)
+                      _section_nodes, _taylor_start, quadrature_nodes)
 from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
@@ -302,12 +302,30 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     model without a supply is :func:`_stroke_state` itself; otherwise :func:`_model_state`
     at the reachable temperature (:func:`_reach`).
     """
+    y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
+                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
+    return _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
+                               shape, ogden, nodes, NodeTable(y, wy, wyy, work), p_atm)
+
+
+@formula
+def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
+                        shape, ogden, nodes, table, p_atm):
+    """:func:`_design_state` in a node table and scratch ``table`` (a
+    :class:`~.records.NodeTable` of :func:`~.bending._node_count` nodes, overwritten: the
+    section's nodes from the quadrature's ``nodes``), which it makes no array for: what the
+    pointwise kernel calls, with one table a thread."""
+    y, wy, wyy = table.y, table.wy, table.wyy
+    _section_nodes(section.radius, section.wall, section.base, nodes.x_base, nodes.w_base,
+                   nodes.phi_trig, nodes.w_phi, y, wy, wyy)
+    unsolved = SolvedCurve(y, y, y, y)
     if model == PAPER and voltage <= 0.0:
-        st = _stroke_state(section, lever, coil, 0.0, ogden, nodes, p_atm)
+        st = _stroke_state_nodes(section, lever, coil, 0.0, ogden, table, p_atm, unsolved, 0)
         return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, shape.t_max
     t_reach, s_free, limited = _reach(coil, length, pitch, section, wrap_angle, voltage, shape)
-    ms = _model_state(model, section, lever, coil, s_free,
-                      coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, nodes, p_atm)
+    ms = _model_state_nodes(model, section, lever, coil, s_free,
+                            coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, table,
+                            p_atm, unsolved, 0)
     lf = _length_factor(model, section.radius, length)
     return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
 
