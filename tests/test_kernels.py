@@ -353,6 +353,79 @@ def test_a_callee_body_kernel_takes_plain_positional_parameters():
         _compile.jit_kernel(keyword_only, callee_body=True)
 
 
+def _fill_and_sum(kappa, y, work, mu):
+    # loops over an array argument that Numba's reference-count pruning cannot see through
+    for i in range(y.shape[0]):
+        work[0, i] = 1.0 + kappa * y[i]
+    for j in range(mu.shape[0]):
+        for i in range(y.shape[0]):
+            work[0, i] += mu[j]
+    total = 0.0
+    for i in range(y.shape[0]):
+        total += work[0, i]
+    return total
+
+
+def _sums(kappas, y, work, mu, out):
+    for k in range(kappas.shape[0]):
+        out[k] = _fill_and_sum(kappas[k], y, work, mu)
+
+
+def _makes_an_array(n):
+    return np.empty(n).shape[0]
+
+
+def _calls_maker(n, out):
+    out[0] = _makes_an_array(n)
+
+
+def _reference_counts(kernel) -> int:
+    """Calls of NRT_incref and NRT_decref in what ``kernel`` calls: its body (a callee,
+    jit_kernel(callee_body=True)) and the formulas, not the Python-facing wrapper, which
+    counts the arrays it is given once a call."""
+    ir = kernel.inspect_llvm(kernel.signatures[0])
+    callees = [f for f in re.split(r"\n(?=define )", ir)
+               if f.startswith("define linkonce_odr") and "@NRT_" not in f.split("\n")[0]]
+    assert callees  # the body, and the formula where LLVM did not inline it
+    return sum(len(re.findall(r"call void @NRT_(?:incref|decref)\(", f)) for f in callees)
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="reads Numba's compiled code")
+@pytest.mark.parametrize("borrows", [False, True])
+def test_a_borrowing_kernel_counts_no_references_in_its_formulas(borrows, monkeypatch):
+    # each call of a formula that takes arrays counted them up and down, atomically (a
+    # fifth of the grid kernel's time); a borrowing kernel's formulas count nothing
+    from numba.extending import register_jitable
+
+    monkeypatch.setitem(_compile.JIT_OPTIONS, "cache", False)
+    globals()["_fill_and_sum"] = type(_fill_and_sum)(_fill_and_sum.__code__, globals(),
+                                                     "_fill_and_sum")
+    register_jitable(**_compile.CALLEE_OPTIONS)(globals()["_fill_and_sum"])
+    body = type(_sums)(_sums.__code__, globals(), "_sums")
+    kernel = _compile.jit_kernel(body, callee_body=True, borrows=borrows)
+    y, mu, out = np.linspace(0.0, 1e-2, 16), np.array([1.0, 2.0]), np.zeros(3)
+    kernel(np.array([0.0, 1.0, 2.0]), y, np.zeros((1, 16)), mu, out)
+    np.testing.assert_array_equal(out, [_fill_and_sum(k, y, np.zeros((1, 16)), mu)
+                                        for k in (0.0, 1.0, 2.0)])
+    counts = _reference_counts(kernel)
+    assert (counts == 0) if borrows else (counts > 0)
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiles with Numba")
+def test_a_borrowing_kernel_cannot_call_a_formula_that_makes_an_array(monkeypatch):
+    # without the runtime nothing could free the array: Numba refuses to compile it
+    from numba.extending import register_jitable
+
+    monkeypatch.setitem(_compile.JIT_OPTIONS, "cache", False)
+    register_jitable(**_compile.CALLEE_OPTIONS)(_makes_an_array)
+    body = type(_calls_maker)(_calls_maker.__code__, globals(), "_calls_maker")
+    kernel = _compile.jit_kernel(body, callee_body=True, borrows=True)
+    with pytest.raises(numba.core.errors.TypingError):
+        kernel(3, np.zeros(1))
+    with pytest.raises(TypeError, match="borrows needs callee_body"):
+        _compile.jit_kernel(_calls_maker, borrows=True)
+
+
 @pytest.mark.parametrize("base", ["wall", "fixed"])
 def test_the_paper_kernel_gives_the_general_kernels_bits(base):
     # design_slab_paper is design_slab's source with the variants' and the supply's
