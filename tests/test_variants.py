@@ -94,7 +94,7 @@ def test_compiled_variants_match_the_python_loop(model, voltage):
 
 
 def test_paper_through_the_variant_path_is_the_paper():
-    # a supply too strong to bind sends the paper's model through _model_state: same numbers
+    # a supply too strong to bind sends the paper's model through _model_state_nodes: same numbers
     a = nf.design_limits(**EXAMPLE_1)
     b = nf.design_limits(**EXAMPLE_1, supply_voltage=1000.0)
     for name in a:

@@ -195,36 +195,27 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
 
 
 @formula
-def _model_state(model, section, lever, coil, s_free, force_blocked, supply_limited, ogden,
-                 nodes, p_atm):
+def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
+                       ogden, table, p_atm, curve, n):
     """The length-free design limits of a model variant, with a reachable free stroke.
 
     ``section`` a :class:`~.records.Section`, ``lever`` the wrap's pitch over cos psi [m],
     ``coil`` the :class:`~.records.CoilRow` (F_lim, s_max), ``ogden`` the silicone's
-    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
-    the initial chamber pressure [Pa]. ``s_free`` is the free stroke at the reachable
-    temperature (s_max without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that
-    temperature (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle
-    below T_max. Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0
-    stroke, 1 strength, 2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes``
+    :class:`~.records.Ogden`, ``table`` the section's node table and scratch (a
+    :class:`~.records.NodeTable`, :func:`~.bending._section_nodes`), ``p_atm`` the initial
+    chamber pressure [Pa]. ``s_free`` is the free stroke at the reachable temperature (s_max
+    without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that temperature
+    (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle below
+    T_max. ``n`` solved points of the model's kappa(p) in ``curve`` (a
+    :class:`~.records.SolvedCurve`) start the curvature solves (:func:`_stroke_state_nodes`;
+    none: ``n`` = 0, the full-stroke solve from its own start and the strength-limited one
+    from a second-order Taylor of it).
+
+    Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes): limit 0 stroke, 1
+    strength, 2 supply, 3 load (docs/model.md s. 8, 15, 16); ``closes``
     (``incompressible_wall``) when the chamber would close before s_max, and then kappa_full
     is inf (range fraction 0).
     """
-    y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
-                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
-    return _model_state_nodes(model, section, lever, coil, s_free, force_blocked,
-                              supply_limited, ogden, NodeTable(y, wy, wyy, work), p_atm,
-                              SolvedCurve(y, y, y, y), 0)
-
-
-@formula
-def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
-                       ogden, table, p_atm, curve, n):
-    """:func:`_model_state` on a section's node table and scratch (``table``, a
-    :class:`~.records.NodeTable`), with ``n`` solved points of the model's kappa(p) in
-    ``curve`` (a :class:`~.records.SolvedCurve`) to start the curvature solves from
-    (:func:`_stroke_state_nodes`; none: ``n`` = 0, the full-stroke solve from its own start
-    and the strength-limited one from a second-order Taylor of it)."""
     radius, wall_thickness, base_thickness = section.radius, section.wall, section.base
     force_limit, s_max = coil.force_limit, coil.s_max
     mu, alpha = ogden.mu, ogden.alpha
@@ -299,8 +290,9 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     the initial chamber pressure [Pa].
 
     Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
-    model without a supply is :func:`_stroke_state` itself; otherwise :func:`_model_state`
-    at the reachable temperature (:func:`_reach`).
+    model without a supply is :func:`_stroke_state_nodes` itself; otherwise
+    :func:`_model_state_nodes` at the reachable temperature (:func:`_reach`). It makes the
+    section's node table and runs :func:`_design_state_nodes` in it.
     """
     y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
                                    nodes.w_base, nodes.phi_trig, nodes.w_phi)
@@ -506,28 +498,19 @@ def _validity(bend_angle, kappa, section, stretch_max, turns, closes, efficiency
 
 
 @formula
-def _stroke_state(section, lever, coil, kappa_full, ogden, nodes, p_atm):
-    """The length-free part of the design limits.
+def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, curve, n):
+    """The length-free part of the design limits of the paper's model.
 
     ``section`` a :class:`~.records.Section`, ``lever`` [m], ``coil`` the
     :class:`~.records.CoilRow` (F_lim, s_max), ``ogden`` the silicone's
-    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
-    [Pa]. ``kappa_full`` is the curvature at p(s_max) [1/m] (<= 0: computed here). Returns
-    (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full).
+    :class:`~.records.Ogden`, ``table`` the section's node table and scratch (a
+    :class:`~.records.NodeTable`; :func:`~.bending._section_moment`), ``p_atm`` [Pa].
+    ``kappa_full`` is the curvature at p(s_max) [1/m] (<= 0: computed here). ``n`` solved
+    points of kappa(p) and its first two derivatives in p (``curve``, a
+    :class:`~.records.SolvedCurve` whose first ``n`` entries count,
+    :func:`~.bending._curvature_start`) start the curvature solves (none: ``n`` = 0).
+    Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full).
     """
-    y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
-                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
-    return _stroke_state_nodes(section, lever, coil, kappa_full, ogden,
-                               NodeTable(y, wy, wyy, work), p_atm, SolvedCurve(y, y, y, y), 0)
-
-
-@formula
-def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, curve, n):
-    """:func:`_stroke_state` on a section's node table and scratch (``table``, a
-    :class:`~.records.NodeTable`; :func:`_section_moment`), with ``n`` solved points of
-    kappa(p) and its first two derivatives in p (``curve``, a :class:`~.records.SolvedCurve`
-    whose first ``n`` entries count, :func:`_curvature_start`) to start the curvature solves
-    from (none: ``n`` = 0)."""
     radius, wall_thickness, base_thickness = section.radius, section.wall, section.base
     force_limit, s_max = coil.force_limit, coil.s_max
     mu, alpha = ogden.mu, ogden.alpha
