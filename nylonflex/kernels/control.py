@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from ..physics.bending import _curvature, _material_moment, _pressure_moment
+from ..physics.bending import _curvature_nodes, _node_table, _pressure_moment, _section_moment
 from ..physics.chamber import _gauge_pressure
 from ..physics.nylon import _stroke_shape
 from ..physics.thermal import _temperature_step
@@ -57,13 +57,15 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
     """
     kappa = 0.0
     lever = _pressure_moment(1.0, radius, base_thickness)  # dM_P/dp: M_P is linear in p
+    # the section's node table once a table (physics' _curvature and _material_moment
+    # make one a call, the same numbers: two a point)
+    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
+                                   phi_trig, w_phi)
     for k in range(out_angle.shape[0]):
         # warm start from the previous grid point: a few Halley steps each
-        kappa = _curvature(lever * (k * pressure_step), radius, wall_thickness,
-                           base_thickness, mu, alpha, x_base, w_base, phi_trig, w_phi, kappa,
-                           rtol)
-        _, stiffness = _material_moment(kappa, radius, wall_thickness, base_thickness, mu,
-                                        alpha, x_base, w_base, phi_trig, w_phi)
+        kappa = _curvature_nodes(lever * (k * pressure_step), y, wy, wyy, work, mu, alpha,
+                                 kappa, rtol, False)
+        stiffness = _section_moment(kappa, y, wy, wyy, work, mu, alpha, False)[1]
         out_angle[k] = kappa * length
         out_slope[k] = length * lever / stiffness
 
