@@ -22,7 +22,7 @@ import nylonflex.physics as ph
 from nylonflex.cli import main
 from nylonflex.materials import silicone_parameters
 from nylonflex.kernels.control import _switch, angle_table, estimate_angle, plant_angle
-from nylonflex.physics.bending import NEWTON_RTOL, quadrature_nodes
+from nylonflex.physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from nylonflex.sim import (
     PLANT_TABLE_POINTS,
     parse_sim_config,
@@ -97,7 +97,9 @@ def _tables(points, p_top=24e3):
     mu, alpha = silicone_parameters("tc5005").arrays()
     dp = p_top / (points - 1)
     angle, slope = np.empty(points), np.empty(points)
-    angle_table(dp, A, T, T, L, mu, alpha, *quadrature_nodes(), NEWTON_RTOL, angle, slope)
+    nodes = quadrature_nodes()
+    angle_table(dp, A, T, T, L, mu, alpha, *nodes, NEWTON_RTOL, node_scratch(nodes), angle,
+                slope)
     return dp, angle, slope
 
 

@@ -25,7 +25,7 @@ from ..materials import (NYLON_PARAMETERS, NYLON_TABLES, SILICONE_PARAMETERS, Ny
                          check_nylon, check_silicone, cooling_parameters, nylon_parameters,
                          silicone_kind, silicone_parameters)
 from ..physics import check_input, check_section, check_wrap_angle
-from ..physics.bending import quadrature_nodes
+from ..physics.bending import node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
@@ -305,8 +305,7 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     nodes = Nodes(*quadrature_nodes())
     args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha), nodes,
             Muscle(*muscle), Options(*options), P_ATM, out)
-    run_chunks(lambda i0, i1: kernels.design_points(*args, kernels.point_scratch(nodes), i0,
-                                                    i1), n,
+    run_chunks(lambda i0, i1: kernels.design_points(*args, node_scratch(nodes), i0, i1), n,
                parallel=n >= _PARALLEL_FROM and not getattr(_SERIAL, "on", False))
     # the kernel's rows by name (kernels.rows, the one table both sides read)
     design = out.design.reshape(N_FLOAT_DESIGN, *shape)

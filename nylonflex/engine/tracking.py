@@ -20,7 +20,7 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..kernels.rows import N_TRACKING, TRACKING_ROWS
-from ..physics.bending import NEWTON_RTOL, quadrature_nodes
+from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import stroke, stroke_scale
 from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length, \
@@ -131,7 +131,7 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     slope = np.empty_like(kappa)
     run_chunks(lambda q0, q1: kt.kappa_tables(
         p_group, a, t, -1.0 if base is None else base, mu, alpha, *nodes, NEWTON_RTOL,
-        kappa, slope, q0, q1), len(a) * len(t), parallel=parallel)
+        node_scratch(nodes), kappa, slope, q0, q1), len(a) * len(t), parallel=parallel)
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
     muscle = (np.ascontiguousarray(np.atleast_1d(coil_resistance_per_length(C, ny)), float),
               ny.heat_capacity_per_length,
@@ -152,7 +152,8 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     args = ((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
             kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
             bandwidth, sensor_noise(spec, _longest_run(spec)), out)
-    run_chunks(lambda q0, q1: kt.track_slab(*args, q0, q1), lm.size, parallel=parallel)
+    run_chunks(lambda q0, q1: kt.track_slab(*args, kt.track_scratch(nodes, spec.table_points),
+                                            q0, q1), lm.size, parallel=parallel)
     wanted = tracking_variables(cfg)
     return {name: out[row].reshape(lm.shape) for name, row in TRACKING_ROWS.items()
             if name in wanted}

@@ -22,18 +22,18 @@ import math
 
 import numpy as np
 
-from ..physics.bending import _curvature_nodes, _node_table, _pressure_moment, _section_moment
+from ..physics.bending import (_curvature_nodes, _pressure_moment, _section_moment,
+                               _section_nodes)
 from ..physics.chamber import _gauge_pressure
 from ..physics.nylon import _stroke_shape
 from ..physics.thermal import _temperature_step
 from ._compile import jit_kernel
 
-__all__ = ["angle_table", "closed_loop", "estimate_angle", "plant_angle"]
+__all__ = ["angle_table", "closed_loop", "estimate_angle", "loop_state", "plant_angle"]
 
 
-@jit_kernel
-def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, mu, alpha,
-                x_base, w_base, phi_trig, w_phi, rtol, out_angle, out_slope):
+def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, mu, alpha,
+                 x_base, w_base, phi_trig, w_phi, rtol, table, out_angle, out_slope):
     """Bend angle theta(p_k) = kappa(p_k) L and its slope at p_k = k dp [rad], [rad/Pa].
 
     Parameters
@@ -48,19 +48,25 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
         Gauss-Legendre nodes and weights (``physics.bending.quadrature_nodes()``).
     rtol : float
         Tolerance of the curvature solve [-] (``physics.bending.NEWTON_RTOL``).
+    table : NodeTable
+        The section's node table and scratch, overwritten
+        (:func:`nylonflex.physics.bending.node_scratch` of the same nodes).
     out_angle, out_slope : ndarray, shape (points,)
         Written with theta(p_k) [rad] and d theta/dp [rad/Pa].
 
     Notes
     -----
     d theta/dp = L (dM_P/dp) / (dM_S/dkappa), from the moment balance M_S(kappa) = M_P(p).
+    The section's node table is filled once a table (physics' ``_curvature`` and
+    ``_material_moment`` make one a call: two a point, the same numbers); each point's
+    curvature is solved in it, warm-started from the previous point's, and its stiffness
+    evaluated there.
     """
+    y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
+    _section_nodes(radius, wall_thickness, base_thickness, x_base, w_base, phi_trig, w_phi, y,
+                   wy, wyy)
     kappa = 0.0
     lever = _pressure_moment(1.0, radius, base_thickness)  # dM_P/dp: M_P is linear in p
-    # the section's node table once a table (physics' _curvature and _material_moment
-    # make one a call, the same numbers: two a point)
-    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                                   phi_trig, w_phi)
     for k in range(out_angle.shape[0]):
         # warm start from the previous grid point: a few Halley steps each
         kappa = _curvature_nodes(lever * (k * pressure_step), y, wy, wyy, work, mu, alpha,
@@ -68,6 +74,11 @@ def angle_table(pressure_step, radius, wall_thickness, base_thickness, length, m
         stiffness = _section_moment(kappa, y, wy, wyy, work, mu, alpha, False)[1]
         out_angle[k] = kappa * length
         out_slope[k] = length * lever / stiffness
+
+
+#: The angle table, from Python (``nylonflex simulate``) and from the tracking kernels; it
+#: makes no array (the caller's node table), so it borrows (``jit_kernel``).
+angle_table = jit_kernel(_angle_table, callee_body=True, borrows=True)
 
 
 @jit_kernel
@@ -195,8 +206,7 @@ def _duty(kind, on, integral, estimate, reference, half_band, gain, integral_ste
     return duty, duty > 0.0, integral
 
 
-@jit_kernel
-def closed_loop(supply, muscles, tables_, control, out):
+def _closed_loop(supply, muscles, tables_, control, state, out):
     """Step the closed loop of ``n`` actuators on one supply through ``m`` samples.
 
     At sample k each actuator's chamber pressure is read (plus ``noise``), turned into an
@@ -225,6 +235,9 @@ def closed_loop(supply, muscles, tables_, control, out):
         (n, m) [rad] and ``noise`` (n, m) additive pressure-sensor noise [Pa] at each sample;
         ``kind`` (n,) int64, 0 bang-bang, 1 PI; ``gain`` (n,) [1/rad] and ``integral_step``
         (n,) dt/T_i [-] of a PI (:func:`_duty`).
+    state : tuple
+        The loop's state, arrays (n,), as :func:`loop_state` starts it (overwritten):
+        temperature [K], estimate [rad], on (bool), duty [-], the PI's integral [rad].
     out : :class:`~.records.SimOut`, arrays (n, m)
         Written: temperature [K], stroke [-], pressure [Pa], angle [rad], estimate [rad],
         voltage [V], current [A] and electric power [W] at each sample; the voltage is the
@@ -237,14 +250,9 @@ def closed_loop(supply, muscles, tables_, control, out):
     half_band, filter_keep, reference, noise, kind, gain, integral_step = control
     (out_temperature, out_stroke, out_pressure, out_angle, out_estimate, out_voltage,
      out_current, out_power) = out
+    temperature, estimate, on, duty, integral = state
     n = muscle_length.shape[0]
     m = reference.shape[1]
-    temperature = t_start.copy()
-    estimate = np.zeros(n)
-    on = np.zeros(n, dtype=np.bool_)
-    duty = np.zeros(n)
-    integral = np.zeros(n)
-    resistance = r_per_len * muscle_length
     for k in range(m):
         conductance = 0.0
         for j in range(n):
@@ -261,7 +269,7 @@ def closed_loop(supply, muscles, tables_, control, out):
                                                 reference[j, k], half_band[j], gain[j],
                                                 integral_step[j])
             if on[j]:
-                conductance += duty[j] / resistance[j]
+                conductance += duty[j] / (r_per_len[j] * muscle_length[j])
             out_temperature[j, k] = t_j
             out_stroke[j, k] = s
             out_pressure[j, k] = p
@@ -271,9 +279,24 @@ def closed_loop(supply, muscles, tables_, control, out):
         terminal = supply_voltage / (1.0 + internal_resistance * conductance)
         for j in range(n):
             v = terminal * math.sqrt(duty[j]) if on[j] else 0.0
+            resistance = r_per_len[j] * muscle_length[j]
             out_voltage[j, k] = v
-            out_current[j, k] = v / resistance[j]
-            out_power[j, k] = v * v / resistance[j]
+            out_current[j, k] = v / resistance
+            out_power[j, k] = v * v / resistance
             temperature[j] = _temperature_step(temperature[j], v, dt, muscle_length[j],
                                                t_amb[j], r_per_len[j], c_per_len[j],
                                                loss_per_len[j])
+
+
+#: The closed loop; its state comes from the caller (:func:`loop_state`), so it makes no
+#: array and borrows (``jit_kernel``).
+closed_loop = jit_kernel(_closed_loop, callee_body=True, borrows=True)
+
+
+def loop_state(t_start) -> tuple:
+    """The state :data:`closed_loop` starts from, for the actuators' initial temperatures
+    ``t_start`` (n,) [K]: temperature (a copy), estimate 0 [rad], off, duty 0 [-],
+    integral 0 [rad]."""
+    n = len(t_start)
+    return (np.array(t_start, dtype=float), np.zeros(n), np.zeros(n, dtype=np.bool_),
+            np.zeros(n), np.zeros(n))

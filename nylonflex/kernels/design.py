@@ -260,7 +260,8 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
     ``designs`` is a :class:`~.records.PointDesigns`, ``coil`` a
     :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
     design. ``silicone`` holds 2-D arrays (row, term) with one row for all designs or one
-    row a design. ``table`` is the thread's node table and scratch (:func:`point_scratch`).
+    row a design. ``table`` is the thread's node table and scratch
+    (:func:`nylonflex.physics.bending.node_scratch`).
     The loop body is the one :func:`nylonflex.physics.design_limits` runs, so both give the
     same numbers.
     """
@@ -356,14 +357,6 @@ def grid_scratch(grid, nodes):
     return GridScratch(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)),
                        np.empty(npr), np.empty(npr), np.empty(npr), np.empty(ns),
                        np.empty(ns))
-
-
-def point_scratch(nodes):
-    """The pointwise kernel's node table and scratch for the quadrature ``nodes`` (a
-    :class:`~.records.Nodes`): a :class:`~nylonflex.physics.records.NodeTable`, one a
-    thread (each design overwrites it)."""
-    n = _node_count(nodes.x_base, nodes.w_phi)
-    return NodeTable(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)))
 
 
 def grid_kernel(model: int, voltage: float):

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from ..physics.bending import node_scratch
 from ..physics.chamber import _gauge_pressure
 from ..physics.nylon import _stroke_shape
 from ..physics.thermal import _temperature_step
@@ -27,13 +28,14 @@ from .control import _duty, angle_table, estimate_angle, plant_angle
 from .rows import (ROW_TRACKING_BANDWIDTH, ROW_TRACKING_ENERGY, ROW_TRACKING_MAX_TEMPERATURE,
                    ROW_TRACKING_RMS_ERROR)
 
-__all__ = ["kappa_tables", "run_loop", "track_slab"]
+__all__ = ["kappa_tables", "run_loop", "track_scratch", "track_slab"]
 
 def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig, w_phi,
-                  rtol, out_kappa, out_slope, q0, q1):
+                  rtol, table, out_kappa, out_slope, q0, q1):
     """kappa(k dp) [1/m] and d kappa/dp [1/(m Pa)], dp = p_max[i, j] / (points - 1), of
     the (radius i, wall j) pairs q0 <= q = i nt + j < q1 (a thread's chunk); ``base`` <= 0
-    means b = t. NaN rows where p_max is NaN."""
+    means b = t. NaN rows where p_max is NaN. ``table`` is the thread's node table and
+    scratch (:func:`nylonflex.physics.bending.node_scratch`)."""
     na, nt = p_max.shape
     points = out_kappa.shape[2]
     for q in range(q0, q1):
@@ -42,14 +44,14 @@ def _kappa_tables(p_max, radius, wall, base, mu, alpha, x_base, w_base, phi_trig
         b = wall[j] if base <= 0.0 else base
         if p_max[i, j] > 0.0:
             angle_table(p_max[i, j] / (points - 1), radius[i], wall[j], b, 1.0, mu, alpha,
-                        x_base, w_base, phi_trig, w_phi, rtol, out_kappa[i, j],
+                        x_base, w_base, phi_trig, w_phi, rtol, table, out_kappa[i, j],
                         out_slope[i, j])
         else:
             out_kappa[i, j, :] = np.nan
             out_slope[i, j, :] = np.nan
 
 
-kappa_tables = jit_kernel(_kappa_tables)
+kappa_tables = jit_kernel(_kappa_tables, callee_body=True, borrows=True)
 
 
 @jit_kernel
@@ -150,17 +152,18 @@ def _one_design(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t
                 points, mu, alpha, x_base, w_base, phi_trig, w_phi, rtol, plant_step, kappa,
                 kappa_slope, kind, half_band, gain, integral_step, filter_keep, noise,
                 ref_kind, mean, amplitude, frequency, phase, initial, final, at, rms_from,
-                bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods):
+                bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods, est, scratch,
+                table):
     """(rms error, highest temperature, energy, bandwidth) of one design; NaN when its
     ``p_top`` is NaN. Its estimator table is ``nylonflex simulate``'s: ``points`` angles
-    on p_top / (points - 1), from the same curvature solve (:func:`.control.angle_table`)."""
+    on p_top / (points - 1), from the same curvature solve (:func:`.control.angle_table`),
+    written into ``est`` (its slopes into ``scratch``, both of ``points`` entries) in the
+    node table ``table``: the thread's (:func:`track_scratch`)."""
     if not p_top > 0.0:
         return math.nan, math.nan, math.nan, math.nan
-    est = np.empty(points)
-    scratch = np.empty(points)
     est_step = p_top / (points - 1)
     angle_table(est_step, radius, wall, base, length, mu, alpha, x_base, w_base, phi_trig,
-                w_phi, rtol, est, scratch)
+                w_phi, rtol, table, est, scratch)
     rms, t_top, energy = run_loop(dt, m, voltage, p_atm, lm, r_per_len, c_per_len,
                                   loss_per_len, t_amb, t_start, scale, gamma, beta, t_g,
                                   sigma_g, length, plant_step, kappa, kappa_slope, est_step,
@@ -179,7 +182,8 @@ def _one_design(dt, m, voltage, p_atm, lm, r_per_len, c_per_len, loss_per_len, t
 
 
 def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, muscle,
-                silicone, nodes, rtol, settings, reference, bandwidth, noise, out, q0, q1):
+                silicone, nodes, rtol, settings, reference, bandwidth, noise, out, scratch,
+                q0, q1):
     """Every design's tracking metrics into ``out`` (4, n), designs in C order of the
     slab's (radius, wall, length, coil, wrap).
 
@@ -220,6 +224,8 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
         Written, in the rows of :mod:`.rows` (``ROW_TRACKING_*``, the registry's
         ``TRACKING`` order): rms error [rad], highest temperature [K], energy [J],
         bandwidth [Hz].
+    scratch : tuple
+        The thread's estimator table, its slopes and node table (:func:`track_scratch`).
     q0, q1 : int
         The designs q0 <= q < q1 of that C order are computed (a thread's chunk).
     """
@@ -231,6 +237,7 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
      filter_keep) = settings
     ref_kind, mean, amplitude, frequency, phase, initial, final, at, rms_from = reference
     bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods = bandwidth
+    est, est_slope, table = scratch
     na, nt, nl, nc, nw = lm.shape
     plant_points = kappa.shape[2]
     for q in range(q0, q1):
@@ -249,7 +256,8 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
             phi_trig, w_phi, rtol, p_group[i, j] / (plant_points - 1), kappa[i, j],
             kappa_slope[i, j], kind, half_band, gain, integral_step, filter_keep, noise,
             ref_kind, g * mean, g * amplitude, frequency, phase, g * initial, g * final, at,
-            rms_from, bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods)
+            rms_from, bw_on, bw_error, bw_low, bw_high, bw_iterations, bw_periods, est,
+            est_slope, table)
         out[ROW_TRACKING_RMS_ERROR, q] = tracking_rms_error
         out[ROW_TRACKING_MAX_TEMPERATURE, q] = tracking_max_temperature
         out[ROW_TRACKING_ENERGY, q] = tracking_energy
@@ -257,4 +265,11 @@ def _track_slab(axes, lm, p_top, scale, ref_scale, p_group, kappa, kappa_slope, 
 
 
 #: The compiled loop, for threaded runs (chunks on the engine's threads) and serial ones.
-track_slab = jit_kernel(_track_slab)
+track_slab = jit_kernel(_track_slab, callee_body=True, borrows=True)
+
+
+def track_scratch(nodes, points: int) -> tuple:
+    """A thread's working arrays for :data:`track_slab`: the estimator table and its slopes
+    (``points`` entries each) and a node table for the quadrature ``nodes``
+    (:func:`nylonflex.physics.bending.node_scratch`)."""
+    return np.empty(points), np.empty(points), node_scratch(nodes)

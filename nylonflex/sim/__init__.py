@@ -41,7 +41,7 @@ from ..config.simulate import (  # noqa: F401 - the config layer's names, import
     top_temperature,
 )
 from ..kernels.records import AngleTables, Control, Muscles, SimOut, Supply
-from ..physics.bending import NEWTON_RTOL, quadrature_nodes
+from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length
@@ -176,7 +176,7 @@ def _tables(a: ActuatorSpec, p_top: float):
     mu, alpha = a.silicone.arrays()
     nodes = quadrature_nodes()
     geom = (a.radius, a.wall_thickness, a.base_thickness, a.length, mu, alpha, *nodes,
-            NEWTON_RTOL)
+            NEWTON_RTOL, node_scratch(nodes))
     dp_plant = p_top / (PLANT_TABLE_POINTS - 1)
     plant = np.empty(PLANT_TABLE_POINTS)
     slope = np.empty(PLANT_TABLE_POINTS)
@@ -213,7 +213,7 @@ def run_simulation(cfg: SimConfig):
     """
     import xarray as xr
 
-    from ..kernels.control import closed_loop
+    from ..kernels.control import closed_loop, loop_state
 
     n, m = len(cfg.actuators), cfg.n_steps
     t = np.arange(m) * cfg.step
@@ -263,7 +263,7 @@ def run_simulation(cfg: SimConfig):
     out = SimOut(outs["temperature"], outs["stroke"], outs["pressure"], outs["bend_angle"],
                  outs["bend_angle_estimate"], outs["voltage"], outs["current"], outs["power"])
     tic = time.perf_counter()
-    closed_loop(supply, muscles, tables, control, out)
+    closed_loop(supply, muscles, tables, control, loop_state(arr["t0"]), out)
     loop_time = time.perf_counter() - tic
     outs["bend_angle_reference"] = reference
 
