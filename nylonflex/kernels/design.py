@@ -26,9 +26,9 @@ import math
 
 import numpy as np
 from ..physics import specialised
-from ..physics.bending import (MOMENT_WORK_ROWS, NEWTON_RTOL, _curvature_rates,
-                               _curvature_solve, _curvature_start, _node_count,
-                               _pressure_moment, _section_nodes)
+from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
+                               _curvature_start, _pressure_moment, _section_nodes,
+                               node_scratch)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               _curve_factor, _design_state_nodes, _design_values,
@@ -351,12 +351,11 @@ design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper", _
 def grid_scratch(grid, nodes):
     """The grid kernel's working arrays for a call on ``grid`` (a :class:`~.records.GridAxes`)
     with the quadrature ``nodes`` (a :class:`~.records.Nodes`): a
-    :class:`~.records.GridScratch`, one a thread (each call fills what it reads)."""
-    n = _node_count(nodes.x_base, nodes.w_phi)
+    :class:`~.records.GridScratch`, one a thread (each call fills what it reads): the
+    section's node table (:func:`~nylonflex.physics.bending.node_scratch`) and the curves."""
     npr, ns = len(grid.pressure), len(grid.stroke)
-    return GridScratch(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)),
-                       np.empty(npr), np.empty(npr), np.empty(npr), np.empty(ns),
-                       np.empty(ns))
+    return GridScratch(*node_scratch(nodes), np.empty(npr), np.empty(npr), np.empty(npr),
+                       np.empty(ns), np.empty(ns))
 
 
 def grid_kernel(model: int, voltage: float):
