@@ -152,6 +152,20 @@ class SweepConfig(_Strict):
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
+    @field_validator("fidelity", mode="before")
+    @classmethod
+    def _fidelity_form(cls, value):
+        """One line for a fidelity of neither form (a union's first branch would name only
+        ``'spread'``)."""
+        if isinstance(value, dict) and set(value) - {"spread"}:
+            extra = sorted(str(k) for k in set(value) - {"spread"})[0]
+            raise ValueError(f"unknown key {short(extra)}; accepted: spread")
+        if value is None or value == "spread" or (
+                isinstance(value, dict) and isinstance(value.get("spread"), list)):
+            return value
+        raise ValueError("must be 'spread' or {spread: [variant, ...]} with at least two of "
+                         f"{', '.join(MODELS)}")
+
 
 @dataclass(frozen=True)
 class ResolvedConfig:
