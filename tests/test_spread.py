@@ -269,3 +269,17 @@ def test_the_explorer_pairs_each_variable_with_its_range(spread_cube):
     assert args["bands"][names.index("nylon_use")] is None
     assert ", ".join(VARIANTS) in args["spreadnote"]
     assert p["validity_any"] is not None and p["validity_any"].size == p["data"][j].size
+
+
+def test_each_cooling_slice_of_the_range_is_its_own_sweep():
+    # a supply puts the headline variables on the cooling dimension: so is their range
+    raw = _with(fidelity={"spread": ["paper", "incompressible_wall"]},
+                supply={"voltage": 12}, cooling=["still_air", "still_water"])
+    ds = nf.run_sweep(parse_config(raw))
+    for name in SPREAD:
+        assert ds[name].dims[-1] == "cooling", name
+    for label_, one_set in zip(["still_air", "still_water"], raw["cooling"]):
+        one = nf.run_sweep(parse_config({**raw, "cooling": one_set}))
+        for name in SPREAD:
+            assert ds[name].sel(cooling=label_).values.tobytes() == \
+                one[name].values.tobytes(), name
