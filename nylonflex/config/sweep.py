@@ -22,7 +22,7 @@ from typing import Annotated, Any, Literal, Union
 
 import numpy as np
 import yaml
-from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
+from pydantic import BeforeValidator, Field, ValidationError, field_validator, model_validator
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
@@ -124,7 +124,9 @@ class Spread(_Strict):
     """``fidelity: {spread: [variant, ...]}``: the model variants whose range the cube
     stores beside each headline value (docs/model.md s. 22)."""
 
-    spread: list[str]
+    # checked by _spread (one line naming the entry); the schema lists the variants
+    spread: list[str] = Field(json_schema_extra={"items": {"enum": list(MODELS)},
+                                                 "minItems": 2, "uniqueItems": True})
 
 
 class SweepConfig(_Strict):
