@@ -283,3 +283,36 @@ def test_each_cooling_slice_of_the_range_is_its_own_sweep():
         for name in SPREAD:
             assert ds[name].sel(cooling=label_).values.tobytes() == \
                 one[name].values.tobytes(), name
+
+
+@pytest.mark.slow
+def test_the_explorer_read_out_shows_the_range_in_a_browser(spread_file, tmp_path):
+    import os
+
+    if not os.path.exists("/usr/bin/chromium"):
+        pytest.skip("no Chromium at /usr/bin/chromium (.ci/run installs it)")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    pytest.importorskip("bokeh")
+    from nylonflex.explore.page import DEFAULT_DESIGN
+    from nylonflex.variables import to_display
+
+    page_file = tmp_path / "page.html"
+    assert main(["explore", str(spread_file), "--html", str(page_file)]) == 0
+    with open_cube(spread_file) as ds:
+        at = ds.sel(DEFAULT_DESIGN, method="nearest")
+        want = [float(to_display("tip_force_max", at[spread_name("tip_force_max", s)]))
+                for s in ("lo", "hi")]
+    with sync_api.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium",
+                                    args=["--headless", "--no-sandbox", "--disable-gpu"])
+        try:
+            page = browser.new_page(viewport={"width": 1300, "height": 1000})
+            page.goto(page_file.as_uri())
+            page.wait_for_selector("#nf-spread", timeout=60_000)
+            shown = page.locator("#nf-spread")
+            got = [float(shown.get_attribute(f"data-{s}")) for s in ("lo", "hi")]
+            assert got == pytest.approx(want, rel=1e-6)  # float32 on the page
+            assert ", ".join(VARIANTS) in shown.inner_text()
+            assert page.locator("#nf-validity-any").count() == 1
+        finally:
+            browser.close()
