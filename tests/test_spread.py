@@ -250,7 +250,7 @@ def test_fig12_draws_the_range_and_names_the_examples(spread_cube):
         with_band, without = draw(spread_cube), draw(plain)
         assert bars(with_band) > bars(without), draw.__name__
         texts = " ".join(t.get_text() for t in with_band.findobj(Text))
-        assert "range over 3 models" in texts, draw.__name__
+        assert "over 3 model variants" in texts, draw.__name__
         assert "(models " in texts  # the paper's example names its range
         assert ", ".join(VARIANTS) in texts.replace("\n", " ")
 

@@ -365,8 +365,7 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                                        fixed=wrap_angle is not None)
             load, bits = load | drew, bits | flags
             _quantile_bands(ax, one, "torque_max", sel, coils, psi_ref)
-            model_bands(ax, one, "torque_max", sel, coils, psi_ref,
-                        note_at=(0.99, 0.07 if "quantile" in one.coords else 0.01))
+            model_bands(ax, one, "torque_max", sel, coils, psi_ref, note_at=None)
             _examples(ax, one, "torque_max", t, coils=coils, brief=many)
             ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
                          f"{model}\n{_eq('wall_thickness', t)}",
@@ -383,7 +382,7 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
               "any length (M* does not depend on L; tip force = M*/L)" +
               (f"\none column per model ({len(models)}), one scale along each row"
-               if many else "") + legend_text(ds))
+               if many else "") + legend_text(ds, psi_ref))
     _footer(fig, ds)
     return fig
 
@@ -441,8 +440,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             load, bits = load | drew, bits | flags
             _quantile_bands(top, one, "bend_angle_max", sel, coils, psi,
                             note_at=(0.02, 0.98))
-            model_bands(top, one, "bend_angle_max", sel, coils, psi,
-                        note_at=(0.02, 0.91 if "quantile" in one.coords else 0.98))
+            model_bands(top, one, "bend_angle_max", sel, coils, psi, note_at=None)
             _examples(top, one, "bend_angle_max", t, length, corner="lower right",
                       coils=coils, brief=many)
             top.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
@@ -479,7 +477,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
               f"{_eq('length', length)} (the angle grows in proportion to L; "
               "the range fraction does not)" +
               (f"\none column per model ({len(models)}), one scale along each row"
-               if many else "") + legend_text(ds))
+               if many else "") + legend_text(ds, psi))
     _footer(fig, ds)
     return fig
 

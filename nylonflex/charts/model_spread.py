@@ -103,11 +103,12 @@ def example_range(ds, var, at) -> str:
     return f" (models {lo:.3g}-{hi:.3g}{'' if unit == '1' else ' ' + unit})"
 
 
-def legend_text(ds) -> str:
-    """The suptitle's lines on a cube's model spread (wrapped), "" without one."""
+def legend_text(ds, wrap_angle) -> str:
+    """The suptitle's lines on a cube's model spread, its bars drawn at ``wrap_angle``
+    [rad] (wrapped), "" without one."""
     variants = spread_variants(ds)
     if not variants:
         return ""
     return "\n" + "\n".join(textwrap.wrap(
-        "bars: the lowest to the highest value over the model variants "
-        f"{', '.join(variants)} (fidelity: spread)", 110))
+        f"bars at {_eq('wrap_angle', wrap_angle)}: the lowest to the highest value over "
+        f"{len(variants)} model variants, {', '.join(variants)} (fidelity: spread)", 110))
