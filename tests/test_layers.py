@@ -11,6 +11,8 @@ neither numba, xarray nor matplotlib. Imports sit at module top unless they are 
 """
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -149,6 +151,38 @@ def test_physics_imports_no_numba_xarray_matplotlib():
             for name in names:
                 assert name.split(".")[0] not in ("numba", "xarray", "matplotlib", "h5py",
                                                   "h5netcdf"), (path, name)
+
+
+#: Modules outside kernels/ that still compile with Numba, each with its reason: the FE
+#: twin's Ogden material (its stress and tangent at every quadrature point, 8-27 a cell).
+NUMBA_OUTSIDE_KERNELS = {"nylonflex/fe/ogden.py"}
+
+
+def test_numba_is_imported_in_kernels_only():
+    """All of Numba sits behind kernels/ (the performance fence, docs/architecture.md):
+    a module elsewhere that imports it, even lazily inside a function, is listed here."""
+    found = set()
+    for path in PKG.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level \
+                else []
+            if any(n.split(".")[0] in ("numba", "llvmlite") for n in names):
+                found.add(path.relative_to(PKG.parent).as_posix())
+    outside = {p for p in found if not p.startswith("nylonflex/kernels/")}
+    assert outside == NUMBA_OUTSIDE_KERNELS
+
+
+def test_importing_the_package_changes_nothing_in_the_process():
+    """``import nylonflex`` (and reading its version) loads no Numba, registers no Numba
+    event listener and patches no module: a notebook that imports nylonflex beside its own
+    Numba code sees Numba as it was."""
+    code = ("import sys, nylonflex; nylonflex.__version__; dir(nylonflex); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('numba', 'llvmlite', 'scipy', 'xarray', 'matplotlib', 'h5py')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "[]"
 
 
 def test_charts_compute_no_physics():
