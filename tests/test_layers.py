@@ -153,9 +153,8 @@ def test_physics_imports_no_numba_xarray_matplotlib():
                                                   "h5netcdf"), (path, name)
 
 
-#: Modules outside kernels/ that still compile with Numba, each with its reason: the FE
-#: twin's Ogden material (its stress and tangent at every quadrature point, 8-27 a cell).
-NUMBA_OUTSIDE_KERNELS = {"nylonflex/fe/ogden.py"}
+#: Modules outside kernels/ that import Numba, each with its reason (none).
+NUMBA_OUTSIDE_KERNELS = set()
 
 
 def test_numba_is_imported_in_kernels_only():
