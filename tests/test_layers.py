@@ -184,6 +184,25 @@ def test_importing_the_package_changes_nothing_in_the_process():
     assert out == "[]"
 
 
+#: The most positional parameters a function of the package may take: past it, a record
+#: (kernels/records.py, physics/records.py) carries the group.
+MAX_POSITIONAL = 12
+#: Functions still past it, each to be given records.
+TOO_MANY_POSITIONAL = {"nylonflex/physics/limits.py:_design_state_nodes",
+                       "nylonflex/physics/bending.py:_curvature_of",
+                       "nylonflex/fe/solve.py:_increments"}
+
+
+def test_no_function_takes_more_than_twelve_positional_arguments():
+    found = set()
+    for path in PKG.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and \
+                    len(node.args.posonlyargs) + len(node.args.args) > MAX_POSITIONAL:
+                found.add(f"{path.relative_to(PKG.parent).as_posix()}:{node.name}")
+    assert found == TOO_MANY_POSITIONAL
+
+
 def test_charts_compute_no_physics():
     for path, module, target in _edges():
         if _unit(module) == "charts":
