@@ -121,6 +121,8 @@ LoopControl = namedtuple("LoopControl", "kind half_band gain integral_step filte
 LoopReference = namedtuple("LoopReference", "kind mean amplitude frequency phase initial "
                                             "final at rms_from")
 
-#: The estimator table of one design: the top pressure ``p_top`` [Pa] (NaN: no loop), its
-#: ``points`` and the curvature solve's ``rtol`` [-].
-TableSpec = namedtuple("TableSpec", "p_top points rtol")
+#: The estimator table of one design: its ``section`` (a :class:`Section` [m]), the top
+#: pressure ``p_top`` [Pa] (NaN: no loop), its ``points``, the ``silicone``
+#: (:class:`Ogden`), the quadrature ``nodes`` (:class:`Nodes`) and the curvature solve's
+#: ``rtol`` [-].
+TableSpec = namedtuple("TableSpec", "section p_top points silicone nodes rtol")

@@ -148,11 +148,10 @@ def _bandwidth(dt, noise, muscle, plant, estimator, control, mean, amplitude, se
 
 
 @jit_kernel
-def _one_design(dt, m, noise, muscle, section, silicone, nodes, spec, plant, control,
-                reference, search, scratch):
+def _one_design(dt, m, noise, muscle, spec, plant, control, reference, search, scratch):
     """(rms error, highest temperature, energy, bandwidth) of one design; NaN when its
     ``spec.p_top`` is NaN. Its estimator table is ``nylonflex simulate``'s: ``spec.points``
-    angles on p_top / (points - 1), from the same curvature solve of the ``section``
+    angles on p_top / (points - 1), from the same curvature solve of its section
     (:func:`.control.angle_table`), written into the thread's ``scratch`` (the table, its
     slopes and the node table: :func:`track_scratch`). ``spec`` a
     :class:`~.records.TableSpec`; ``search`` the bandwidth search (enabled first); the
@@ -161,8 +160,9 @@ def _one_design(dt, m, noise, muscle, section, silicone, nodes, spec, plant, con
         return math.nan, math.nan, math.nan, math.nan
     est, est_slope, table = scratch
     est_step = spec.p_top / (spec.points - 1)
-    angle_table(est_step, section.radius, section.wall, section.base, plant.length, silicone,
-                nodes, spec.rtol, table, est, est_slope)
+    section = spec.section
+    angle_table(est_step, section.radius, section.wall, section.base, plant.length,
+                spec.silicone, spec.nodes, spec.rtol, table, est, est_slope)
     estimator = Estimator(est_step, est)
     rms, t_top, energy = run_loop(dt, m, noise, muscle, plant, estimator, control, reference)
     bandwidth = math.nan
@@ -245,9 +245,10 @@ def _track_slab(axes, designs, plant_tables, muscle, silicone, nodes, rtol, loop
                                          g * initial, g * final, at, rms_from)
         (tracking_rms_error, tracking_max_temperature, tracking_energy,
          tracking_bandwidth) = _one_design(
-            dt, m, noise, design_muscle, Section(radius[i], wall[j], b), silicone, nodes,
-            TableSpec(p_top[i, j, li, ci, wi], points, rtol), plant, control,
-            design_reference, search, scratch)
+            dt, m, noise, design_muscle,
+            TableSpec(Section(radius[i], wall[j], b), p_top[i, j, li, ci, wi], points,
+                      silicone, nodes, rtol), plant, control, design_reference, search,
+            scratch)
         out[ROW_TRACKING_RMS_ERROR, q] = tracking_rms_error
         out[ROW_TRACKING_MAX_TEMPERATURE, q] = tracking_max_temperature
         out[ROW_TRACKING_ENERGY, q] = tracking_energy
