@@ -83,7 +83,7 @@ def _eigh3(M, lam, Q):
 
 
 @jit_kernel
-def ogden_points(F, mu, alpha, P, A, tangent):
+def ogden_points(F, mu, alpha, P, A, tangent):  # noqa: C901 (one compiled pass a point)
     """Stress P[i, J, n] and, with ``tangent``, A[i, J, k, L, n] at every point n of
     F[i, I, n] (all in FElupe's index order) [Pa]."""
     n_points = F.shape[2]
