@@ -95,7 +95,6 @@ def provenance(cfg: ResolvedConfig) -> dict:
     from importlib.metadata import version
 
     import h5py
-    import numba
 
     def material(m):
         d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}
@@ -113,7 +112,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
         "config_sha256": cfg.sha256,
         "nylonflex_version": __version__,
         "model_sources_sha256": source_digest(),
-        "numba_version": numba.__version__,
+        "numba_version": version("numba"),
         "numpy_version": np.__version__,
         # the reader's version, not imported by a sweep (importing it costs 0.4 s)
         "xarray_version": version("xarray"),
