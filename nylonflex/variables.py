@@ -27,7 +27,7 @@ __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.
 MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment",
-          "lateral_pressure", "fe_calibrated")
+          "lateral_pressure", "fe_calibrated", "sealed_chamber")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")

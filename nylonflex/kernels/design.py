@@ -31,7 +31,7 @@ from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
                                node_scratch)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _curve_factor, _design_state_nodes, _design_values,
+                              SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes, _design_values,
                               _dynamic_values,
                               _length_factor, _model_moment, _model_state_nodes,
                               _nylon_force_model, _reach,
@@ -138,10 +138,15 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                                  jp), NEWTON_RTOL, cauchy)
             kappa_curve[jp] = kappa
             rate_curve[jp], rate2_curve[jp] = _curvature_rates(lever_p, dm, d2m)
+            # sealed_chamber's squeeze at the stroke that holds this pressure (else 0)
+            if not _PAPER_ONLY:
+                k_sq, m_sq = _curve_squeeze(model, pressure[jp], section, ogden, table, p_atm)
+                kappa += k_sq
+                moment += m_sq
             for il in range(nl):
                 factor = 1.0 if _PAPER_ONLY else _curve_factor(
                     model, pressure[jp], a, t, length[il], mu, alpha)
-                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * factor
+                out_angle[ia, it, il, jp] = kappa * length[il] * factor
                 out_tip[ia, it, il, jp] = moment / length[il]
         curve = SolvedCurve(pressure, kappa_curve, rate_curve, rate2_curve)
         # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
@@ -244,7 +249,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                         bend_angle_max, st[4] * lf, section, stretch_max, length[il] / pitch,
                         closes, efficiency)
                 for js in range(ns):
-                    if not _PAPER_ONLY and model == INCOMPRESSIBLE_WALL:
+                    if not _PAPER_ONLY and (model == INCOMPRESSIBLE_WALL or
+                                            model == SEALED_CHAMBER):
                         f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
                                                alpha, p_atm)[0]
                         out_force[ia, it, ic, ip, js] = f if f < math.inf else math.nan

@@ -17,12 +17,14 @@ from ._formula import (check, check_input, check_section, check_wrap_angle, form
                        scalar_or_array, specialised)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
-                      _section_nodes, _taylor_start, quadrature_nodes)
+                      _section_moment, _section_nodes, _taylor_start, quadrature_nodes)
 from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .records import CoilRow, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
+from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
+    _squeeze_curvature
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from .thermal import _cooling_time, _heating_power, _heating_time, \
     _steady_temperature, check_supply_rise, coil_heat_loss_per_length, coil_resistance
@@ -34,7 +36,7 @@ __all__ = ["DESIGN_VARIABLES", "EFFICIENCY_BOUND", "MODELS", "VALIDITY_FLAGS", "
 
 from ..variables import DESIGN, MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE, \
-    FE_CALIBRATED = range(7)
+    FE_CALIBRATED, SEALED_CHAMBER = range(8)
 
 #: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
@@ -74,8 +76,9 @@ def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, 
     """F_n(s) and dF_n/ds [N] of a model variant (``solid`` = A_s/A_out, wall variant only).
 
     ``paper_eq10`` takes the hoop stress of the paper's eqs. (10)-(12),
-    ``incompressible_wall`` the chamber pressure with a conserved wall area; the others
-    are the paper's F_n (docs/model.md s. 4, 15).
+    ``incompressible_wall`` the chamber pressure with a conserved wall area,
+    ``sealed_chamber`` the sealed, compliant chamber's (:mod:`.sealed`); the others are the
+    paper's F_n (docs/model.md s. 4, 15, 22).
     """
     if model == PAPER_EQ10:
         p = _gauge_pressure(stroke, p_atm)
@@ -83,6 +86,9 @@ def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, 
         s_theta, ds_dlam = _equibiaxial_stress_and_slope(1.0 - stroke, mu, alpha)
     elif model == INCOMPRESSIBLE_WALL:
         p, dp = _gauge_pressure_wall(stroke, p_atm, solid)
+        s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
+    elif model == SEALED_CHAMBER:
+        p, dp = _sealed_pressure(stroke, radius, wall_thickness, mu, alpha, p_atm, 1.0, _SEALED)
         s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
     else:
         return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
@@ -183,13 +189,13 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
     """The moment that bends the section at chamber pressure p [N m] in a model variant.
 
     The paper's end-cap moment M_P (eq. 16; every variant but ``lateral_pressure``, bit for
-    bit); ``lateral_pressure`` (and ``fe_calibrated``, which corrects its curvature) adds the
-    pressure on the wall and floor, p times :func:`~.bending._lateral_lever` (docs/model.md
-    s. 18). Linear in p in every model:
-    ``_model_moment(model, 1, ...)`` is dM/dp.
+    bit); ``lateral_pressure`` (and ``fe_calibrated``, which corrects its curvature, and
+    ``sealed_chamber``, which adds the squeeze) adds the pressure on the wall and floor, p
+    times :func:`~.bending._lateral_lever` (docs/model.md s. 18). Linear in p in every
+    model: ``_model_moment(model, 1, ...)`` is dM/dp.
     """
     m = _pressure_moment(pressure, radius, base_thickness)
-    if model == LATERAL_PRESSURE or model == FE_CALIBRATED:
+    if model == LATERAL_PRESSURE or model == FE_CALIBRATED or model == SEALED_CHAMBER:
         m += pressure * _lateral_lever(radius, wall_thickness, base_thickness)
     return m
 
@@ -238,7 +244,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
         kappa_full = math.inf
         p_full = math.inf
     else:
-        p_full = _nylon_pressure(model, s_max, p_atm, solid)
+        p_full = _nylon_pressure(model, s_max, p_atm, solid, radius, wall_thickness, mu, alpha)
         kappa_full, dm, d2m = _curvature_solve(
             _model_moment(model, p_full, radius, wall_thickness, base_thickness), y, wy, wyy,
             work, mu, alpha, _curvature_start(p_full, pressures, kappas, rates, rates2, n),
@@ -261,7 +267,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
         limit = 3
     else:
         limit = 0
-    p = _nylon_pressure(model, s, p_atm, solid)
+    p = _nylon_pressure(model, s, p_atm, solid, radius, wall_thickness, mu, alpha)
     moment = _model_moment(model, p, radius, wall_thickness, base_thickness)
     if limit == 0:
         kappa = kappa_full
@@ -274,7 +280,35 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     if model == FE_CALIBRATED:  # the balance's curvatures, corrected (:mod:`.calibrated`)
         kappa *= _section_correction(p, radius, wall_thickness, mu, alpha)
         kappa_full *= _section_correction(p_full, radius, wall_thickness, mu, alpha)
+    elif model == SEALED_CHAMBER:  # the squeeze's curvature and blocked moment (:mod:`.sealed`)
+        kappa_full += _squeeze_curvature(s_max, radius, wall_thickness, base_thickness, _SEALED)
+        k_sq, m_sq = _squeeze_state(s, section, ogden, table)
+        kappa += k_sq
+        moment += m_sq
     return s, limit, p, moment, kappa, force, kappa_full, closes
+
+
+@formula
+def _squeeze_state(stroke, section, ogden, table):
+    """``sealed_chamber``'s squeeze at stroke s [-]: its curvature kappa_sq [1/m] and the
+    blocked moment c_b M_S(kappa_sq) [N m] that holds it straight (docs/model.md s. 22), in
+    the section's node table ``table`` (its ``work`` overwritten)."""
+    k_sq = _squeeze_curvature(stroke, section.radius, section.wall, section.base, _SEALED)
+    m_sq = _section_moment(k_sq, table.y, table.wy, table.wyy, table.work, ogden.mu,
+                           ogden.alpha, False)[0]
+    return k_sq, _SEALED[6] * m_sq
+
+
+@formula
+def _curve_squeeze(model, pressure, section, ogden, table, p_atm):
+    """What a model adds at chamber pressure p [Pa] to the balance's curvature [1/m] and
+    moment [N m] on the bend-angle and tip-force curves: ``sealed_chamber``'s squeeze at the
+    stroke that holds p (:func:`~.sealed._sealed_stroke`), else (0, 0)."""
+    if model != SEALED_CHAMBER:
+        return 0.0, 0.0
+    s = _sealed_stroke(pressure, section.radius, section.wall, ogden.mu, ogden.alpha, p_atm,
+                       1.0, _SEALED)
+    return _squeeze_state(s, section, ogden, table)
 
 
 @formula
@@ -342,10 +376,13 @@ def _curve_factor(model, pressure, radius, wall_thickness, length, mu, alpha):
 
 
 @formula
-def _nylon_pressure(model, stroke, p_atm, solid):
+def _nylon_pressure(model, stroke, p_atm, solid, radius, wall_thickness, mu, alpha):
     """Chamber gauge pressure p(s) of a model variant [Pa]."""
     if model == INCOMPRESSIBLE_WALL:
         return _gauge_pressure_wall(stroke, p_atm, solid)[0]
+    if model == SEALED_CHAMBER:
+        return _sealed_pressure(stroke, radius, wall_thickness, mu, alpha, p_atm, 1.0,
+                                _SEALED)[0]
     return _gauge_pressure(stroke, p_atm)
 
 
@@ -705,7 +742,8 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
     The variants differ here by the moment that bends the section (``lateral_pressure``:
     :func:`_model_moment`) or the stress it is balanced by
     (``cauchy_moment``); ``coupled_muscle``, ``paper_eq10`` and ``incompressible_wall``
-    change the muscle's side only and give the paper's angle (docs/model.md s. 16, 18).
+    change the muscle's side only and give the paper's angle (docs/model.md s. 16, 18);
+    ``sealed_chamber`` adds the squeeze of the stroke that holds p (s. 22).
 
     Parameters
     ----------
@@ -739,7 +777,9 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
     def one(p_, a_, t_, b_, l_):
         y, wy, wyy, work = _node_table(a_, t_, b_, *nodes)
         moment = _model_moment(code, p_, a_, t_, b_)
-        return _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
-                                cauchy) * l_ * _curve_factor(code, p_, a_, t_, l_, mu, alpha)
+        kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL, cauchy)
+        kappa += _curve_squeeze(code, p_, Section(a_, t_, b_), Ogden(mu, alpha),
+                                NodeTable(y, wy, wyy, work), P_ATM)[0]
+        return kappa * l_ * _curve_factor(code, p_, a_, t_, l_, mu, alpha)
 
     return scalar_or_array(np.vectorize(one, otypes=[float])(p, a, t, b, L))
