@@ -1,5 +1,6 @@
 """``nylonflex fit silicone|stroke|thermal|muscle DATA``: fit a set, write its material file;
-``nylonflex fit fe``: fit ``fe_calibrated``'s correction to FE runs of the twin."""
+``nylonflex fit fe``: fit ``fe_calibrated``'s correction to FE runs of the twin;
+``nylonflex fit chamber DATA``: the sealed chamber of one built actuator (docs/bench.md)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ from ..units import InputError, json_text, parse_quantity
 from . import warn
 from ._common import progress_bar
 
-HELP = "fit a silicone or nylon muscle set to bench data, or fe_calibrated to the FE twin"
+HELP = ("fit a silicone or nylon muscle set or a sealed chamber to bench data, or "
+        "fe_calibrated to the FE twin")
 DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
 as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md.
 
@@ -22,9 +24,11 @@ as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md
   nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
   nylonflex fit thermal step.csv --voltage 5V --muscle-length 300mm
   nylonflex fit muscle force.csv
+  nylonflex fit chamber bench.csv --radius 20mm --wall-thickness 6mm --length 90mm \
+      --out fits/chamber.yaml                                 # docs/bench.md
   nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]"""
 
-KINDS = ("silicone", "stroke", "thermal", "muscle", "fe")
+KINDS = ("silicone", "stroke", "thermal", "muscle", "fe", "chamber")
 
 
 def add_arguments(p):
@@ -46,6 +50,14 @@ def add_arguments(p):
                    help="stroke/thermal/muscle: base nylon set (T_amb, T_max, coil table)")
     p.add_argument("--t-amb", help="ambient temperature, e.g. 25degC (default: the set's)")
     p.add_argument("--t-max", help="highest temperature, e.g. 150degC (default: the set's)")
+    p.add_argument("--radius", help="chamber: the actuator's radius, e.g. 20mm")
+    p.add_argument("--wall-thickness", help="chamber: its wall thickness, e.g. 6mm")
+    p.add_argument("--length", help="chamber: its length, e.g. 90mm")
+    p.add_argument("--base-thickness", help="chamber: its base thickness (default the wall's)")
+    p.add_argument("--chamber-volume", help="chamber: its measured volume V0, e.g. 56ml "
+                   "(default pi a^2 L / 2)")
+    p.add_argument("--silicone", default="tc5005",
+                   help="chamber: the silicone set it is made of (default tc5005)")
     p.add_argument("--name", default="", help="name of the fitted set")
     p.add_argument("--out", metavar="FILE.yaml", help="write the material file here")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
@@ -71,6 +83,8 @@ def fit(args):
     t_max = _q(args.t_max, "--t-max", "temperature", "degC")
     if args.kind == "silicone":
         return fit_silicone(args.data, args.model, args.test, args.max_stretch, args.name)
+    if args.kind == "chamber":
+        return _fit_chamber(args)
     nylon = {"file": args.nylon} if args.nylon.endswith((".yaml", ".yml")) else args.nylon
     if args.kind == "stroke":
         if args.coil_index is None:
@@ -84,6 +98,27 @@ def fit(args):
                            _q(args.resistance, "--resistance", "resistance", "ohm"),
                            nylon, t_amb, args.name)
     return fit_muscle(args.data, nylon, t_amb, t_max, args.name)
+
+
+def _fit_chamber(args):
+    from ..calibration.chamber_bench import fit_chamber
+
+    size = {}
+    for flag in ("radius", "wall_thickness", "length"):
+        text = getattr(args, flag)
+        if text is None:
+            raise InputError(f"--{flag.replace('_', '-')}: required for 'fit chamber', "
+                             "e.g. 20mm")
+        size[flag] = _q(text, f"--{flag.replace('_', '-')}", "length", "mm")
+        if not size[flag] > 0:
+            raise InputError(f"--{flag.replace('_', '-')}: must be > 0 mm, got {text}")
+    base = _q(args.base_thickness, "--base-thickness", "length", "mm")
+    volume = _q(args.chamber_volume, "--chamber-volume", "volume", "ml")
+    for flag, v in (("--base-thickness", base), ("--chamber-volume", volume)):
+        if v is not None and not v > 0:
+            raise InputError(f"{flag}: must be > 0, got {v:g} (SI)")
+    return fit_chamber(args.data, **size, base_thickness=base, chamber_volume=volume,
+                       silicone=args.silicone, name=args.name)
 
 
 def _shown(unit, value, spread=False):

@@ -1,0 +1,123 @@
+"""``nylonflex fit chamber`` (calibration.chamber_bench, docs/bench.md): it recovers known
+chamber parameters from bench data that the coupled model made, with noise."""
+
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from nylonflex.calibration.chamber_bench import fit_chamber
+from nylonflex.cli import main
+from nylonflex.config.material_files import read_chamber_file
+from nylonflex.physics import P_ATM
+from nylonflex.physics.sealed_model import boyle_pressure
+
+A, T, L = 20e-3, 6e-3, 90e-3
+V0 = 0.5 * math.pi * A * A * L
+TRUE = dict(stiffness=9000.0, rounding=0.6, air_heating=0.3, squeeze=1.1)
+HEADER = ("phase,volume [ml],pressure [kPa],stroke,air_temperature [degC],"
+          "muscle_temperature [degC],bend_angle [deg]")
+
+
+def bench_csv(path, truth=TRUE, noise=1.0, seed=0, held=15000.0, phases=(1, 2, 3, 4)):
+    """The four phases of docs/bench.md as the coupled model says (noise in units of
+    10 Pa, 0.2 deg and 0.3 K)."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    dv = np.linspace(0.0, 5e-6, 11)
+    if 1 in phases:
+        p = truth["stiffness"] * dv / V0 + noise * 10.0 * rng.standard_normal(dv.size)
+        rows += [(1, v * 1e6, q / 1e3, 0, 25, 25, 0) for v, q in zip(dv, p)]
+    if 2 in phases:
+        p = held * dv / V0 + noise * 10.0 * rng.standard_normal(dv.size)
+        rows += [(2, v * 1e6, q / 1e3, 0, 25, 25, 0) for v, q in zip(dv, p)]
+    s = np.linspace(0.0, 0.054, 19)
+    t_m = 25.0 + 125.0 * s / 0.054
+    t_air = 25.0 + truth["air_heating"] * (t_m - 25.0) + noise * 0.3 * rng.standard_normal(s.size)
+    t_air[0] = 25.0
+    v = (1 - s) ** 2 * np.exp(truth["rounding"] * s)
+    p = boyle_pressure(v, truth["stiffness"], (t_air + 273.15) / 298.15, P_ATM)
+    p = p + noise * 10.0 * rng.standard_normal(s.size)
+    rows += [(3, 0, q / 1e3, si, ta, tm, 0) for q, si, ta, tm in zip(p, s, t_air, t_m)]
+    h = T + A + T / 2  # b + a + t/2, b = t
+    theta = truth["squeeze"] * s * L / h + noise * math.radians(0.2) * rng.standard_normal(s.size)
+    rows += [(4, 0, 0, si, 25, tm, math.degrees(th)) for si, tm, th in zip(s, t_m, theta)]
+    path.write_text(HEADER + "\n" + "\n".join(",".join(f"{x:.9g}" for x in r) for r in rows)
+                    + "\n")
+    return path
+
+
+def test_recovers_known_parameters_exactly_without_noise(tmp_path):
+    res = fit_chamber(bench_csv(tmp_path / "b.csv", noise=0.0), A, T, L)
+    for k, v in TRUE.items():
+        assert res.parameters[k] == pytest.approx(v, rel=1e-5, abs=1e-6), k
+    assert res.derived["stiffness_held"]["value"] == pytest.approx(15000.0, rel=1e-6)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_recovers_known_parameters_through_noise_inside_the_intervals(tmp_path, seed):
+    res = fit_chamber(bench_csv(tmp_path / "b.csv", seed=seed), A, T, L)
+    for k, v in TRUE.items():
+        lo, hi = res.ci95[k]
+        assert lo <= res.parameters[k] <= hi
+        assert lo - 0.5 * (hi - lo) <= v <= hi + 0.5 * (hi - lo), (k, v, lo, hi)
+    assert res.parameters["stiffness"] == pytest.approx(TRUE["stiffness"], rel=0.05)
+    # the heating's share of the top pressure: what tau adds over the isothermal squeeze
+    assert 0.0 < res.derived["heating_share"]["value"] < 1.0
+
+
+def test_cli_writes_a_chamber_file_a_reader_takes_back(tmp_path, capsys):
+    data = bench_csv(tmp_path / "bench.csv", seed=4)
+    out = tmp_path / "chamber.yaml"
+    rc = main(["fit", "chamber", str(data), "--radius", "20mm", "--wall-thickness", "6mm",
+               "--length", "90mm", "--out", str(out)])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "chamber fit: sealed_chamber" in text and "stiffness [Pa]" in text
+    doc = yaml.safe_load(out.read_text())
+    assert doc["kind"] == "chamber" and doc["design"]["radius"] == pytest.approx(A)
+    back = read_chamber_file(out)
+    assert back["stiffness"] == pytest.approx(TRUE["stiffness"], rel=0.05)
+    # never overwritten without asking
+    assert main(["fit", "chamber", str(data), "--radius", "20mm", "--wall-thickness", "6mm",
+                 "--length", "90mm", "--out", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, match", [
+    ([], r"--radius: required for 'fit chamber'"),
+    (["--radius", "20mm", "--wall-thickness", "6mm", "--length", "9 deg"],
+     r"--length: unit 'deg' is not a length"),
+    (["--radius", "20mm", "--wall-thickness", "6mm", "--length", "90mm",
+      "--chamber-volume", "5 kPa"], r"--chamber-volume: unit 'kPa' is not a volume"),
+])
+def test_bad_flags_are_one_line(tmp_path, capsys, args, match):
+    import re
+    data = bench_csv(tmp_path / "b.csv")
+    assert main(["fit", "chamber", str(data), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert re.search(match, err) and len(err.splitlines()) == 1
+
+
+def test_a_bad_phase_or_too_few_rows_is_refused(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text(HEADER + "\n5,0,0,0,25,25,0\n")
+    assert main(["fit", "chamber", str(bad), "--radius", "20mm", "--wall-thickness", "6mm",
+                 "--length", "90mm"]) == 2
+    assert "column 'phase': must be one of 1, 2, 3, 4" in capsys.readouterr().err
+    few = bench_csv(tmp_path / "few.csv", phases=(1, 2))
+    text = few.read_text().splitlines()
+    few.write_text("\n".join([text[0]] + [r for r in text[1:] if not r.startswith("4,")]))
+    assert main(["fit", "chamber", str(few), "--radius", "20mm", "--wall-thickness", "6mm",
+                 "--length", "90mm"]) == 2
+    assert "needs at least 3 rows of phase 4" in capsys.readouterr().err
+
+
+def test_a_chamber_file_with_a_bad_value_is_refused(tmp_path):
+    from nylonflex.units import InputError
+    f = tmp_path / "c.yaml"
+    f.write_text("kind: chamber\nstiffness: -3\nrounding: 0\nair_heating: 0\nsqueeze: 1\n"
+                 "units: {stiffness: Pa, rounding: '1', air_heating: '1', squeeze: '1'}\n")
+    with pytest.raises(InputError, match=r"stiffness: must be a number in \[0, 1e\+09\] Pa"):
+        read_chamber_file(f)
