@@ -177,5 +177,19 @@ def fit_chamber(data, radius, wall_thickness, length, base_thickness=None,
                "rmse": "Pa"},
         extra={"design": {"radius": radius, "wall_thickness": wall_thickness, "length": length,
                           "base_thickness": b, "chamber_volume": v0}},
-        notes=[] if np.sum(phase == 1) >= 2 else
-        ["no phase-1 rows: K and gamma from the sealed pressures alone, weakly separated"])
+        notes=_notes(phase, gamma, r2))
+
+
+def _notes(phase, gamma, r2) -> list:
+    """What a user should know of a fit that may not say what it seems to."""
+    notes = []
+    if np.sum(phase == 1) < 2:
+        notes.append("no phase-1 rows: K and gamma from the sealed pressures alone, weakly "
+                     "separated")
+    if gamma <= -20.0 + 1e-6 or gamma >= 1.5 - 1e-6:
+        notes.append(f"rounding on its bound ({gamma:g}): these pressures fit no chamber of "
+                     "this form; check --chamber-volume, the strokes and the units")
+    if not r2 > 0.9:
+        notes.append(f"the pressures fit poorly (R^2 {r2:.3f}); docs/bench.md says what to "
+                     "check")
+    return notes

@@ -1,0 +1,9 @@
+import numpy
+
+
+def f():
+    import json
+    import numpy as np
+    from . import scan
+    import scipy.optimize
+    from ..kernels import design
