@@ -121,3 +121,80 @@ def test_a_chamber_file_with_a_bad_value_is_refused(tmp_path):
                  "units: {stiffness: Pa, rounding: '1', air_heating: '1', squeeze: '1'}\n")
     with pytest.raises(InputError, match=r"stiffness: must be a number in \[0, 1e\+09\] Pa"):
         read_chamber_file(f)
+
+
+def test_anchored_coefficients_give_the_measured_chamber_at_its_own_design():
+    from nylonflex.physics.sealed import COEFFICIENTS, anchored_coefficients
+    from nylonflex.physics.sealed_model import chamber_stiffness, free_volume
+    from nylonflex.materials import silicone_parameters
+
+    measured = dict(TRUE, radius=A, wall_thickness=T)
+    base = COEFFICIENTS._replace(k1=0.4, g1=-0.2, c1=0.3, cb=2.0)
+    coef = anchored_coefficients(measured, silicone_parameters("tc5005").initial_shear_modulus,
+                                 base)
+    assert chamber_stiffness(A, T, coefficients=coef) == pytest.approx(TRUE["stiffness"],
+                                                                       rel=1e-12)
+    s = 0.05
+    assert free_volume(s, A, T, coefficients=coef) == pytest.approx(
+        (1 - s) ** 2 * math.exp(TRUE["rounding"] * s), rel=1e-12)
+    assert coef.c0 + coef.c1 * math.log(T / A) == pytest.approx(TRUE["squeeze"], rel=1e-12)
+    assert (coef.k1, coef.g1, coef.c1, coef.cb) == (0.4, -0.2, 0.3, 2.0)
+
+
+def _sweep_raw(chamber_file, model=("sealed_chamber",)):
+    return {"name": "chamber", "model": list(model), "chamber": {"file": str(chamber_file)},
+            "grid": {"radius": {"values": [10, 20], "units": "mm"},
+                     "wall_thickness": {"values": [3, 6], "units": "mm"},
+                     "length": {"values": [90], "units": "mm"},
+                     "coil_index": {"values": [1.1, 1.7]},
+                     "wrap_angle": {"values": [8], "units": "deg"}},
+            "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                       "pressure": {"start": 0, "stop": 5, "num": 3, "units": "kPa"}}}
+
+
+def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
+    import nylonflex as nf
+    from nylonflex.config import parse_config
+    from nylonflex.engine.provenance import cube_settings
+    from nylonflex.materials import silicone_parameters
+    from nylonflex.physics.sealed import anchored_coefficients
+    from nylonflex.storage.sweep import run_sweep
+
+    out = tmp_path / "chamber.yaml"
+    assert main(["fit", "chamber", str(bench_csv(tmp_path / "b.csv", seed=5)), "--radius",
+                 "20mm", "--wall-thickness", "6mm", "--length", "90mm", "--out", str(out)]) == 0
+    measured = read_chamber_file(out)
+    cfg = parse_config(_sweep_raw(out, ("paper", "sealed_chamber")))
+    coef = anchored_coefficients(measured, silicone_parameters("tc5005").initial_shear_modulus)
+    ds = run_sweep(cfg, out=tmp_path / "cube.h5")
+    grids = np.meshgrid(*cfg.axes.values(), indexing="ij")
+    exact = nf.evaluate(*grids, model="sealed_chamber", chamber=coef)
+    sealed = ds.sel(model="sealed_chamber")
+    for name in ("pressure_max", "bend_angle_max", "tip_force_max", "usable_stroke"):
+        np.testing.assert_allclose(sealed[name].values, exact[name], rtol=1e-9, err_msg=name)
+    shipped = nf.evaluate(*grids, model="sealed_chamber")
+    assert not np.allclose(shipped["pressure_max"], exact["pressure_max"])
+    # the cube remembers the coefficients: re-evaluating under its settings gives its values
+    back = nf.open_cube(tmp_path / "cube.h5")
+    settings = cube_settings(back)
+    assert settings.chamber == pytest.approx(tuple(coef))
+    again = nf.evaluate(*grids, **settings.evaluate_kwargs("sealed_chamber"))
+    np.testing.assert_allclose(again["pressure_max"], exact["pressure_max"], rtol=1e-12)
+
+
+def test_a_chamber_file_needs_the_sealed_model_and_a_good_file(tmp_path):
+    from nylonflex.config import parse_config
+    from nylonflex.units import InputError
+
+    out = tmp_path / "chamber.yaml"
+    main(["fit", "chamber", str(bench_csv(tmp_path / "b.csv")), "--radius", "20mm",
+          "--wall-thickness", "6mm", "--length", "90mm", "--out", str(out)])
+    with pytest.raises(InputError, match="chamber: applies to model sealed_chamber only"):
+        parse_config(_sweep_raw(out, ("paper",)))
+    with pytest.raises(InputError, match="chamber.file: .*no such material file"):
+        parse_config(_sweep_raw(tmp_path / "missing.yaml"))
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(out.read_text().replace("stiffness: Pa", "stiffness: kPa"))
+    with pytest.raises(InputError, match="chamber.file: .*stiffness: the file's units must "
+                                         "say 'Pa'"):
+        parse_config(_sweep_raw(bare))

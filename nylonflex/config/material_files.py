@@ -130,7 +130,8 @@ CHAMBER_FIELDS = {"stiffness": ("Pa", 0.0, 1e9), "rounding": ("1", -20.0, 1.5),
 
 def read_chamber_file(path) -> dict:
     """A chamber file (``kind: chamber``, written by ``nylonflex fit chamber``) as its fitted
-    values {name: SI float} (:data:`CHAMBER_FIELDS`), checked against the units it names.
+    values {name: SI float} (:data:`CHAMBER_FIELDS`), checked against the units it names,
+    with the ``radius`` and ``wall_thickness`` [m] of the actuator it was measured on.
 
     Raises
     ------
@@ -151,6 +152,13 @@ def read_chamber_file(path) -> dict:
         if units.get(key) != unit:
             raise InputError(f"{path}: {key}: the file's units must say {unit!r}, got "
                              f"{units.get(key)!r}")
+        out[key] = float(v)
+    design = doc.get("design") or {}
+    for key in ("radius", "wall_thickness"):
+        v = design.get(key) if isinstance(design, dict) else None
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 1e-4 <= v <= 1.0:
+            raise InputError(f"{path}: design.{key}: must be the measured actuator's, in "
+                             f"[0.1, 1000] mm (written in m), got {v!r}")
         out[key] = float(v)
     return out
 
@@ -221,7 +229,8 @@ def read_material_set(kind: str, path, table: dict, known=()) -> tuple[str, dict
 
 
 def anchor_material_files(raw, folder):
-    """Make relative ``file`` paths of ``silicone``/``nylon`` mappings relative to ``folder``.
+    """Make relative ``file`` paths of ``silicone``/``nylon``/``chamber`` mappings relative to
+    ``folder``.
 
     Walks the config mapping (top level and nested actuators) and returns a copy.
     """
@@ -232,7 +241,7 @@ def anchor_material_files(raw, folder):
         return raw
     out = {}
     for key, value in raw.items():
-        if key in ("silicone", "nylon") and isinstance(value, dict) and \
+        if key in ("silicone", "nylon", "chamber") and isinstance(value, dict) and \
                 isinstance(value.get("file"), str) and not Path(value["file"]).is_absolute():
             value = {**value, "file": str(folder / value["file"])}
         elif isinstance(value, (dict, list)):

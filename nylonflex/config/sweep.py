@@ -26,7 +26,7 @@ from pydantic import BeforeValidator, ValidationError, field_validator, model_va
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
-from .material_files import anchor_material_files
+from .material_files import anchor_material_files, read_chamber_file
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES
@@ -120,6 +120,13 @@ class Limits(_Strict):
     gigabytes: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["gigabytes"]
 
 
+class ChamberFile(_Strict):
+    """``chamber: {file: fits/chamber.yaml}``: a ``nylonflex fit chamber`` file
+    (``sealed_chamber``, docs/bench.md)."""
+
+    file: str
+
+
 class SweepConfig(_Strict):
     """The sweep config of docs/interface.md, as typed (not yet resolved to SI)."""
 
@@ -139,6 +146,7 @@ class SweepConfig(_Strict):
     supply: Supply | None = None
     tracking: Tracking | None = None
     cooling: Union[str, dict[str, Any], list[Union[str, dict[str, Any]]], None] = None
+    chamber: ChamberFile | None = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -169,6 +177,9 @@ class ResolvedConfig:
     cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
     # several cooling sets: the cube's string ``cooling`` dimension (then ``cooling`` is None)
     coolings: tuple[Cooling, ...] = ()
+    # a chamber file's measured values (``sealed_chamber``; docs/bench.md), SI, with the
+    # file's path: the kernels' coefficients are anchored on them (engine.model_slab)
+    chamber: dict | None = None
 
     @property
     def cooling_names(self) -> tuple[str, ...]:
@@ -224,6 +235,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["cooling"] = cfg.cooling.to_dict()
     if cfg.coolings:
         doc["cooling"] = [c.to_dict() for c in cfg.coolings]
+    if cfg.chamber is not None:  # only then: other cubes keep their hash
+        doc["chamber"] = {k: v for k, v in cfg.chamber.items() if k != "file"}
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -325,6 +338,15 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                               tracking is not None):
         raise InputError("cooling: a sweep with uncertainty, requirements or tracking takes "
                          "one cooling set; sweep each set on its own")
+    chamber = None
+    if cfg.chamber is not None:
+        if "sealed_chamber" not in models:
+            raise InputError("chamber: applies to model sealed_chamber only; add it to model: "
+                             f"(got {', '.join(models)})")
+        try:
+            chamber = {**read_chamber_file(cfg.chamber.file), "file": cfg.chamber.file}
+        except InputError as err:
+            raise InputError(f"chamber.file: {err}") from None
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
@@ -332,7 +354,7 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                           requirements=requirements, models=models,
                           supply_voltage=voltage, tracking=tracking,
                           cooling=coolings[0] if len(coolings) == 1 else None,
-                          coolings=coolings if len(coolings) > 1 else ())
+                          coolings=coolings if len(coolings) > 1 else (), chamber=chamber)
 
 
 def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:

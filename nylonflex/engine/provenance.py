@@ -20,6 +20,7 @@ from ..materials import (COOLING_PARAMETERS, Cooling, Nylon, Silicone, cooling_p
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
 from ..units import decimal_to_si, from_si
+from .model_slab import chamber_coefficients
 from ..variables import is_complete  # noqa: F401 - re-exported
 from ..variables import AXES, VARIABLES
 
@@ -150,8 +151,9 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
     variants' names, space-separated); ``base_thickness`` [m] float64, only where b is not
     t; ``supply_voltage`` [V] float64, only with a supply; and, only with cooling,
     ``cooling`` and ``cooling_fluid`` (the sets' names and fluids, space-separated) with
-    ``cooling_speed`` [m/s] (a float64 array, one speed a set). :func:`cube_settings` reads
-    them back.
+    ``cooling_speed`` [m/s] (a float64 array, one speed a set); with ``sealed_chamber``
+    among the models, ``sealed_chamber_coefficients`` (float64 (7,), the coefficients it ran
+    with). :func:`cube_settings` reads them back.
     """
     def numbers(material, names, kind):
         out = {}
@@ -175,6 +177,8 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
         out["cooling"] = " ".join(c.name for c in coolings)
         out["cooling_fluid"] = " ".join(c.fluid for c in coolings)
         out["cooling_speed"] = np.array([c.speed for c in coolings], np.float64)
+    if "sealed_chamber" in cfg.models:  # the coefficients it ran with (docs/model.md s. 22)
+        out["sealed_chamber_coefficients"] = np.asarray(chamber_coefficients(cfg), np.float64)
     return out
 
 
@@ -208,6 +212,9 @@ class CubeSettings:
     supply_voltage: float | None = None
     cooling: Cooling | None = None
     coolings: tuple[Cooling, ...] = ()
+    #: ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) the cube ran with;
+    #: None: the shipped ones (a cube without that model, or from before they were stored)
+    chamber: tuple | None = None
 
     def evaluate_kwargs(self, model: str | None = None, cooling: Cooling | None = None) -> dict:
         """Keyword arguments of :func:`nylonflex.evaluate` under one model variant and
@@ -233,6 +240,8 @@ class CubeSettings:
         cooling = self.cooling if cooling is None else cooling
         if cooling is not None:
             out["cooling"] = cooling
+        if self.chamber is not None:
+            out["chamber"] = self.chamber
         return out
 
 
@@ -288,7 +297,9 @@ def cube_settings(ds_or_attrs) -> CubeSettings:
         models=tuple(_text(attrs, "models").split()),
         supply_voltage=_number(attrs, "supply_voltage") if "supply_voltage" in attrs else None,
         cooling=coolings[0] if len(coolings) == 1 else None,
-        coolings=coolings if len(coolings) > 1 else ())
+        coolings=coolings if len(coolings) > 1 else (),
+        chamber=tuple(float(c) for c in _numbers(attrs, "sealed_chamber_coefficients"))
+        if "sealed_chamber_coefficients" in attrs else None)
 
 
 def _value(attrs, key):

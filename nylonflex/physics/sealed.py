@@ -35,9 +35,10 @@ from pathlib import Path
 
 from ._formula import formula
 from .calibrated import _initial_shear_modulus
+from .records import SealedCoefficients
 
 __all__ = ["CALIBRATION_FILE", "COEFFICIENTS", "COEFFICIENT_NAMES", "GAMMA_MAX", "ROUNDING_BOUND",
-           "calibration"]
+           "anchored_coefficients", "calibration", "sealed_coefficients"]
 
 #: The shipped coefficients, their status and provenance.
 CALIBRATION_FILE = Path(__file__).with_name("sealed_chamber.json")
@@ -62,7 +63,45 @@ def calibration() -> dict:
 
 
 #: (k0, k1, g0, g1, c0, c1, cb) of :data:`CALIBRATION_FILE` (dimensionless).
-COEFFICIENTS = tuple(float(calibration()["coefficients"][n]) for n in COEFFICIENT_NAMES)
+COEFFICIENTS = SealedCoefficients(*(float(calibration()["coefficients"][n])
+                                    for n in COEFFICIENT_NAMES))
+
+
+def sealed_coefficients(value=None) -> SealedCoefficients:
+    """The coefficients as a :class:`~.records.SealedCoefficients`: the shipped ones for
+    None, else from a dict by name or a sequence in :data:`COEFFICIENT_NAMES` order."""
+    if value is None:
+        return COEFFICIENTS
+    if isinstance(value, dict):
+        missing = [n for n in COEFFICIENT_NAMES if n not in value]
+        if missing:
+            raise ValueError(f"chamber: needs {', '.join(COEFFICIENT_NAMES)}; missing "
+                             f"{', '.join(missing)}")
+        value = [value[n] for n in COEFFICIENT_NAMES]
+    coef = tuple(float(c) for c in value)
+    if len(coef) != len(COEFFICIENT_NAMES) or not all(math.isfinite(c) for c in coef):
+        raise ValueError(f"chamber: needs {len(COEFFICIENT_NAMES)} finite numbers "
+                         f"({', '.join(COEFFICIENT_NAMES)}), got {value!r}")
+    return SealedCoefficients(*coef)
+
+
+def anchored_coefficients(measured, mu0, base=None) -> SealedCoefficients:
+    """The coefficients that give one measured actuator's chamber (``nylonflex fit
+    chamber``, docs/bench.md) at its own t/a and keep ``base``'s trends in t/a elsewhere.
+
+    ``measured`` holds ``stiffness`` K [Pa], ``rounding`` gamma [-], ``squeeze`` c_sq [-]
+    and the actuator's ``radius``, ``wall_thickness`` [m]; ``mu0`` [Pa] is the sweep's
+    silicone's initial shear modulus; ``base`` the coefficients whose k1, g1, c1 and cb are
+    kept (the shipped ones for None). With x = ln(t/a): k0 = ln(K / (mu0 (1 - (a/(a+t))^2)))
+    - k1 x, g0 = gamma - g1 x, c0 = c_sq - c1 x.
+    """
+    base = sealed_coefficients(base)
+    a, t = measured["radius"], measured["wall_thickness"]
+    x = math.log(t / a)
+    lame = 1.0 - (a / (a + t)) ** 2
+    return base._replace(k0=math.log(measured["stiffness"] / (mu0 * lame)) - base.k1 * x,
+                         g0=measured["rounding"] - base.g1 * x,
+                         c0=measured["squeeze"] - base.c1 * x)
 
 
 @formula

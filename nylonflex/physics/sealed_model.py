@@ -16,26 +16,11 @@ from .bending import _curvature_nodes, _node_table, _section_moment, NEWTON_RTOL
     quadrature_nodes
 from .chamber import P_ATM
 from .limits import LATERAL_PRESSURE, _model_moment
-from .sealed import (COEFFICIENT_NAMES, COEFFICIENTS, _boyle_pressure, _chamber_stiffness,
-                     _free_volume, _rounding, _sealed_pressure, _sealed_stroke,
-                     _squeeze_curvature)
+from .sealed import (_boyle_pressure, _chamber_stiffness, _free_volume, _rounding,
+                     _sealed_pressure, _sealed_stroke, _squeeze_curvature, sealed_coefficients)
 
-__all__ = ["boyle_pressure", "chamber_stiffness", "coefficient_tuple", "free_volume",
-           "lateral_state", "sealed_pressure", "sealed_state", "sealed_stroke"]
-
-
-def coefficient_tuple(coefficients=None) -> tuple:
-    """The seven coefficients (k0, k1, g0, g1, c0, c1, cb) as a tuple of floats: the
-    shipped ones for None, a dict by name or a sequence in that order otherwise."""
-    if coefficients is None:
-        return COEFFICIENTS
-    if isinstance(coefficients, dict):
-        return tuple(float(coefficients[n]) for n in COEFFICIENT_NAMES)
-    coef = tuple(float(c) for c in coefficients)
-    if len(coef) != len(COEFFICIENT_NAMES):
-        raise ValueError(f"coefficients: need {len(COEFFICIENT_NAMES)} "
-                         f"({', '.join(COEFFICIENT_NAMES)}), got {len(coef)}")
-    return coef
+__all__ = ["boyle_pressure", "chamber_stiffness", "free_volume", "lateral_state",
+           "sealed_pressure", "sealed_state", "sealed_stroke", "squeeze_moment"]
 
 
 def boyle_pressure(volume, stiffness=math.inf, tau=1.0, p_atm=P_ATM):
@@ -68,7 +53,7 @@ def chamber_stiffness(radius, wall_thickness, silicone="tc5005", coefficients=No
     [Pa] (docs/model.md s. 22)."""
     a, t, _ = check_section(radius, wall_thickness, None)
     mu, alpha = silicone_parameters(silicone).arrays()
-    coef = coefficient_tuple(coefficients)
+    coef = sealed_coefficients(coefficients)
     f = np.vectorize(lambda a_, t_: _chamber_stiffness(a_, t_, mu, alpha, coef), otypes=[float])
     return scalar_or_array(f(a, t))
 
@@ -77,7 +62,7 @@ def free_volume(stroke, radius, wall_thickness, coefficients=None):
     """The unpressurised chamber's volume over its initial one, (1 - s)^2 exp(gamma s) [-]."""
     s = check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-")
     a, t, _ = check_section(radius, wall_thickness, None)
-    coef = coefficient_tuple(coefficients)
+    coef = sealed_coefficients(coefficients)
     f = np.vectorize(lambda s_, a_, t_: _free_volume(s_, _rounding(a_, t_, coef))[0],
                      otypes=[float])
     return scalar_or_array(f(s, a, t))
@@ -90,7 +75,7 @@ def sealed_pressure(stroke, radius, wall_thickness, silicone="tc5005", coefficie
     a, t, _ = check_section(radius, wall_thickness, None)
     tau = check("tau", tau, 0.0, lo_open=True, unit="-")
     mu, alpha = silicone_parameters(silicone).arrays()
-    coef = coefficient_tuple(coefficients)
+    coef = sealed_coefficients(coefficients)
     f = np.vectorize(lambda s_, a_, t_, u_: _sealed_pressure(s_, a_, t_, mu, alpha, p_atm, u_,
                                                              coef)[0], otypes=[float])
     return scalar_or_array(f(s, a, t, tau))
@@ -102,7 +87,7 @@ def sealed_stroke(pressure, radius, wall_thickness, silicone="tc5005", coefficie
     p = check("pressure", pressure, 0.0, unit="Pa")
     a, t, _ = check_section(radius, wall_thickness, None)
     mu, alpha = silicone_parameters(silicone).arrays()
-    coef = coefficient_tuple(coefficients)
+    coef = sealed_coefficients(coefficients)
     f = np.vectorize(lambda p_, a_, t_: _sealed_stroke(p_, a_, t_, mu, alpha, p_atm, tau, coef),
                      otypes=[float])
     return scalar_or_array(f(p, a, t))
@@ -140,7 +125,7 @@ def sealed_state(stroke, radius, wall_thickness, length, base_thickness=None, si
     a, t, b = (float(x) for x in check_section(radius, wall_thickness, base_thickness))
     L = float(check("length", length, 0.0, lo_open=True, unit="m"))
     mu, alpha = silicone_parameters(silicone).arrays()
-    coef = coefficient_tuple(coefficients)
+    coef = sealed_coefficients(coefficients)
     k = _chamber_stiffness(a, t, mu, alpha, coef)
     v = _free_volume(s, _rounding(a, t, coef))[0]
     p = _sealed_pressure(s, a, t, mu, alpha, p_atm, tau, coef)[0]

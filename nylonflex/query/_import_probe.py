@@ -1,9 +1,0 @@
-import numpy
-
-
-def f():
-    import json
-    import numpy as np
-    from . import scan
-    import scipy.optimize
-    from ..kernels import design
