@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from nylonflex.calibration.chamber import fit_sealed_chamber
+from nylonflex.physics import P_ATM
 from nylonflex.physics.sealed import COEFFICIENT_NAMES
 from nylonflex.physics.sealed_model import sealed_state
 
@@ -59,3 +60,40 @@ def test_recovers_through_noise():
 def test_too_few_records_are_refused():
     with pytest.raises(ValueError, match="records: need at least 3"):
         fit_sealed_chamber(_records(2, TRUE))
+
+
+def _write_fe_records(folder, records, stalled=1):
+    """Records in the sealed twin's file format (fe_runs/README.txt), one of them stalled."""
+    import json
+    folder.mkdir()
+    for i, r in enumerate(records):
+        d = {**r["design"], "base_thickness": r["design"]["wall_thickness"],
+             "coil_index": 1.1, "wrap_angle": 0.14}
+        doc = {"index": i, "design": d, "silicone": "tc5005", "stroke": r["stroke"],
+               "paper": {"pressure": 1e4, "bend_angle": 1.0, "tip_force": 1.0},
+               "free": {"pressure": r["pressure"], "volume_ratio": P_ATM / (P_ATM + r["pressure"]),
+                        "bend_angle": r["bend_angle"], "discretisation_error": 0.01},
+               "blocked": {"pressure": 2 * r["pressure"], "volume_ratio": 0.9,
+                           "tip_force": r["tip_force"], "tip_moment": 0.0,
+                           "discretisation_error": 0.02},
+               "reached": {"free": True, "blocked": i >= stalled}}
+        (folder / f"design_{i:03d}.json").write_text(json.dumps(doc))
+
+
+def test_fit_sealed_reads_the_twins_records_and_writes_the_variants_file(tmp_path, capsys):
+    import json
+    from nylonflex.cli import main
+
+    truth = {**TRUE, "k0": 0.0, "k1": 0.0}
+    _write_fe_records(tmp_path / "runs", _records(9, truth, seed=3, free_volume=False))
+    out = tmp_path / "sealed.json"
+    assert main(["fit", "sealed", str(tmp_path / "runs"), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "8 designs (1 records left out)" in text and "within 15%" in text
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "fitted" and doc["provenance"]["skipped"] == ["design_000.json"]
+    for name in COEFFICIENT_NAMES:
+        assert doc["coefficients"][name] == pytest.approx(truth[name], rel=1e-6, abs=1e-9)
+    assert len(doc["training"]) == 8 and doc["fit"]["loo"]["bend_and_force_within"] == 8
+    assert main(["fit", "sealed", str(tmp_path / "runs"), "--out", str(out)]) == 2
+    assert main(["fit", "sealed", str(tmp_path / "nowhere"), "--out", str(out)]) == 2

@@ -7,7 +7,8 @@ A record is one design driven to one stroke: ``design`` (``radius``, ``wall_thic
 the same stroke), optionally ``volume_ratio`` V/V0 [-] (else p0/(p0 + p), Boyle),
 ``free_volume`` [-] (the chamber's volume with the air vented, which separates the
 compliance from the rounding) and ``blocked_pressure`` [Pa] (the chamber's pressure held
-straight; else ``pressure``).
+straight; kept, not fitted: the model's blocked moment takes the free pressure and c_b
+carries the rest). :func:`fe_records` reads the sealed twin's record files into this form.
 
 Each group is fitted by linear least squares on what a record says of it:
 
@@ -15,7 +16,7 @@ Each group is fitted by linear least squares on what a record says of it:
   v_free), only from records with ``free_volume`` (without: k0 = k1 = 0, Lame's);
 - rounding: gamma_i = ln(v_free / (1 - s)^2) / s = g0 + g1 ln(t/a), v_free = V/V0 - p/K;
 - squeeze: c_i = (theta - theta_lateral(p)) h / (s L) = c0 + c1 ln(t/a);
-- blocked: (F L - M_lateral(p_b)) / M_S(kappa_sq) = c_b, relative least squares.
+- blocked: (F L - M_lateral(p)) / M_S(kappa_sq) = c_b, relative least squares.
 
 Left out one design at a time, the others' coefficients predict its pressure, bend and
 blocked force through the whole model (:func:`~nylonflex.physics.sealed_model.sealed_state`
@@ -24,19 +25,61 @@ at the record's stroke), which is the error reported.
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
 from ..materials import silicone_parameters
 from ..physics import P_ATM
-from ..physics.sealed import COEFFICIENT_NAMES, GAMMA_MAX
+from ..physics.sealed import COEFFICIENT_NAMES, GAMMA_MAX, calibration
 from ..physics.sealed_model import lateral_state, sealed_state, squeeze_moment
 
-__all__ = ["TOLERANCE", "fit_sealed_chamber", "record_groups"]
+__all__ = ["TOLERANCE", "calibration_document", "fe_records", "fit_sealed_chamber",
+           "record_groups"]
 
 #: The relative miss counted as a hit in the leave-one-out summary [-].
 TOLERANCE = 0.15
+
+
+def fe_records(folder) -> tuple[list, list]:
+    """The sealed twin's records in ``folder`` (``design_NNN.json``, written by
+    ``nf.fe_stroke`` runs; the folder's README.txt gives the format) as the records
+    :func:`fit_sealed_chamber` takes, the free and the blocked solve both reached, in index
+    order; and the names of the files left out (a solve that stalled, or a file that is not
+    a complete record)."""
+    records, skipped = [], []
+    for path in sorted(Path(folder).glob("design_*.json")):
+        try:
+            doc = json.loads(path.read_text())
+            reached = doc.get("reached", {})
+            if not (reached.get("free") and reached.get("blocked")):
+                skipped.append(path.name)
+                continue
+            free, blocked = doc["free"], doc["blocked"]
+            rec = {"design": dict(doc["design"]), "stroke": float(doc["stroke"]),
+                   "pressure": float(free["pressure"]),
+                   "volume_ratio": float(free["volume_ratio"]),
+                   "bend_angle": float(free["bend_angle"]),
+                   "tip_force": float(blocked["tip_force"]),
+                   "blocked_pressure": float(blocked["pressure"]),
+                   "index": int(doc.get("index", len(records))),
+                   "silicone": doc.get("silicone", "tc5005"),
+                   "paper": dict(doc.get("paper") or {}),
+                   "discretisation_error": max(float(free.get("discretisation_error") or 0),
+                                               float(blocked.get("discretisation_error")
+                                                     or 0))}
+        except (ValueError, KeyError, TypeError, OSError):
+            skipped.append(path.name)
+            continue
+        if all(math.isfinite(rec[k]) and rec[k] > 0 for k in
+               ("stroke", "pressure", "bend_angle", "tip_force")):
+            records.append(rec)
+        else:
+            skipped.append(path.name)
+    records.sort(key=lambda r: r["index"])
+    return records, skipped
 
 
 def _design(rec):
@@ -64,8 +107,7 @@ def record_groups(records, silicone="tc5005", p_atm=P_ATM) -> dict:
                                 else math.nan)
         out["volume"].append(v)
         out["theta_p"].append(lateral_state(p, a, t, b, silicone)[0] * L)
-        p_b = float(rec.get("blocked_pressure") or p)
-        out["moment_b"].append(lateral_state(p_b, a, t, b, silicone)[1])
+        out["moment_b"].append(lateral_state(p, a, t, b, silicone)[1])
         out["h"].append(b + a + 0.5 * t)
     return {k: np.asarray(v, dtype=float) for k, v in out.items()}
 
@@ -160,3 +202,20 @@ def fit_sealed_chamber(records, silicone="tc5005", p_atm=P_ATM, tolerance=TOLERA
             "designs": [dict(r["design"]) for r in records],
             "loo": {**loo, "within": within, "bend_and_force_within": both, "n": n,
                     "tolerance": tolerance}}
+
+
+def calibration_document(fit: dict, records: list, provenance: dict) -> dict:
+    """The ``physics/sealed_chamber.json`` document of a fit (:func:`fit_sealed_chamber`)
+    to ``records``: ``status: fitted``, the form, the coefficients, ``provenance`` (given:
+    the command, the records' folder, ...), ``fit`` (the leave-one-out and the designs) and
+    ``training`` (each record's stroke and FE values, SI)."""
+    form = calibration()["form"]
+    keep = ("design", "stroke", "pressure", "volume_ratio", "bend_angle", "tip_force",
+            "blocked_pressure", "discretisation_error")
+    return {"model": "sealed_chamber", "status": "fitted",
+            "note": f"fitted to {len(records)} sealed FE twin designs; the leave-one-out "
+                    "errors are in 'fit'",
+            "form": form, "coefficients": dict(fit["coefficients"]),
+            "provenance": {**provenance, "stiffness_from": fit["stiffness_from"]},
+            "fit": {"designs": fit["designs"], "loo": fit["loo"]},
+            "training": [{k: r[k] for k in keep if k in r} for r in records]}

@@ -26,15 +26,17 @@ as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md
   nylonflex fit muscle force.csv
   nylonflex fit chamber bench.csv --radius 20mm --wall-thickness 6mm --length 90mm \
       --out fits/chamber.yaml                                 # docs/bench.md
-  nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]"""
+  nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]
+  nylonflex fit sealed fe_runs/ --out sealed_chamber.json    # sealed_chamber from FE records"""
 
-KINDS = ("silicone", "stroke", "thermal", "muscle", "fe", "chamber")
+KINDS = ("silicone", "stroke", "thermal", "muscle", "fe", "chamber", "sealed")
 
 
 def add_arguments(p):
     p.add_argument("kind", choices=KINDS, help="what to fit")
     p.add_argument("data", nargs="?", help="data file (CSV with units in the header, or a "
-                   "Soft Robotics Materials Database file); none for 'fe'")
+                   "Soft Robotics Materials Database file); none for 'fe'; for 'sealed' the "
+                   "folder of the sealed FE twin's records")
     p.add_argument("--model", default="ogden2",
                    help="silicone: ogden1|ogden2|ogden3|neo_hookean|yeoh2 (default ogden2)")
     p.add_argument("--test", default="uniaxial", choices=["uniaxial", "planar"],
@@ -241,9 +243,61 @@ def run_fe(args) -> int:
     return 0
 
 
+def run_sealed(args) -> int:
+    """``fit sealed DIR``: ``sealed_chamber``'s coefficients from the sealed FE twin's
+    records in DIR, with their leave-one-design-out errors, as the JSON file the variant
+    ships (``nylonflex/physics/sealed_chamber.json``)."""
+    from datetime import datetime, timezone
+
+    import numpy as np
+
+    from ..calibration.chamber import calibration_document, fe_records, fit_sealed_chamber
+    from ..storage.files import refuse_special, write_atomic
+
+    if args.data is None or not Path(args.data).is_dir():
+        raise InputError(f"DIR: 'fit sealed' needs the folder of FE records, got {args.data!r}")
+    out = Path(args.out or "sealed_chamber.json")
+    refuse_special(out, "--out", [])
+    if os.path.lexists(out) and not args.overwrite:
+        raise InputError(f"--out {out}: exists; give --overwrite to replace it")
+    records, skipped = fe_records(args.data)
+    silicones = {r["silicone"] for r in records}
+    if len(silicones) > 1:
+        raise InputError(f"DIR: records of several silicones ({', '.join(sorted(silicones))}); "
+                         "fit one at a time")
+    if len(records) < 3:
+        raise InputError(f"DIR: {len(records)} complete records in {args.data}; need at least 3")
+    silicone = silicones.pop()
+    fit = fit_sealed_chamber(records, silicone)
+    doc = calibration_document(fit, records, {
+        "command": "nylonflex fit sealed " + " ".join(sys.argv[3:]),
+        "nylonflex_version": __version__,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "records": str(args.data), "skipped": skipped, "silicone": silicone})
+    write_atomic(out, json_text(doc, indent=1).encode(), what="fit sealed")
+    if args.format == "json":
+        sys.stdout.write(json_text(doc, indent=2))
+        return 0
+    loo = fit["loo"]
+    print("sealed_chamber: " + ", ".join(f"{k} {v:+.4f}" for k, v in
+                                         fit["coefficients"].items())
+          + f" (stiffness: {fit['stiffness_from']})")
+    print(f"  {loo['n']} designs ({len(skipped)} records left out); leave-one-out / FE:")
+    for name in ("pressure", "bend_angle", "tip_force"):
+        r = np.asarray(loo[name])
+        print(f"  {name:<12} median {np.median(r):.3f}, range {r.min():.3f}-{r.max():.3f}, "
+              f"within {loo['tolerance']:.0%}: {loo['within'][name]} of {r.size}")
+    print(f"  bend and blocked force both within {loo['tolerance']:.0%}: "
+          f"{loo['bend_and_force_within']} of {loo['n']}")
+    print(f"wrote {out}")
+    return 0
+
+
 def run(args) -> int:
     if args.kind == "fe":
         return run_fe(args)
+    if args.kind == "sealed":
+        return run_sealed(args)
     if args.data is None:
         raise InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
     from ..calibration import write_material_file
