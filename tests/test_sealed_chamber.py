@@ -102,6 +102,10 @@ def test_the_stroke_that_holds_a_pressure_inverts_it(coef, s):
           - _sealed_pressure(s - h, a, t, MU, ALPHA, P_ATM, 1.0, coef)[0]) / (2 * h)
     assert dp == pytest.approx(fd, rel=1e-6)
     assert _sealed_stroke(0.0, a, t, MU, ALPHA, P_ATM, 1.0, coef) == 0.0
+    # a pressure no stroke reaches: the compliance alone would take more than the air's
+    # whole volume, p/K > p0/(p0 + p)
+    k = _chamber_stiffness(a, t, MU, ALPHA, coef)
+    assert math.isnan(_sealed_stroke(2.0 * k, a, t, MU, ALPHA, P_ATM, 1.0, coef))
 
 
 @pytest.mark.parametrize("a, t, L", [(20e-3, 6e-3, 90e-3), (7.5e-3, 2e-3, 70e-3),

@@ -158,7 +158,7 @@ def _sealed_pressure(stroke, radius, wall_thickness, mu, alpha, p_atm, tau, coef
 def _sealed_stroke(pressure, radius, wall_thickness, mu, alpha, p_atm, tau, coef):
     """The stroke s [-] at which the sealed chamber holds the gauge pressure p [Pa]:
     the inverse of :func:`_sealed_pressure` (0 where p is at or below the pressure at
-    s = 0).
+    s = 0; NaN where no stroke reaches p: p/K alone would exceed the air's whole volume).
 
     The volume Boyle allows, v = p0 tau/(p0 + p) - p/K, is v_free(s): 2 ln(1 - s) +
     gamma s = ln v, decreasing in s (gamma < 2), by Newton safeguarded by bisection.
@@ -169,7 +169,7 @@ def _sealed_stroke(pressure, radius, wall_thickness, mu, alpha, p_atm, tau, coef
         return 0.0
     gamma = _rounding(radius, wall_thickness, coef)
     if v <= 0.0:
-        return 1.0
+        return math.nan
     target = math.log(v)
     lo = 0.0
     hi = 1.0
