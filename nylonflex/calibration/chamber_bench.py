@@ -101,62 +101,28 @@ def fit_chamber(data, radius, wall_thickness, length, base_thickness=None,
         pressure at phase 3's largest stroke [-]. x, y: phases 1 and 3's pressures.
     """
     table = read_table(data)
-    phase = column(table, ("phase",), "phase (1-4, docs/bench.md)", "dimensionless")[1]
-    bad = ~np.isin(phase, list(PHASES))
-    if np.any(bad):
-        raise InputError(f"{data}: column 'phase': must be one of 1, 2, 3, 4 (docs/bench.md), "
-                         f"got {phase[bad][0]:g}")
-    for code in (3, 4):
-        if np.sum(phase == code) < 3:
-            raise InputError(f"{data}: needs at least 3 rows of phase {code} "
-                             f"({PHASES[code]}), got {int(np.sum(phase == code))}")
+    phase = _phases(table, data)
     cols = _columns(table, phase)
     b = wall_thickness if base_thickness is None else base_thickness
     v0 = chamber_volume or 0.5 * math.pi * radius ** 2 * length
-    use = np.isin(phase, (1, 3))
-    p3 = phase[use] == 3
-    y = cols["pressure"][use]
-    s = np.where(p3, cols["stroke"][use], 0.0)
-    t_air = np.where(p3, cols["air_temperature"][use], 1.0)
-    t0 = float(t_air[p3][0])
-    tau = t_air / t0
-    dv = np.where(p3, 0.0, cols["volume"][use] / v0) if "volume" in cols else np.zeros(y.size)
-
-    def residual(x):
-        return _pressure_model(x, s, tau, dv, p3, p_atm) - y
-
-    def jacobian(x):
-        h = np.array([1e-6 * x[0], 1e-6])
-        return np.stack([(residual(x + np.eye(2)[i] * h[i]) - residual(x - np.eye(2)[i] * h[i]))
-                         / (2 * h[i]) for i in range(2)], axis=1)
-
     k_model = float(chamber_stiffness(radius, wall_thickness, silicone))
-    sol = solve(residual, jacobian, [np.array([k_model, 0.0]), np.array([3 * k_model, 1.0])],
-                [1.0, -20.0], [1e9, 1.5])
-    if sol is None:
-        raise InputError(f"{data}: the phase 1 and 3 pressures fit no chamber (K, gamma)")
+    pv = _pressure_fit(phase, cols, v0, k_model, p_atm, data)
+    sol, s, y, p3, fit = pv["solution"], pv["stroke"], pv["pressure"], pv["sealed"], pv["fit"]
     k, gamma = (float(v) for v in sol.x)
-    se = sol.stderr
-    ci = sol.ci95()
+    se, ci = sol.stderr, sol.ci95()
     rows3 = phase == 3
-    heat = _through_origin(cols["muscle_temperature"][rows3] - cols["muscle_temperature"][rows3][0],
-                           cols["air_temperature"][rows3] - t0)
+    t_m = cols["muscle_temperature"][rows3]
+    heat = _through_origin(t_m - t_m[0], cols["air_temperature"][rows3] - pv["t0"])
     rows4 = phase == 4
-    h_s = b + radius + 0.5 * wall_thickness
-    squeeze = _through_origin(cols["stroke"][rows4] * length / h_s, cols["bend_angle"][rows4])
+    squeeze = _through_origin(cols["stroke"][rows4] * length / (b + radius + 0.5 * wall_thickness),
+                              cols["bend_angle"][rows4])
     derived = {"stiffness_factor": {"value": k / k_model, "stderr": float(se[0]) / k_model,
-                                    "ci95": [float(ci[0, 0]) / k_model, float(ci[0, 1]) / k_model]}}
+                                    "ci95": [float(c) / k_model for c in ci[0]]},
+               "heating_share": {"value": pv["heating_share"], "stderr": math.nan,
+                                 "ci95": [math.nan, math.nan]}}
     if np.sum(phase == 2) >= 2:
         held = _through_origin(cols["volume"][phase == 2] / v0, cols["pressure"][phase == 2])
         derived["stiffness_held"] = {"value": held[0], "stderr": held[1], "ci95": held[2]}
-    top = int(np.argmax(np.where(p3, s, -1.0)))
-    p_hot = float(_pressure_model(sol.x, s[top:top + 1], tau[top:top + 1], dv[top:top + 1],
-                                  p3[top:top + 1], p_atm)[0])
-    p_cold = float(_pressure_model(sol.x, s[top:top + 1], np.ones(1), dv[top:top + 1],
-                                   p3[top:top + 1], p_atm)[0])
-    share = (p_hot - p_cold) / p_hot if p_hot > 0 else math.nan
-    derived["heating_share"] = {"value": share, "stderr": math.nan, "ci95": [math.nan, math.nan]}
-    fit = _pressure_model(sol.x, s, tau, dv, p3, p_atm)
     rmse, r2 = statistics(y, fit)
     params = {"stiffness": k, "rounding": gamma, "air_heating": heat[0], "squeeze": squeeze[0]}
     cov = np.diag([se[0] ** 2, se[1] ** 2, heat[1] ** 2, squeeze[1] ** 2])
@@ -178,6 +144,53 @@ def fit_chamber(data, radius, wall_thickness, length, base_thickness=None,
         extra={"design": {"radius": radius, "wall_thickness": wall_thickness, "length": length,
                           "base_thickness": b, "chamber_volume": v0}},
         notes=_notes(phase, gamma, r2))
+
+
+def _phases(table, data) -> np.ndarray:
+    """The ``phase`` column, checked: codes 1-4, at least 3 rows of phases 3 and 4."""
+    phase = column(table, ("phase",), "phase (1-4, docs/bench.md)", "dimensionless")[1]
+    bad = ~np.isin(phase, list(PHASES))
+    if np.any(bad):
+        raise InputError(f"{data}: column 'phase': must be one of 1, 2, 3, 4 (docs/bench.md), "
+                         f"got {phase[bad][0]:g}")
+    for code in (3, 4):
+        if np.sum(phase == code) < 3:
+            raise InputError(f"{data}: needs at least 3 rows of phase {code} "
+                             f"({PHASES[code]}), got {int(np.sum(phase == code))}")
+    return phase
+
+
+def _pressure_fit(phase, cols, v0, k_model, p_atm, data) -> dict:
+    """K and gamma by least squares on the pressures of phases 1 and 3 (the module
+    docstring), with the rows fitted, the fit and the heating's share of the pressure at
+    phase 3's largest stroke."""
+    use = np.isin(phase, (1, 3))
+    p3 = phase[use] == 3
+    y = cols["pressure"][use]
+    s = np.where(p3, cols["stroke"][use], 0.0)
+    t_air = np.where(p3, cols["air_temperature"][use], 1.0)
+    t0 = float(t_air[p3][0])
+    tau = t_air / t0
+    dv = np.where(p3, 0.0, cols["volume"][use] / v0) if "volume" in cols else np.zeros(y.size)
+
+    def residual(x):
+        return _pressure_model(x, s, tau, dv, p3, p_atm) - y
+
+    def jacobian(x):
+        h = np.array([1e-6 * x[0], 1e-6])
+        return np.stack([(residual(x + np.eye(2)[i] * h[i]) - residual(x - np.eye(2)[i] * h[i]))
+                         / (2 * h[i]) for i in range(2)], axis=1)
+
+    sol = solve(residual, jacobian, [np.array([k_model, 0.0]), np.array([3 * k_model, 1.0])],
+                [1.0, -20.0], [1e9, 1.5])
+    if sol is None:
+        raise InputError(f"{data}: the phase 1 and 3 pressures fit no chamber (K, gamma)")
+    top = np.array([int(np.argmax(np.where(p3, s, -1.0)))])
+    hot = float(_pressure_model(sol.x, s[top], tau[top], dv[top], p3[top], p_atm)[0])
+    cold = float(_pressure_model(sol.x, s[top], np.ones(1), dv[top], p3[top], p_atm)[0])
+    return {"solution": sol, "stroke": s, "pressure": y, "sealed": p3, "t0": t0,
+            "fit": _pressure_model(sol.x, s, tau, dv, p3, p_atm),
+            "heating_share": (hot - cold) / hot if hot > 0 else math.nan}
 
 
 def _notes(phase, gamma, r2) -> list:
