@@ -45,6 +45,10 @@ def table(records, loo) -> str:
     lines = ["| model | quantity | median | range | within 15 % |", "|---|---|---|---|---|"]
     for model, q in ratios(records, loo).items():
         for name, r in q.items():
+            r = np.asarray(r, dtype=float)
+            r = r[np.isfinite(r)]
+            if r.size == 0:
+                continue
             ok = int(np.sum(np.abs(r - 1.0) <= TOLERANCE))
             lines.append(f"| {model} | {name} | {np.median(r):.3f} | {r.min():.3f}-"
                          f"{r.max():.3f} | {ok} of {r.size} |")

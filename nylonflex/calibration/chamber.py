@@ -46,18 +46,20 @@ TOLERANCE = 0.15
 def fe_records(folder) -> tuple[list, list]:
     """The sealed twin's records in ``folder`` (``design_NNN.json``, written by
     ``nf.fe_stroke`` runs; the folder's README.txt gives the format) as the records
-    :func:`fit_sealed_chamber` takes, the free and the blocked solve both reached, in index
-    order; and the names of the files left out (a solve that stalled, or a file that is not
-    a complete record)."""
+    :func:`fit_sealed_chamber` takes, in index order (``tip_force`` NaN where the blocked
+    solve stalled: the record still informs the free fit); and the names of the files left
+    out (a free solve that stalled, or a file that is not a complete record)."""
     records, skipped = [], []
     for path in sorted(Path(folder).glob("design_*.json")):
         try:
             doc = json.loads(path.read_text())
             reached = doc.get("reached", {})
-            if not (reached.get("free") and reached.get("blocked")):
+            if not reached.get("free"):
                 skipped.append(path.name)
                 continue
-            free, blocked = doc["free"], doc["blocked"]
+            free = doc["free"]
+            blocked = doc["blocked"] if reached.get("blocked") else \
+                {"tip_force": math.nan, "pressure": math.nan}
             rec = {"design": dict(doc["design"]), "stroke": float(doc["stroke"]),
                    "pressure": float(free["pressure"]),
                    "volume_ratio": float(free["volume_ratio"]),
@@ -74,7 +76,7 @@ def fe_records(folder) -> tuple[list, list]:
             skipped.append(path.name)
             continue
         if all(math.isfinite(rec[k]) and rec[k] > 0 for k in
-               ("stroke", "pressure", "bend_angle", "tip_force")):
+               ("stroke", "pressure", "bend_angle")):
             records.append(rec)
         else:
             skipped.append(path.name)
@@ -146,9 +148,11 @@ def _fit(records, groups, idx, silicone):
                                       np.nan))
     c0, c1 = _linear(g["x"], (theta - g["theta_p"]) * g["h"] / (s * L))
     k_sq = (c0 + c1 * g["x"]) * s / g["h"]
-    m_sq = np.array([squeeze_moment(k, *_design(r)[:3], silicone) for k, r in zip(k_sq, recs)])
-    z = m_sq / (force * L)
-    r = (force * L - g["moment_b"]) / (force * L)
+    blocked = np.isfinite(force) & (force > 0)  # records whose blocked solve was reached
+    m_sq = np.array([squeeze_moment(k, *_design(r)[:3], silicone)
+                     for k, r, ok in zip(k_sq, recs, blocked) if ok])
+    z = m_sq / (force * L)[blocked]
+    r = ((force * L - g["moment_b"]) / (force * L))[blocked]
     cb = float(z @ r / (z @ z)) if np.any(z > 0) else 1.0
     return (k0, k1, g0, g1, c0, c1, cb)
 
@@ -178,8 +182,9 @@ def fit_sealed_chamber(records, silicone="tc5005", p_atm=P_ATM, tolerance=TOLERA
         ``coefficients`` (name -> value, all records), ``stiffness_from`` (``"free_volume"``
         or ``"closed_form"``), ``designs`` (the records' designs), and ``loo``: per record
         the left-out prediction over the record of ``pressure``, ``bend_angle`` and
-        ``tip_force`` (lists), and ``within`` (how many of them are within ``tolerance``,
-        of ``n``).
+        ``tip_force`` (lists; NaN where the record has none), ``within`` (how many of them
+        are within ``tolerance``) of ``counted`` (how many are known), and
+        ``bend_and_force_within`` of ``n_both`` (designs with both known) and ``n``.
     """
     if len(records) < 3:
         raise ValueError(f"records: need at least 3 designs, got {len(records)}")
@@ -192,15 +197,17 @@ def fit_sealed_chamber(records, silicone="tc5005", p_atm=P_ATM, tolerance=TOLERA
         pred = _predict(records[j], c, silicone, p_atm)
         for name in loo:
             loo[name].append(pred[name] / float(records[j][name]))
-    within = {name: int(np.sum(np.abs(np.asarray(v) - 1.0) <= tolerance))
-              for name, v in loo.items()}
-    both = int(np.sum((np.abs(np.asarray(loo["bend_angle"]) - 1.0) <= tolerance)
-                      & (np.abs(np.asarray(loo["tip_force"]) - 1.0) <= tolerance)))
+    miss = {name: np.abs(np.asarray(v) - 1.0) for name, v in loo.items()}
+    within = {name: int(np.sum(m <= tolerance)) for name, m in miss.items()}
+    counted = {name: int(np.sum(np.isfinite(m))) for name, m in miss.items()}
+    both = int(np.sum((miss["bend_angle"] <= tolerance) & (miss["tip_force"] <= tolerance)))
+    n_both = int(np.sum(np.isfinite(miss["bend_angle"]) & np.isfinite(miss["tip_force"])))
     return {"coefficients": dict(zip(COEFFICIENT_NAMES, coef)),
             "stiffness_from": "free_volume" if np.any(np.isfinite(groups["stiffness"]))
             else "closed_form",
             "designs": [dict(r["design"]) for r in records],
-            "loo": {**loo, "within": within, "bend_and_force_within": both, "n": n,
+            "loo": {**loo, "within": within, "counted": counted,
+                    "bend_and_force_within": both, "n_both": n_both, "n": n,
                     "tolerance": tolerance}}
 
 

@@ -284,11 +284,15 @@ def run_sealed(args) -> int:
           + f" (stiffness: {fit['stiffness_from']})")
     print(f"  {loo['n']} designs ({len(skipped)} records left out); leave-one-out / FE:")
     for name in ("pressure", "bend_angle", "tip_force"):
-        r = np.asarray(loo[name])
+        r = np.asarray(loo[name], dtype=float)
+        r = r[np.isfinite(r)]
+        if r.size == 0:
+            print(f"  {name:<12} no FE values")
+            continue
         print(f"  {name:<12} median {np.median(r):.3f}, range {r.min():.3f}-{r.max():.3f}, "
               f"within {loo['tolerance']:.0%}: {loo['within'][name]} of {r.size}")
     print(f"  bend and blocked force both within {loo['tolerance']:.0%}: "
-          f"{loo['bend_and_force_within']} of {loo['n']}")
+          f"{loo['bend_and_force_within']} of {loo['n_both']}")
     print(f"wrote {out}")
     return 0
 
