@@ -13,6 +13,7 @@ import pytest
 import nylonflex as nf
 from conftest import DEG, EXAMPLE_1, EXAMPLE_2
 from nylonflex.materials import silicone_parameters
+from nylonflex.physics import material_moment
 from nylonflex.physics.chamber import P_ATM, _gauge_pressure
 from nylonflex.physics.limits import design_limits
 from nylonflex.physics.sealed import (COEFFICIENTS, ROUNDING_BOUND, _boyle_pressure,
@@ -135,6 +136,13 @@ def test_the_design_at_the_sealed_pressure():
         _squeeze_curvature(s, 20e-3, 6e-3, 6e-3, COEFFICIENTS) * 90e-3
     assert d["bend_angle_max"] == pytest.approx(theta, rel=1e-9)
     assert d["nylon_force_max"] < paper["nylon_force_max"]
+    # blocked: lateral_pressure's moment at p* plus c_b M_S(kappa_sq), over L
+    lateral = design_limits(**EXAMPLE_1, model="lateral_pressure")
+    m_lat = lateral["torque_max"] * p / lateral["pressure_max"]  # linear in p (s. 18)
+    k_sq = _squeeze_curvature(s, 20e-3, 6e-3, 6e-3, COEFFICIENTS)
+    m_sq = float(material_moment(k_sq, 20e-3, 6e-3))
+    assert d["torque_max"] == pytest.approx(m_lat + COEFFICIENTS[6] * m_sq, rel=1e-9)
+    assert d["tip_force_max"] == pytest.approx(d["torque_max"] / 90e-3, rel=1e-14)
 
 
 def test_the_shipped_file_says_what_it_is():
