@@ -180,6 +180,14 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
     assert settings.chamber == pytest.approx(tuple(coef))
     again = nf.evaluate(*grids, **settings.evaluate_kwargs("sealed_chamber"))
     np.testing.assert_allclose(again["pressure_max"], exact["pressure_max"], rtol=1e-12)
+    # info --config names the file again, while it says what the cube ran with
+    from nylonflex.engine.provenance import runnable_config
+    text = runnable_config(back.attrs)
+    assert yaml.safe_load(text)["chamber"] == {"file": str(out)}
+    assert parse_config(yaml.safe_load(text)).sha256 == cfg.sha256
+    out.write_text(out.read_text().replace("squeeze: ", "squeeze: 1", 1))
+    with pytest.raises(ValueError, match="chamber file .* has changed since the sweep"):
+        runnable_config(back.attrs)
 
 
 def test_a_chamber_file_needs_the_sealed_model_and_a_good_file(tmp_path):

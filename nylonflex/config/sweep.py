@@ -236,7 +236,7 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
     if cfg.coolings:
         doc["cooling"] = [c.to_dict() for c in cfg.coolings]
     if cfg.chamber is not None:  # only then: other cubes keep their hash
-        doc["chamber"] = {k: v for k, v in cfg.chamber.items() if k != "file"}
+        doc["chamber"] = dict(cfg.chamber)
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 

@@ -13,13 +13,14 @@ import yaml
 
 from .. import __version__
 from ..config import ResolvedConfig, parse_config
+from ..config.material_files import read_chamber_file
 from ..config.tracking import tracking_section
 from ..kernels import source_digest
 from ..materials import (COOLING_PARAMETERS, Cooling, Nylon, Silicone, cooling_parameters,
                          nylon_parameters, silicone_parameters)
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
-from ..units import decimal_to_si, from_si
+from ..units import InputError, decimal_to_si, from_si
 from .model_slab import chamber_coefficients
 from ..variables import is_complete  # noqa: F401 - re-exported
 from ..variables import AXES, VARIABLES
@@ -479,6 +480,8 @@ def runnable_config(attrs) -> str:
         out["requirements"] = list(doc["requirements"])
     if "tracking" in doc:  # docs/model.md s. 19
         out["tracking"] = tracking_section(doc["tracking"])
+    if "chamber" in doc:  # docs/bench.md: by its file, while that still says the same
+        out["chamber"] = _chamber_spec(doc["chamber"])
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
     out["charts"] = []
@@ -493,6 +496,21 @@ def runnable_config(attrs) -> str:
             f"{str(attrs.get('config_sha256', ''))[:16]}), written by nylonflex info "
             "--config\n")
     return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
+
+
+def _chamber_spec(chamber: dict) -> dict:
+    """``chamber: {file: ...}`` of a cube's config, its file checked to hold the values the
+    cube ran with (a ValueError naming it otherwise: no other form can recompute it)."""
+    path = str(chamber.get("file", ""))
+    try:
+        now = read_chamber_file(path)
+    except InputError as err:
+        raise ValueError(f"cube: its chamber file cannot be read ({err}); cannot rebuild "
+                         "its config") from None
+    if any(now.get(k) != v for k, v in chamber.items() if k != "file"):
+        raise ValueError(f"cube: its chamber file {path} has changed since the sweep; "
+                         "cannot rebuild its config")
+    return {"file": path}
 
 
 #: The SI unit a config may give each axis in (the last resort of :func:`runnable_config`).
