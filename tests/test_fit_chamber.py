@@ -180,6 +180,15 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
     assert settings.chamber == pytest.approx(tuple(coef))
     again = nf.evaluate(*grids, **settings.evaluate_kwargs("sealed_chamber"))
     np.testing.assert_allclose(again["pressure_max"], exact["pressure_max"], rtol=1e-12)
+    # design re-evaluates a one-model cube's designs under the coefficients it ran with
+    from nylonflex.design import parse_spec, run_design
+    one = run_sweep(parse_config(_sweep_raw(out)))
+    res = run_design(parse_spec({"cube": "unused.h5", "objectives": [{"max": "tip_force_max"}],
+                                 "refine": {"starts": 2, "maxiter": 5}}), cube=one)
+    best = res.designs[0]
+    want = nf.evaluate(*(best[a] for a in ("radius", "wall_thickness", "length", "coil_index",
+                                           "wrap_angle")), model="sealed_chamber", chamber=coef)
+    assert best["tip_force_max"] == pytest.approx(float(want["tip_force_max"]), rel=1e-9)
     # info --config names the file again, while it says what the cube ran with
     from nylonflex.engine.provenance import runnable_config
     text = runnable_config(back.attrs)
