@@ -165,7 +165,9 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
                  "20mm", "--wall-thickness", "6mm", "--length", "90mm", "--out", str(out)]) == 0
     measured = read_chamber_file(out)
     cfg = parse_config(_sweep_raw(out, ("paper", "sealed_chamber")))
-    coef = anchored_coefficients(measured, silicone_parameters("tc5005").initial_shear_modulus)
+    assert measured["initial_shear_modulus"] == pytest.approx(
+        silicone_parameters("tc5005").initial_shear_modulus)
+    coef = anchored_coefficients(measured, measured["initial_shear_modulus"])
     ds = run_sweep(cfg, out=tmp_path / "cube.h5")
     grids = np.meshgrid(*cfg.axes.values(), indexing="ij")
     exact = nf.evaluate(*grids, model="sealed_chamber", chamber=coef)

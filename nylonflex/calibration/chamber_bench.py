@@ -23,6 +23,7 @@ import math
 import numpy as np
 from scipy import stats
 
+from ..materials import silicone_parameters
 from ..physics import P_ATM
 from ..physics.sealed_model import boyle_pressure, chamber_stiffness
 from ..units import InputError
@@ -86,7 +87,8 @@ def fit_chamber(data, radius, wall_thickness, length, base_thickness=None,
     chamber_volume : float, optional
         V0 [m^3]; pi a^2 L / 2 when None.
     silicone : str, dict or Silicone
-        The silicone it is made of (for K over the model's closed form).
+        The silicone it is made of (for K over the model's closed form; its initial shear
+        modulus is written with the design, the mu0 a sweep anchors K on).
     name : str
         Name of the fitted set.
     p_atm : float
@@ -142,7 +144,9 @@ def fit_chamber(data, radius, wall_thickness, length, base_thickness=None,
                "stiffness_factor": "1", "stiffness_held": "Pa", "heating_share": "1",
                "rmse": "Pa"},
         extra={"design": {"radius": radius, "wall_thickness": wall_thickness, "length": length,
-                          "base_thickness": b, "chamber_volume": v0}},
+                          "base_thickness": b, "chamber_volume": v0,
+                          "initial_shear_modulus": silicone_parameters(silicone)
+                          .initial_shear_modulus}},
         notes=_notes(phase, gamma, r2))
 
 

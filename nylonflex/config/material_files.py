@@ -131,7 +131,8 @@ CHAMBER_FIELDS = {"stiffness": ("Pa", 0.0, 1e9), "rounding": ("1", -20.0, 1.5),
 def read_chamber_file(path) -> dict:
     """A chamber file (``kind: chamber``, written by ``nylonflex fit chamber``) as its fitted
     values {name: SI float} (:data:`CHAMBER_FIELDS`), checked against the units it names,
-    with the ``radius`` and ``wall_thickness`` [m] of the actuator it was measured on.
+    with the ``radius`` and ``wall_thickness`` [m] of the actuator it was measured on and
+    its silicone's ``initial_shear_modulus`` [Pa].
 
     Raises
     ------
@@ -154,11 +155,14 @@ def read_chamber_file(path) -> dict:
                              f"{units.get(key)!r}")
         out[key] = float(v)
     design = doc.get("design") or {}
-    for key in ("radius", "wall_thickness"):
+    for key, lo, hi, shown in (("radius", 1e-4, 1.0, "[0.1, 1000] mm (written in m)"),
+                               ("wall_thickness", 1e-4, 1.0, "[0.1, 1000] mm (written in m)"),
+                               ("initial_shear_modulus", 1e2, 1e8,
+                                "[100 Pa, 100 MPa] (written in Pa)")):
         v = design.get(key) if isinstance(design, dict) else None
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 1e-4 <= v <= 1.0:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= v <= hi:
             raise InputError(f"{path}: design.{key}: must be the measured actuator's, in "
-                             f"[0.1, 1000] mm (written in m), got {v!r}")
+                             f"{shown}, got {v!r}")
         out[key] = float(v)
     return out
 

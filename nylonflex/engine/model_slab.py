@@ -84,11 +84,12 @@ def kernel_inputs(cfg: ResolvedConfig, model: int) -> tuple:
 def chamber_coefficients(cfg) -> SealedCoefficients:
     """``sealed_chamber``'s coefficients for a sweep: the shipped ones, or those anchored on
     its ``chamber:`` file's measured actuator (``physics.sealed.anchored_coefficients``,
-    with the sweep's silicone)."""
+    with that actuator's silicone's mu0: the sweep's own silicone then scales K by its mu0,
+    sample by sample in a sampled sweep)."""
     chamber = getattr(cfg, "chamber", None)
     if chamber is None:
         return sealed_coefficients()
-    return anchored_coefficients(chamber, cfg.silicone.initial_shear_modulus)
+    return anchored_coefficients(chamber, chamber["initial_shear_modulus"])
 
 
 def paper_kernel(cfg: ResolvedConfig) -> bool:
