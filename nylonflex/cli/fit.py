@@ -24,7 +24,7 @@ as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md
   nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
   nylonflex fit thermal step.csv --voltage 5V --muscle-length 300mm
   nylonflex fit muscle force.csv
-  nylonflex fit chamber bench.csv --radius 20mm --wall-thickness 6mm --length 90mm \
+  nylonflex fit chamber bench.csv --radius 20mm --wall-thickness 6mm --length 90mm \\
       --out fits/chamber.yaml                                 # docs/bench.md
   nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]
   nylonflex fit sealed fe_runs/ --out sealed_chamber.json    # sealed_chamber from FE records"""
@@ -266,7 +266,8 @@ def run_sealed(args) -> int:
         raise InputError(f"DIR: records of several silicones ({', '.join(sorted(silicones))}); "
                          "fit one at a time")
     if len(records) < 3:
-        raise InputError(f"DIR: {len(records)} complete records in {args.data}; need at least 3")
+        raise InputError(f"DIR: {len(records)} complete record(s) in {args.data}; need at "
+                         "least 3")
     silicone = silicones.pop()
     fit = fit_sealed_chamber(records, silicone)
     doc = calibration_document(fit, records, {
