@@ -52,13 +52,15 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "ohm": ("resistance", 1.0, 0.0),
     "kohm": ("resistance", 1e3, 0.0),
     "mA": ("current", 1e-3, 0.0),
+    "ml": ("volume", 1e-6, 0.0),
+    "uL": ("volume", 1e-9, 0.0),
     "1": ("dimensionless", 1.0, 0.0),
     "%": ("dimensionless", 1e-2, 0.0),
 }
 
 _ALIASES = {"Nm": "N m", "N*m": "N m", "N.m": "N m", "Nmm": "N mm", "C": "degC",
             "celsius": "degC", "degrees": "deg", "degree": "deg", "": "1", "-": "1",
-            "mNm": "mN m", "Ohm": "ohm", "\u03a9": "ohm"}
+            "mNm": "mN m", "Ohm": "ohm", "mL": "ml", "ul": "uL", "\u03a9": "ohm"}
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 

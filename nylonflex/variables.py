@@ -28,7 +28,7 @@ __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.
 MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment",
-          "lateral_pressure", "fe_calibrated")
+          "lateral_pressure", "fe_calibrated", "sealed_chamber")
 
 #: The design axes, in the cube's order.
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
@@ -301,7 +301,7 @@ TRACKING = {v.name: v for v in [
 ]}
 
 #: The headline design variables whose range over model variants a sweep with
-#: ``fidelity: spread`` stores (docs/model.md s. 22): the torque of figure 12(b), the tip
+#: ``fidelity: spread`` stores (docs/model.md s. 23): the torque of figure 12(b), the tip
 #: force, the bend angle and the range of motion of figure 12(c).
 SPREAD_OF = ("torque_max", "tip_force_max", "bend_angle_max", "range_fraction")
 
@@ -319,10 +319,10 @@ def _spread_variable(v: Variable, side: str) -> Variable:
     return Variable(spread_name(v.name, side), AXES, v.units, f"{v.long_name}, {word} model",
                     f"the {word} {v.name} over the model variants of fidelity.spread (the "
                     "cube attribute model_spread), flagged designs included (docs/model.md "
-                    f"s. 22); {v.description}", v.display, v.kind, by_model=True)
+                    f"s. 23); {v.description}", v.display, v.kind, by_model=True)
 
 
-#: Variables of a sweep with ``fidelity: spread`` (docs/model.md s. 22): the range of each
+#: Variables of a sweep with ``fidelity: spread`` (docs/model.md s. 23): the range of each
 #: of :data:`SPREAD_OF` over the named model variants, and the OR of their validity bits;
 #: the cube holds them only then. Never a ``model`` dimension of their own (they summarise
 #: it); ``by_model`` lets them follow their variable onto a ``cooling`` dimension.

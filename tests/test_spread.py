@@ -1,5 +1,5 @@
 """Issue 45: ``fidelity: spread``, the range of the headline variables over model variants
-(docs/model.md s. 22).
+(docs/model.md s. 23).
 
 The range is checked against separate one-model sweeps of the same grid (an independent
 path: each runs the kernel on its own), the cube's own values against a sweep without a
@@ -114,7 +114,7 @@ def test_round_trip_through_the_cube_file_with_units(tmp_path, spread_cube):
         base = disk[name].attrs["units"]
         for side in ("lo", "hi"):
             attrs = disk[spread_name(name, side)].attrs
-            assert attrs["units"] == base and "docs/model.md s. 22" in attrs["description"]
+            assert attrs["units"] == base and "docs/model.md s. 23" in attrs["description"]
     assert disk["validity_model_any"].attrs["flag_meanings"].split()[3] == "chamber_closes"
     assert label(disk["tip_force_max_model_lo"]) == "maximum tip force, lowest model [N]"
     assert label(disk["bend_angle_max_model_hi"]) == "maximum bend angle, highest model [deg]"

@@ -1,4 +1,4 @@
-"""A cube's model spread on the figure-12 panels (``fidelity: spread``, docs/model.md s. 22).
+"""A cube's model spread on the figure-12 panels (``fidelity: spread``, docs/model.md s. 23).
 
 Each coil index's curve gets range bars, from the lowest to the highest value of its
 variable over the cube's model variants (``<var>_model_lo``/``_hi``), at a few radii and

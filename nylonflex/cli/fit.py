@@ -1,5 +1,6 @@
 """``nylonflex fit silicone|stroke|thermal|muscle DATA``: fit a set, write its material file;
-``nylonflex fit fe``: fit ``fe_calibrated``'s correction to FE runs of the twin."""
+``nylonflex fit fe``: fit ``fe_calibrated``'s correction to FE runs of the twin;
+``nylonflex fit chamber DATA``: the sealed chamber of one built actuator (docs/bench.md)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ from ..units import InputError, json_text, parse_quantity
 from . import warn
 from ._common import progress_bar
 
-HELP = "fit a silicone or nylon muscle set to bench data, or fe_calibrated to the FE twin"
+HELP = ("fit a silicone or nylon muscle set or a sealed chamber to bench data, or "
+        "fe_calibrated to the FE twin")
 DESCRIPTION = """Fit a material set to measurements and write the material file a config uses
 as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md.
 
@@ -22,15 +24,19 @@ as `silicone: {file: ...}` or `nylon: {file: ...}`. Formats: docs/calibration.md
   nylonflex fit stroke heating.csv --coil-index 1.5 --out fits/nylon.yaml
   nylonflex fit thermal step.csv --voltage 5V --muscle-length 300mm
   nylonflex fit muscle force.csv
-  nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]"""
+  nylonflex fit chamber bench.csv --radius 20mm --wall-thickness 6mm --length 90mm \\
+      --out fits/chamber.yaml                                 # docs/bench.md
+  nylonflex fit fe --designs 48 --workers 2 --out fe_calibration.json   # needs [fe]
+  nylonflex fit sealed fe_runs/ --out sealed_chamber.json    # sealed_chamber from FE records"""
 
-KINDS = ("silicone", "stroke", "thermal", "muscle", "fe")
+KINDS = ("silicone", "stroke", "thermal", "muscle", "fe", "chamber", "sealed")
 
 
 def add_arguments(p):
     p.add_argument("kind", choices=KINDS, help="what to fit")
     p.add_argument("data", nargs="?", help="data file (CSV with units in the header, or a "
-                   "Soft Robotics Materials Database file); none for 'fe'")
+                   "Soft Robotics Materials Database file); none for 'fe'; for 'sealed' the "
+                   "folder of the sealed FE twin's records")
     p.add_argument("--model", default="ogden2",
                    help="silicone: ogden1|ogden2|ogden3|neo_hookean|yeoh2 (default ogden2)")
     p.add_argument("--test", default="uniaxial", choices=["uniaxial", "planar"],
@@ -46,6 +52,14 @@ def add_arguments(p):
                    help="stroke/thermal/muscle: base nylon set (T_amb, T_max, coil table)")
     p.add_argument("--t-amb", help="ambient temperature, e.g. 25degC (default: the set's)")
     p.add_argument("--t-max", help="highest temperature, e.g. 150degC (default: the set's)")
+    p.add_argument("--radius", help="chamber: the actuator's radius, e.g. 20mm")
+    p.add_argument("--wall-thickness", help="chamber: its wall thickness, e.g. 6mm")
+    p.add_argument("--length", help="chamber: its length, e.g. 90mm")
+    p.add_argument("--base-thickness", help="chamber: its base thickness (default the wall's)")
+    p.add_argument("--chamber-volume", help="chamber: its measured volume V0, e.g. 56ml "
+                   "(default pi a^2 L / 2)")
+    p.add_argument("--silicone", default="tc5005",
+                   help="chamber: the silicone set it is made of (default tc5005)")
     p.add_argument("--name", default="", help="name of the fitted set")
     p.add_argument("--out", metavar="FILE.yaml", help="write the material file here")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
@@ -71,6 +85,8 @@ def fit(args):
     t_max = _q(args.t_max, "--t-max", "temperature", "degC")
     if args.kind == "silicone":
         return fit_silicone(args.data, args.model, args.test, args.max_stretch, args.name)
+    if args.kind == "chamber":
+        return _fit_chamber(args)
     nylon = {"file": args.nylon} if args.nylon.endswith((".yaml", ".yml")) else args.nylon
     if args.kind == "stroke":
         if args.coil_index is None:
@@ -84,6 +100,27 @@ def fit(args):
                            _q(args.resistance, "--resistance", "resistance", "ohm"),
                            nylon, t_amb, args.name)
     return fit_muscle(args.data, nylon, t_amb, t_max, args.name)
+
+
+def _fit_chamber(args):
+    from ..calibration.chamber_bench import fit_chamber
+
+    size = {}
+    for flag in ("radius", "wall_thickness", "length"):
+        text = getattr(args, flag)
+        if text is None:
+            raise InputError(f"--{flag.replace('_', '-')}: required for 'fit chamber', "
+                             "e.g. 20mm")
+        size[flag] = _q(text, f"--{flag.replace('_', '-')}", "length", "mm")
+        if not size[flag] > 0:
+            raise InputError(f"--{flag.replace('_', '-')}: must be > 0 mm, got {text}")
+    base = _q(args.base_thickness, "--base-thickness", "length", "mm")
+    volume = _q(args.chamber_volume, "--chamber-volume", "volume", "ml")
+    for flag, v in (("--base-thickness", base), ("--chamber-volume", volume)):
+        if v is not None and not v > 0:
+            raise InputError(f"{flag}: must be > 0, got {v:g} (SI)")
+    return fit_chamber(args.data, **size, base_thickness=base, chamber_volume=volume,
+                       silicone=args.silicone, name=args.name)
 
 
 def _shown(unit, value, spread=False):
@@ -206,9 +243,66 @@ def run_fe(args) -> int:
     return 0
 
 
+def run_sealed(args) -> int:
+    """``fit sealed DIR``: ``sealed_chamber``'s coefficients from the sealed FE twin's
+    records in DIR, with their leave-one-design-out errors, as the JSON file the variant
+    ships (``nylonflex/physics/sealed_chamber.json``)."""
+    from datetime import datetime, timezone
+
+    import numpy as np
+
+    from ..calibration.chamber import calibration_document, fe_records, fit_sealed_chamber
+    from ..storage.files import refuse_special, write_atomic
+
+    if args.data is None or not Path(args.data).is_dir():
+        raise InputError(f"DIR: 'fit sealed' needs the folder of FE records, got {args.data!r}")
+    out = Path(args.out or "sealed_chamber.json")
+    refuse_special(out, "--out", [])
+    if os.path.lexists(out) and not args.overwrite:
+        raise InputError(f"--out {out}: exists; give --overwrite to replace it")
+    records, skipped = fe_records(args.data)
+    silicones = {r["silicone"] for r in records}
+    if len(silicones) > 1:
+        raise InputError(f"DIR: records of several silicones ({', '.join(sorted(silicones))}); "
+                         "fit one at a time")
+    if len(records) < 3:
+        raise InputError(f"DIR: {len(records)} complete record(s) in {args.data}; need at "
+                         "least 3")
+    silicone = silicones.pop()
+    fit = fit_sealed_chamber(records, silicone)
+    doc = calibration_document(fit, records, {
+        "command": "nylonflex fit sealed " + " ".join(sys.argv[3:]),
+        "nylonflex_version": __version__,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "records": str(args.data), "skipped": skipped, "silicone": silicone})
+    write_atomic(out, json_text(doc, indent=1).encode(), what="fit sealed")
+    if args.format == "json":
+        sys.stdout.write(json_text(doc, indent=2))
+        return 0
+    loo = fit["loo"]
+    print("sealed_chamber: " + ", ".join(f"{k} {v:+.4f}" for k, v in
+                                         fit["coefficients"].items())
+          + f" (stiffness: {fit['stiffness_from']})")
+    print(f"  {loo['n']} designs ({len(skipped)} records left out); leave-one-out / FE:")
+    for name in ("pressure", "bend_angle", "tip_force"):
+        r = np.asarray(loo[name], dtype=float)
+        r = r[np.isfinite(r)]
+        if r.size == 0:
+            print(f"  {name:<12} no FE values")
+            continue
+        print(f"  {name:<12} median {np.median(r):.3f}, range {r.min():.3f}-{r.max():.3f}, "
+              f"within {loo['tolerance']:.0%}: {loo['within'][name]} of {r.size}")
+    print(f"  bend and blocked force both within {loo['tolerance']:.0%}: "
+          f"{loo['bend_and_force_within']} of {loo['n_both']}")
+    print(f"wrote {out}")
+    return 0
+
+
 def run(args) -> int:
     if args.kind == "fe":
         return run_fe(args)
+    if args.kind == "sealed":
+        return run_sealed(args)
     if args.data is None:
         raise InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
     from ..calibration import write_material_file

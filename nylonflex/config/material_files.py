@@ -22,8 +22,8 @@ from .._version import __version__
 from ..units import InputError
 from .safe_yaml import read_yaml
 
-__all__ = ["anchor_material_files", "material_document", "read_material_set",
-           "write_material_file"]
+__all__ = ["CHAMBER_FIELDS", "anchor_material_files", "material_document", "read_chamber_file",
+           "read_material_set", "write_material_file"]
 
 _OGDEN_FORMS = ("ogden1", "ogden2", "ogden3", "neo_hookean")
 
@@ -53,12 +53,14 @@ def material_document(result, name=None, fields=None) -> dict:
         For a nylon fit: ``{"base": set name, field: value, ...}`` to write.
     """
     name = name or result.name or Path(result.data["path"]).stem
-    doc = {"kind": "silicone" if result.kind == "silicone" else "nylon", "name": name,
-           "fit": result.kind, "model": result.model}
+    kind = result.kind if result.kind in ("silicone", "chamber") else "nylon"
+    doc = {"kind": kind, "name": name, "fit": result.kind, "model": result.model}
     if result.test:
         doc["test"] = result.test
-    if result.kind == "silicone":
+    if result.kind in ("silicone", "chamber"):
         doc.update(result.parameters)
+        if "design" in result.extra:  # the chamber's: the actuator it was measured on
+            doc["design"] = dict(result.extra["design"])
     else:
         doc.update(fields if fields is not None else result.extra.get("fields", {}))
     doc["parameters"] = dict(result.parameters)
@@ -115,10 +117,54 @@ def read_material_file(path) -> dict:
     if not p.is_file():
         raise InputError(f"{path}: no such material file")
     doc = read_yaml(p)
-    if not isinstance(doc, dict) or doc.get("kind") not in ("silicone", "nylon"):
-        raise InputError(f"{path}: not a nylonflex material file (needs 'kind: silicone' or "
-                         "'kind: nylon')")
+    if not isinstance(doc, dict) or doc.get("kind") not in ("silicone", "nylon", "chamber"):
+        raise InputError(f"{path}: not a nylonflex material file (needs 'kind: silicone', "
+                         "'kind: nylon' or 'kind: chamber')")
     return doc
+
+
+#: A chamber file's fitted values (``nylonflex fit chamber``), their SI units and ranges.
+CHAMBER_FIELDS = {"stiffness": ("Pa", 0.0, 1e9), "rounding": ("1", -20.0, 1.5),
+                  "air_heating": ("1", 0.0, 1.0), "squeeze": ("1", 0.0, 20.0)}
+
+
+def read_chamber_file(path) -> dict:
+    """A chamber file (``kind: chamber``, written by ``nylonflex fit chamber``) as its fitted
+    values {name: SI float} (:data:`CHAMBER_FIELDS`), checked against the units it names,
+    with the ``radius`` and ``wall_thickness`` [m] of the actuator it was measured on and
+    its silicone's ``initial_shear_modulus`` [Pa].
+
+    Raises
+    ------
+    InputError
+        A missing or malformed file, another kind, a value missing, outside its range or
+        with another unit than the file's ``units`` table says.
+    """
+    doc = read_material_file(path)
+    if doc["kind"] != "chamber":
+        raise InputError(f"chamber.file: {path} is a {doc['kind']} file, not chamber")
+    units = doc.get("units") or {}
+    out = {}
+    for key, (unit, lo, hi) in CHAMBER_FIELDS.items():
+        v = doc.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= v <= hi:
+            raise InputError(f"{path}: {key}: must be a number in [{lo:g}, {hi:g}] {unit}, "
+                             f"got {v!r}")
+        if units.get(key) != unit:
+            raise InputError(f"{path}: {key}: the file's units must say {unit!r}, got "
+                             f"{units.get(key)!r}")
+        out[key] = float(v)
+    design = doc.get("design") or {}
+    for key, lo, hi, shown in (("radius", 1e-4, 1.0, "[0.1, 1000] mm (written in m)"),
+                               ("wall_thickness", 1e-4, 1.0, "[0.1, 1000] mm (written in m)"),
+                               ("initial_shear_modulus", 1e2, 1e8,
+                                "[100 Pa, 100 MPa] (written in Pa)")):
+        v = design.get(key) if isinstance(design, dict) else None
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= v <= hi:
+            raise InputError(f"{path}: design.{key}: must be the measured actuator's, in "
+                             f"{shown}, got {v!r}")
+        out[key] = float(v)
+    return out
 
 
 def read_material_set(kind: str, path, table: dict, known=()) -> tuple[str, dict]:
@@ -187,7 +233,8 @@ def read_material_set(kind: str, path, table: dict, known=()) -> tuple[str, dict
 
 
 def anchor_material_files(raw, folder):
-    """Make relative ``file`` paths of ``silicone``/``nylon`` mappings relative to ``folder``.
+    """Make relative ``file`` paths of ``silicone``/``nylon``/``chamber`` mappings relative to
+    ``folder``.
 
     Walks the config mapping (top level and nested actuators) and returns a copy.
     """
@@ -198,7 +245,7 @@ def anchor_material_files(raw, folder):
         return raw
     out = {}
     for key, value in raw.items():
-        if key in ("silicone", "nylon") and isinstance(value, dict) and \
+        if key in ("silicone", "nylon", "chamber") and isinstance(value, dict) and \
                 isinstance(value.get("file"), str) and not Path(value["file"]).is_absolute():
             value = {**value, "file": str(folder / value["file"])}
         elif isinstance(value, (dict, list)):

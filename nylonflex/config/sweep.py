@@ -26,7 +26,7 @@ from pydantic import BeforeValidator, Field, ValidationError, field_validator, m
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
-from .material_files import anchor_material_files
+from .material_files import anchor_material_files, read_chamber_file
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
 from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES
@@ -122,11 +122,18 @@ class Limits(_Strict):
 
 class Spread(_Strict):
     """``fidelity: {spread: [variant, ...]}``: the model variants whose range the cube
-    stores beside each headline value (docs/model.md s. 22)."""
+    stores beside each headline value (docs/model.md s. 23)."""
 
     # checked by _spread (one line naming the entry); the schema lists the variants
     spread: list[str] = Field(json_schema_extra={"items": {"enum": list(MODELS)},
                                                  "minItems": 2, "uniqueItems": True})
+
+
+class ChamberFile(_Strict):
+    """``chamber: {file: fits/chamber.yaml}``: a ``nylonflex fit chamber`` file
+    (``sealed_chamber``, docs/bench.md)."""
+
+    file: str
 
 
 class SweepConfig(_Strict):
@@ -149,8 +156,9 @@ class SweepConfig(_Strict):
     tracking: Tracking | None = None
     cooling: Union[str, dict[str, Any], list[Union[str, dict[str, Any]]], None] = None
     # "spread": the range over every variant (or over model's list); {spread: [...]}: over
-    # those (docs/model.md s. 22)
+    # those (docs/model.md s. 23)
     fidelity: Union[Literal["spread"], Spread, None] = None
+    chamber: ChamberFile | None = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
 
@@ -196,8 +204,11 @@ class ResolvedConfig:
     # several cooling sets: the cube's string ``cooling`` dimension (then ``cooling`` is None)
     coolings: tuple[Cooling, ...] = ()
     # ``fidelity: spread``: the model variants the cube's <var>_model_lo/_hi range over;
-    # () without a spread (docs/model.md s. 22)
+    # () without a spread (docs/model.md s. 23)
     spread: tuple[str, ...] = ()
+    # a chamber file's measured values (``sealed_chamber``; docs/bench.md), SI, with the
+    # file's path: the kernels' coefficients are anchored on them (engine.model_slab)
+    chamber: dict | None = None
 
     @property
     def cooling_names(self) -> tuple[str, ...]:
@@ -255,6 +266,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["cooling"] = [c.to_dict() for c in cfg.coolings]
     if cfg.spread:  # only then: cubes without a model spread keep their hash
         doc["fidelity"] = {"spread": list(cfg.spread)}
+    if cfg.chamber is not None:  # only then: other cubes keep their hash
+        doc["chamber"] = dict(cfg.chamber)
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -356,6 +369,15 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                               tracking is not None):
         raise InputError("cooling: a sweep with uncertainty, requirements or tracking takes "
                          "one cooling set; sweep each set on its own")
+    chamber = None
+    if cfg.chamber is not None:
+        if "sealed_chamber" not in models:
+            raise InputError("chamber: applies to model sealed_chamber only; add it to model: "
+                             f"(got {', '.join(models)})")
+        try:
+            chamber = {**read_chamber_file(cfg.chamber.file), "file": cfg.chamber.file}
+        except InputError as err:
+            raise InputError(f"chamber.file: {err}") from None
     return ResolvedConfig(name=cfg.name, axes=axes, curves=curves, base_thickness=base,
                           silicone=silicone, nylon=nylon, charts=tuple(cfg.charts),
                           slab_megabytes=cfg.slab_megabytes, compression=cfg.compression,
@@ -364,7 +386,7 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                           supply_voltage=voltage, tracking=tracking,
                           cooling=coolings[0] if len(coolings) == 1 else None,
                           coolings=coolings if len(coolings) > 1 else (),
-                          spread=_spread(cfg.fidelity, models))
+                          spread=_spread(cfg.fidelity, models), chamber=chamber)
 
 
 def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:

@@ -113,7 +113,7 @@ def _materials(ds, spec):
                          f"{', '.join(c.label for c in s.coolings)}); design answers one: sweep "
                          "the grid with one cooling set")
     return Model(s.silicone, s.nylon, s.base_thickness, s.models[0], _memo(s),
-                 supply_voltage=s.supply_voltage, cooling=s.cooling)
+                 supply_voltage=s.supply_voltage, cooling=s.cooling, chamber=s.chamber)
 
 
 @functools.lru_cache(maxsize=8)

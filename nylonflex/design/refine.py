@@ -65,14 +65,18 @@ class Model:
         The cube's supply [V] (docs/model.md s. 15); None: no supply limit.
     cooling : Cooling, optional
         The cube's cooling set (docs/model.md s. 9); None: the nylon set's heat loss.
+    chamber : tuple, optional
+        ``sealed_chamber``'s coefficients the cube ran with (docs/model.md s. 22); None:
+        the shipped ones.
     """
 
     def __init__(self, silicone, nylon, base_thickness=None, model="paper", memo=None,
-                 supply_voltage=None, cooling=None):
+                 supply_voltage=None, cooling=None, chamber=None):
         self.silicone, self.nylon = silicone, nylon
         self.base_thickness, self.model = base_thickness, model
         self.supply_voltage = supply_voltage
         self.cooling = cooling
+        self.chamber = chamber
         self.evaluations = 0
         # designs already evaluated with these materials (shared between runs on one cube)
         self.memo = {} if memo is None else memo
@@ -87,7 +91,8 @@ class Model:
             design = dict(zip(AXES, X[todo].T))
             values = _exact(**design, base_thickness=self.base_thickness,
                             silicone=self.silicone, nylon=self.nylon, model=self.model,
-                            supply_voltage=self.supply_voltage, cooling=self.cooling)
+                            supply_voltage=self.supply_voltage, cooling=self.cooling,
+                            chamber=self.chamber)
             values = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in values.items()}
             if len(self.memo) > _MEMO_MAX:
                 self.memo.clear()
@@ -100,12 +105,13 @@ class Model:
 
 
 def _exact(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness,
-           silicone, nylon, model, supply_voltage=None, cooling=None):
+           silicone, nylon, model, supply_voltage=None, cooling=None, chamber=None):
     """The one call into the exact pointwise model, :func:`nylonflex.evaluate` (compiled;
     every design variable, SI)."""
     return evaluate(radius, wall_thickness, length, coil_index, wrap_angle,
                     base_thickness=base_thickness, silicone=silicone, nylon=nylon,
-                    model=model, supply_voltage=supply_voltage, cooling=cooling)
+                    model=model, supply_voltage=supply_voltage, cooling=cooling,
+                    chamber=chamber)
 
 
 def evaluate_rows(model, rows) -> dict:

@@ -49,7 +49,7 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
     out.update({n: (v, v.dims) for n, v in uncertain_variables(cfg).items()})
     # the closed loop of every design (docs/model.md s. 19)
     out.update({n: (v, v.dims) for n, v in tracking_variables(cfg).items()})
-    # the range over a model spread, on its variable's cooling dimension (docs/model.md s. 22)
+    # the range over a model spread, on its variable's cooling dimension (docs/model.md s. 23)
     out.update({n: (v, v.dims_for((), cfg.cooling_names, supply))
                 for n, v in spread_variables(cfg).items()})
     return out
@@ -208,7 +208,7 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
     slabs = {(m, k): _compute_model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
              for m in cfg.models for k, one in enumerate(coolings)}
     # a model spread's other variants: the kernel's rows alone, for the range
-    # (docs/model.md s. 22)
+    # (docs/model.md s. 23)
     extra = {(m, k): model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
              for m in extra_models(cfg) for k, one in enumerate(coolings)}
     variables = cube_variables(cfg)

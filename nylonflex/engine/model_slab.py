@@ -17,6 +17,8 @@ from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.nylon import nylon_force_limit, stroke_max
+from ..physics.records import SealedCoefficients
+from ..physics.sealed import anchored_coefficients, sealed_coefficients
 from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length
 from ..physics.wrap import muscle_width
 from ..variables import CURVES, DESIGN
@@ -73,9 +75,21 @@ def kernel_inputs(cfg: ResolvedConfig, model: int) -> tuple:
     :class:`~nylonflex.kernels.records.Ogden`, the quadrature's nodes, the muscle and the
     :class:`~nylonflex.kernels.records.Options`."""
     voltage = -1.0 if cfg.supply_voltage is None else float(cfg.supply_voltage)
-    options = Options(model, voltage, float(cfg.silicone.stretch_range[1]))
+    options = Options(model, voltage, float(cfg.silicone.stretch_range[1]),
+                      chamber_coefficients(cfg))
     return (coil_table(cfg), Ogden(*cfg.silicone.arrays()), Nodes(*quadrature_nodes()),
             muscle_record(cfg), options)
+
+
+def chamber_coefficients(cfg) -> SealedCoefficients:
+    """``sealed_chamber``'s coefficients for a sweep: the shipped ones, or those anchored on
+    its ``chamber:`` file's measured actuator (``physics.sealed.anchored_coefficients``,
+    with that actuator's silicone's mu0: the sweep's own silicone then scales K by its mu0,
+    sample by sample in a sampled sweep)."""
+    chamber = getattr(cfg, "chamber", None)
+    if chamber is None:
+        return sealed_coefficients()
+    return anchored_coefficients(chamber, chamber["initial_shear_modulus"])
 
 
 def paper_kernel(cfg: ResolvedConfig) -> bool:

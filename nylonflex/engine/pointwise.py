@@ -29,6 +29,7 @@ from ..physics.bending import node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape
+from ..physics.sealed import sealed_coefficients
 from ..physics.thermal import check_supply_rise, coil_resistance, convection_loss_per_length
 from ..units import short
 from ..variables import DESIGN
@@ -49,7 +50,7 @@ _SILICONE_FIELDS = ("mu", "alpha")
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
              silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None,
-             cooling=None):
+             cooling=None, chamber=None):
     """Every design variable of designs that broadcast together (compiled, parallel).
 
     Parameters
@@ -83,6 +84,9 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
         Cooling environment (``materials.COOLING_PARAMETERS``: ``still_air``,
         ``forced_air``, ``still_water``); None: the nylon set's ``heat_loss_per_length``
         (docs/model.md s. 9).
+    chamber : dict or sequence, optional
+        ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) [-]; None: the
+        shipped ones (docs/model.md s. 22).
 
     Returns
     -------
@@ -133,7 +137,7 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
         muscle = _single_muscle(nylon)
     else:
         designs, coil, muscle = _design_arrays((a, t, b, L, psi), c, ny, cooling, shape, n)
-    options = (MODELS.index(model), voltage, stretch_max)
+    options = (MODELS.index(model), voltage, stretch_max, sealed_coefficients(chamber))
     out = _run(shape, n, designs, coil, ogden, muscle, options)
     check_supply_rise(voltage, out["muscle_length"], coil[3].reshape(shape),
                       coil[4].reshape(shape), "supply_voltage")

@@ -13,13 +13,15 @@ import yaml
 
 from .. import __version__
 from ..config import ResolvedConfig, parse_config
+from ..config.material_files import read_chamber_file
 from ..config.tracking import tracking_section
 from ..kernels import source_digest
 from ..materials import (COOLING_PARAMETERS, Cooling, Nylon, Silicone, cooling_parameters,
                          nylon_parameters, silicone_parameters)
 from ..physics.bending import NEWTON_RTOL, QUADRATURE_ORDERS
 from ..physics.limits import STROKE_RTOL
-from ..units import decimal_to_si, from_si
+from ..units import InputError, decimal_to_si, from_si
+from .model_slab import chamber_coefficients
 from ..variables import is_complete  # noqa: F401 - re-exported
 from ..variables import AXES, VARIABLES
 
@@ -151,7 +153,9 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
     ``cooling`` and ``cooling_fluid`` (the sets' names and fluids, space-separated) with
     ``cooling_speed`` [m/s] (a float64 array, one speed a set); only with ``fidelity:
     spread``, ``model_spread`` (the variants its ``<var>_model_lo``/``_hi`` range over,
-    space-separated). :func:`cube_settings` reads them back.
+    space-separated); with ``sealed_chamber`` among the models,
+    ``sealed_chamber_coefficients`` (float64 (7,), the coefficients it ran with).
+    :func:`cube_settings` reads them back.
     """
     def numbers(material, names, kind):
         out = {}
@@ -175,8 +179,10 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
         out["cooling"] = " ".join(c.name for c in coolings)
         out["cooling_fluid"] = " ".join(c.fluid for c in coolings)
         out["cooling_speed"] = np.array([c.speed for c in coolings], np.float64)
-    if cfg.spread:  # fidelity: spread (docs/model.md s. 22)
+    if cfg.spread:  # fidelity: spread (docs/model.md s. 23)
         out["model_spread"] = " ".join(cfg.spread)
+    if "sealed_chamber" in cfg.models:  # the coefficients it ran with (docs/model.md s. 22)
+        out["sealed_chamber_coefficients"] = np.asarray(chamber_coefficients(cfg), np.float64)
     return out
 
 
@@ -213,6 +219,9 @@ class CubeSettings:
     cooling: Cooling | None = None
     coolings: tuple[Cooling, ...] = ()
     spread: tuple[str, ...] = ()
+    #: ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) the cube ran with;
+    #: None: the shipped ones (a cube without that model, or from before they were stored)
+    chamber: tuple | None = None
 
     def evaluate_kwargs(self, model: str | None = None, cooling: Cooling | None = None) -> dict:
         """Keyword arguments of :func:`nylonflex.evaluate` under one model variant and
@@ -238,6 +247,8 @@ class CubeSettings:
         cooling = self.cooling if cooling is None else cooling
         if cooling is not None:
             out["cooling"] = cooling
+        if self.chamber is not None:
+            out["chamber"] = self.chamber
         return out
 
 
@@ -294,7 +305,9 @@ def cube_settings(ds_or_attrs) -> CubeSettings:
         supply_voltage=_number(attrs, "supply_voltage") if "supply_voltage" in attrs else None,
         cooling=coolings[0] if len(coolings) == 1 else None,
         coolings=coolings if len(coolings) > 1 else (),
-        spread=tuple(_text(attrs, "model_spread").split()) if "model_spread" in attrs else ())
+        spread=tuple(_text(attrs, "model_spread").split()) if "model_spread" in attrs else (),
+        chamber=tuple(float(c) for c in _numbers(attrs, "sealed_chamber_coefficients"))
+        if "sealed_chamber_coefficients" in attrs else None)
 
 
 def _value(attrs, key):
@@ -474,8 +487,10 @@ def runnable_config(attrs) -> str:
         out["requirements"] = list(doc["requirements"])
     if "tracking" in doc:  # docs/model.md s. 19
         out["tracking"] = tracking_section(doc["tracking"])
-    if isinstance(doc.get("fidelity"), dict):  # docs/model.md s. 22
+    if isinstance(doc.get("fidelity"), dict):  # docs/model.md s. 23
         out["fidelity"] = {"spread": [str(m) for m in doc["fidelity"]["spread"]]}
+    if "chamber" in doc:  # docs/bench.md: by its file, while that still says the same
+        out["chamber"] = _chamber_spec(doc["chamber"])
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
     out["charts"] = []
@@ -490,6 +505,21 @@ def runnable_config(attrs) -> str:
             f"{str(attrs.get('config_sha256', ''))[:16]}), written by nylonflex info "
             "--config\n")
     return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
+
+
+def _chamber_spec(chamber: dict) -> dict:
+    """``chamber: {file: ...}`` of a cube's config, its file checked to hold the values the
+    cube ran with (a ValueError naming it otherwise: no other form can recompute it)."""
+    path = str(chamber.get("file", ""))
+    try:
+        now = read_chamber_file(path)
+    except InputError as err:
+        raise ValueError(f"cube: its chamber file cannot be read ({err}); cannot rebuild "
+                         "its config") from None
+    if any(now.get(k) != v for k, v in chamber.items() if k != "file"):
+        raise ValueError(f"cube: its chamber file {path} has changed since the sweep; "
+                         "cannot rebuild its config")
+    return {"file": path}
 
 
 #: The SI unit a config may give each axis in (the last resort of :func:`runnable_config`).

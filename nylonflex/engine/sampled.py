@@ -30,7 +30,8 @@ from ..physics.chamber import chamber_pressure
 from ..physics.nylon import stroke_max
 from ..query.parse import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
-from .model_slab import grid_axes, grid_out, kernel_inputs, paper_kernel, run_grid
+from .model_slab import (chamber_coefficients, grid_axes, grid_out, kernel_inputs, paper_kernel,
+                         run_grid)
 from .threads import run_chunks
 
 __all__ = ["FLOAT_NAMES", "perturbed_configs", "perturbed_inputs", "sample_configs",
@@ -186,6 +187,7 @@ def perturbed_inputs(designs: dict, cfg: ResolvedConfig, z: np.ndarray) -> dict:
     out["model"] = cfg.models[0]  # a sampled sweep has one model (nylonflex.config refuses more)
     out["supply_voltage"] = cfg.supply_voltage
     out["cooling"] = cfg.cooling
+    out["chamber"] = chamber_coefficients(cfg)  # sealed_chamber's (docs/model.md s. 22)
     return out
 
 

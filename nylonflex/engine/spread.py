@@ -1,4 +1,4 @@
-"""The model spread of a sweep with ``fidelity: spread`` (docs/model.md s. 22).
+"""The model spread of a sweep with ``fidelity: spread`` (docs/model.md s. 23).
 
 The cube's values are its own model's; beside the headline variables
 (:data:`~nylonflex.variables.SPREAD_OF`) it stores their lowest and highest value over the

@@ -1,4 +1,4 @@
-"""The explorer's model spread (``fidelity: spread``, docs/model.md s. 22): the read-out of
+"""The explorer's model spread (``fidelity: spread``, docs/model.md s. 23): the read-out of
 the picked design names the range of the shown variable over the cube's model variants.
 
 :func:`spread_args` gives ``update.js`` what it needs: for each variable of the page the

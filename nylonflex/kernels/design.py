@@ -31,7 +31,7 @@ from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
                                node_scratch)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              _curve_factor, _design_state_nodes, _design_values,
+                              SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes, _design_values,
                               _dynamic_values,
                               _length_factor, _model_moment, _model_state_nodes,
                               _nylon_force_model, _reach,
@@ -78,7 +78,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
     x_base, w_base, phi_trig, w_phi = nodes.x_base, nodes.w_base, nodes.phi_trig, nodes.w_phi
     out_design, out_flags, out_force, out_angle, out_tip = out
     coil_s_max, coil_force_limit, coil_width, coil_r, coil_loss = coil
-    model, voltage, stretch_max = options
+    model, voltage, stretch_max, chamber = options
     t_amb = muscle.t_amb[0]
     t_max = muscle.t_max[0]
     gamma = muscle.gamma[0]
@@ -138,10 +138,16 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                                  jp), NEWTON_RTOL, cauchy)
             kappa_curve[jp] = kappa
             rate_curve[jp], rate2_curve[jp] = _curvature_rates(lever_p, dm, d2m)
+            # sealed_chamber's squeeze at the stroke that holds this pressure (else 0)
+            if not _PAPER_ONLY:
+                k_sq, m_sq = _curve_squeeze(model, pressure[jp], section, ogden, table, p_atm,
+                                            chamber)
+                kappa += k_sq
+                moment += m_sq
             for il in range(nl):
                 factor = 1.0 if _PAPER_ONLY else _curve_factor(
                     model, pressure[jp], a, t, length[il], mu, alpha)
-                out_angle[ia, it, il, jp] = kappa_curve[jp] * length[il] * factor
+                out_angle[ia, it, il, jp] = kappa * length[il] * factor
                 out_tip[ia, it, il, jp] = moment / length[il]
         curve = SolvedCurve(pressure, kappa_curve, rate_curve, rate2_curve)
         # the paper's solves (nominal stress) may start from it (not the Cauchy variant's)
@@ -196,7 +202,7 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                         ms = _model_state_nodes(
                             model, section, lever, coil_row, s_free,
                             force_coeff * (t_reach - t_amb), limited, ogden, table, p_atm,
-                            curve, npr)
+                            chamber, curve, npr)
                         st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
                         closes = ms[7]
                         temps = _working_temperatures(model, ms[0], t_reach, scale, shape)
@@ -233,8 +239,8 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                     else:
                         (cycle_time, cycle_rate, heating_energy, mechanical_work,
                          efficiency) = _dynamic_values(model, usable_stroke, section, lever,
-                                                       solid, ogden, p_atm, thermal, voltage,
-                                                       temps, t_amb, tau)
+                                                       solid, ogden, p_atm, chamber, thermal,
+                                                       voltage, temps, t_amb, tau)
                     out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
                     out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
                     out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
@@ -244,9 +250,10 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                         bend_angle_max, st[4] * lf, section, stretch_max, length[il] / pitch,
                         closes, efficiency)
                 for js in range(ns):
-                    if not _PAPER_ONLY and model == INCOMPRESSIBLE_WALL:
+                    if not _PAPER_ONLY and (model == INCOMPRESSIBLE_WALL or
+                                            model == SEALED_CHAMBER):
                         f = _nylon_force_model(model, stroke[js], a, t, lever, solid, mu,
-                                               alpha, p_atm)[0]
+                                               alpha, p_atm, chamber)[0]
                         out_force[ia, it, ic, ip, js] = f if f < math.inf else math.nan
                     else:
                         out_force[ia, it, ic, ip, js] = _wrap_force(
@@ -269,7 +276,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
     s_max_all, f_lim_all, width_all, r_all, loss_all = coil
     mu_all, alpha_all = silicone
     out_design, out_flags = out
-    model, voltage, stretch_max = options
+    model, voltage, stretch_max, chamber = options
     t_amb_all, t_max_all, gamma_all, beta_all, t_g_all, sigma_g_all = \
         muscle.t_amb, muscle.t_max, muscle.gamma, muscle.beta, muscle.t_g, muscle.sigma_g
     c_all, coeff_all = muscle.c_per_len, muscle.force_coeff
@@ -294,7 +301,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
         st = _design_state_nodes(model, voltage, section, length[i], psi, pitch, lever,
-                                 coil_row, shape, ogden, nodes, table, p_atm)
+                                 coil_row, shape, ogden, nodes, table, p_atm, chamber)
         (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
          range_fraction, nylon_force_max, nylon_use) = _design_values(
             st[0], st[1], st[2], st[3], st[4], st[5], st[6], f_lim, length[i])
@@ -321,7 +328,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         (cycle_time, cycle_rate, heating_energy, mechanical_work,
          efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid, ogden,
-                                       p_atm, thermal, voltage, temps, t_amb,
+                                       p_atm, chamber, thermal, voltage, temps, t_amb,
                                        c_all[i] / loss_all[i])
         out_design[ROW_CYCLE_TIME, i] = cycle_time
         out_design[ROW_CYCLE_RATE, i] = cycle_rate

@@ -58,8 +58,10 @@ Muscle = namedtuple("Muscle", "t_amb t_max gamma beta t_g sigma_g r_per_len c_pe
                               "loss_per_len force_coeff")
 
 #: Run options: ``model`` (int code of ``physics.limits.MODELS``), ``voltage`` the supply
-#: [V] (<= 0: none), ``stretch_max`` the top of the silicone's fitted stretch range [-].
-Options = namedtuple("Options", "model voltage stretch_max")
+#: [V] (<= 0: none), ``stretch_max`` the top of the silicone's fitted stretch range [-],
+#: ``chamber`` ``sealed_chamber``'s coefficients (a ``physics.records.SealedCoefficients``;
+#: the shipped ones unless a sweep's ``chamber:`` gives others).
+Options = namedtuple("Options", "model voltage stretch_max chamber")
 
 #: Scattered designs, one entry each: ``radius``, ``wall``, ``base``, ``length`` [m],
 #: ``wrap`` [rad].

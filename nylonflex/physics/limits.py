@@ -17,12 +17,14 @@ from ._formula import (check, check_input, check_section, check_wrap_angle, form
                        scalar_or_array, specialised)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
-                      _section_nodes, _taylor_start, quadrature_nodes)
+                      _section_moment, _section_nodes, _taylor_start, quadrature_nodes)
 from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .records import CoilRow, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
+from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
+    _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from .thermal import _cooling_time, _heating_power, _heating_time, \
     _steady_temperature, check_supply_rise, coil_heat_loss_per_length, coil_resistance
@@ -34,7 +36,7 @@ __all__ = ["DESIGN_VARIABLES", "EFFICIENCY_BOUND", "MODELS", "VALIDITY_FLAGS", "
 
 from ..variables import DESIGN, MODELS  # noqa: E402  (the registry holds the names)
 PAPER, COUPLED_MUSCLE, PAPER_EQ10, INCOMPRESSIBLE_WALL, CAUCHY_MOMENT, LATERAL_PRESSURE, \
-    FE_CALIBRATED = range(7)
+    FE_CALIBRATED, SEALED_CHAMBER = range(8)
 
 #: Bits of the ``validity`` flag (docs/model.md s. 17).
 VALIDITY_FLAGS = {"self_contact": 1, "stretch_beyond_fit": 2, "under_one_turn": 4,
@@ -70,12 +72,15 @@ STROKE_RTOL = 1e-10
 
 
 @formula
-def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
-    """F_n(s) and dF_n/ds [N] of a model variant (``solid`` = A_s/A_out, wall variant only).
+def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm,
+                       chamber):
+    """F_n(s) and dF_n/ds [N] of a model variant (``solid`` = A_s/A_out, wall variant only;
+    ``chamber`` the :class:`~.records.SealedCoefficients`, ``sealed_chamber`` only).
 
     ``paper_eq10`` takes the hoop stress of the paper's eqs. (10)-(12),
-    ``incompressible_wall`` the chamber pressure with a conserved wall area; the others
-    are the paper's F_n (docs/model.md s. 4, 15).
+    ``incompressible_wall`` the chamber pressure with a conserved wall area,
+    ``sealed_chamber`` the sealed, compliant chamber's (:mod:`.sealed`); the others are the
+    paper's F_n (docs/model.md s. 4, 15, 22).
     """
     if model == PAPER_EQ10:
         p = _gauge_pressure(stroke, p_atm)
@@ -83,6 +88,9 @@ def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, 
         s_theta, ds_dlam = _equibiaxial_stress_and_slope(1.0 - stroke, mu, alpha)
     elif model == INCOMPRESSIBLE_WALL:
         p, dp = _gauge_pressure_wall(stroke, p_atm, solid)
+        s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
+    elif model == SEALED_CHAMBER:
+        p, dp = _sealed_pressure(stroke, radius, wall_thickness, mu, alpha, p_atm, 1.0, chamber)
         s_theta, ds_dlam = _stress_and_slope(1.0 - stroke, mu, alpha)
     else:
         return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
@@ -93,7 +101,7 @@ def _nylon_force_model(model, stroke, radius, wall_thickness, lever, solid, mu, 
 
 @formula
 def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever, solid, mu,
-                        alpha, p_atm, rtol):
+                        alpha, p_atm, chamber, rtol):
     """Usable stroke s*, the limit flag (0 stroke, 1 strength) and F_n(s*) [N] of a model
     variant's F_n (``solid`` = A_s/A_out, wall variant only), below the stroke ``s_max``.
 
@@ -101,7 +109,7 @@ def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever
     bisection; F_n is increasing with F_n(0) = 0.
     """
     f, df = _nylon_force_model(model, s_max, radius, wall_thickness, lever, solid, mu, alpha,
-                               p_atm)
+                               p_atm, chamber)
     if f <= force_limit:
         return s_max, 0, f
     lo = 0.0
@@ -121,16 +129,16 @@ def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever
             break
         s = s_new
         f, df = _nylon_force_model(model, s, radius, wall_thickness, lever, solid, mu, alpha,
-                                   p_atm)
+                                   p_atm, chamber)
     f, df = _nylon_force_model(model, s, radius, wall_thickness, lever, solid, mu, alpha,
-                               p_atm)
+                               p_atm, chamber)
     return s, 1, f
 
 
 @formula
-def _paper_force(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
-    """:func:`_nylon_force_model` of the paper's model: F_n(s) and dF_n/ds [N] (``model``
-    and ``solid`` unused)."""
+def _paper_force(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm, chamber):
+    """:func:`_nylon_force_model` of the paper's model: F_n(s) and dF_n/ds [N] (``model``,
+    ``solid`` and ``chamber`` unused)."""
     return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
 
 
@@ -183,27 +191,28 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
     """The moment that bends the section at chamber pressure p [N m] in a model variant.
 
     The paper's end-cap moment M_P (eq. 16; every variant but ``lateral_pressure``, bit for
-    bit); ``lateral_pressure`` (and ``fe_calibrated``, which corrects its curvature) adds the
-    pressure on the wall and floor, p times :func:`~.bending._lateral_lever` (docs/model.md
-    s. 18). Linear in p in every model:
-    ``_model_moment(model, 1, ...)`` is dM/dp.
+    bit); ``lateral_pressure`` (and ``fe_calibrated``, which corrects its curvature, and
+    ``sealed_chamber``, which adds the squeeze) adds the pressure on the wall and floor, p
+    times :func:`~.bending._lateral_lever` (docs/model.md s. 18). Linear in p in every
+    model: ``_model_moment(model, 1, ...)`` is dM/dp.
     """
     m = _pressure_moment(pressure, radius, base_thickness)
-    if model == LATERAL_PRESSURE or model == FE_CALIBRATED:
+    if model == LATERAL_PRESSURE or model == FE_CALIBRATED or model == SEALED_CHAMBER:
         m += pressure * _lateral_lever(radius, wall_thickness, base_thickness)
     return m
 
 
 @formula
 def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
-                       ogden, table, p_atm, curve, n):
+                       ogden, table, p_atm, chamber, curve, n):
     """The length-free design limits of a model variant, with a reachable free stroke.
 
     ``section`` a :class:`~.records.Section`, ``lever`` the wrap's pitch over cos psi [m],
     ``coil`` the :class:`~.records.CoilRow` (F_lim, s_max), ``ogden`` the silicone's
     :class:`~.records.Ogden`, ``table`` the section's node table and scratch (a
     :class:`~.records.NodeTable`, :func:`~.bending._section_nodes`), ``p_atm`` the initial
-    chamber pressure [Pa]. ``s_free`` is the free stroke at the reachable temperature (s_max
+    chamber pressure [Pa], ``chamber`` the :class:`~.records.SealedCoefficients`
+    (``sealed_chamber``). ``s_free`` is the free stroke at the reachable temperature (s_max
     without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that temperature
     (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle below
     T_max. ``n`` solved points of the model's kappa(p) in ``curve`` (a
@@ -238,7 +247,8 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
         kappa_full = math.inf
         p_full = math.inf
     else:
-        p_full = _nylon_pressure(model, s_max, p_atm, solid)
+        p_full = _nylon_pressure(model, s_max, p_atm, solid, radius, wall_thickness, mu, alpha,
+                                 chamber)
         kappa_full, dm, d2m = _curvature_solve(
             _model_moment(model, p_full, radius, wall_thickness, base_thickness), y, wy, wyy,
             work, mu, alpha, _curvature_start(p_full, pressures, kappas, rates, rates2, n),
@@ -252,7 +262,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
         s_eq = s_top
     s, strength, force = _stroke_limit_model(model, force_limit, s_eq, radius,
                                              wall_thickness, lever, solid, mu, alpha, p_atm,
-                                             STROKE_RTOL)
+                                             chamber, STROKE_RTOL)
     if strength == 1:
         limit = 1
     elif supply_limited:
@@ -261,7 +271,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
         limit = 3
     else:
         limit = 0
-    p = _nylon_pressure(model, s, p_atm, solid)
+    p = _nylon_pressure(model, s, p_atm, solid, radius, wall_thickness, mu, alpha, chamber)
     moment = _model_moment(model, p, radius, wall_thickness, base_thickness)
     if limit == 0:
         kappa = kappa_full
@@ -274,12 +284,41 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     if model == FE_CALIBRATED:  # the balance's curvatures, corrected (:mod:`.calibrated`)
         kappa *= _section_correction(p, radius, wall_thickness, mu, alpha)
         kappa_full *= _section_correction(p_full, radius, wall_thickness, mu, alpha)
+    elif model == SEALED_CHAMBER:  # the squeeze's curvature and blocked moment (:mod:`.sealed`)
+        kappa_full += _squeeze_curvature(s_max, radius, wall_thickness, base_thickness, chamber)
+        k_sq, m_sq = _squeeze_state(s, section, ogden, table, chamber)
+        kappa += k_sq
+        moment += m_sq
     return s, limit, p, moment, kappa, force, kappa_full, closes
 
 
 @formula
+def _squeeze_state(stroke, section, ogden, table, chamber):
+    """``sealed_chamber``'s squeeze at stroke s [-]: its curvature kappa_sq [1/m] and the
+    blocked moment c_b M_S(kappa_sq) [N m] that holds it straight (docs/model.md s. 22), in
+    the section's node table ``table`` (its ``work`` overwritten), with the coefficients
+    ``chamber`` (a :class:`~.records.SealedCoefficients`)."""
+    k_sq = _squeeze_curvature(stroke, section.radius, section.wall, section.base, chamber)
+    m_sq = _section_moment(k_sq, table.y, table.wy, table.wyy, table.work, ogden.mu,
+                           ogden.alpha, False)[0]
+    return k_sq, chamber[6] * m_sq
+
+
+@formula
+def _curve_squeeze(model, pressure, section, ogden, table, p_atm, chamber):
+    """What a model adds at chamber pressure p [Pa] to the balance's curvature [1/m] and
+    moment [N m] on the bend-angle and tip-force curves: ``sealed_chamber``'s squeeze at the
+    stroke that holds p (:func:`~.sealed._sealed_stroke`), else (0, 0)."""
+    if model != SEALED_CHAMBER:
+        return 0.0, 0.0
+    s = _sealed_stroke(pressure, section.radius, section.wall, ogden.mu, ogden.alpha, p_atm,
+                       1.0, chamber)
+    return _squeeze_state(s, section, ogden, table, chamber)
+
+
+@formula
 def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coil, shape,
-                  ogden, nodes, p_atm):
+                  ogden, nodes, p_atm, chamber):
     """The stroke state of one design in any model, with or without a supply.
 
     ``voltage`` the supply [V] (<= 0: none), ``section`` a :class:`~.records.Section`,
@@ -287,7 +326,8 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of its coil index, ``shape``
     the muscle's :class:`~.records.StrokeShape`, ``ogden`` the silicone's
     :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
-    the initial chamber pressure [Pa].
+    the initial chamber pressure [Pa], ``chamber`` the
+    :class:`~.records.SealedCoefficients` (``sealed_chamber``).
 
     Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
     model without a supply is :func:`_stroke_state_nodes` itself; otherwise
@@ -297,12 +337,13 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
                                    nodes.w_base, nodes.phi_trig, nodes.w_phi)
     return _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                               shape, ogden, nodes, NodeTable(y, wy, wyy, work), p_atm)
+                               shape, ogden, nodes, NodeTable(y, wy, wyy, work), p_atm,
+                               chamber)
 
 
 @formula
 def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                        shape, ogden, nodes, table, p_atm):
+                        shape, ogden, nodes, table, p_atm, chamber):
     """:func:`_design_state` in a node table and scratch ``table`` (a
     :class:`~.records.NodeTable` of :func:`~.bending._node_count` nodes, overwritten: the
     section's nodes from the quadrature's ``nodes``), which it makes no array for: what the
@@ -317,7 +358,7 @@ def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, leve
     t_reach, s_free, limited = _reach(coil, length, pitch, section, wrap_angle, voltage, shape)
     ms = _model_state_nodes(model, section, lever, coil, s_free,
                             coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, table,
-                            p_atm, unsolved, 0)
+                            p_atm, chamber, unsolved, 0)
     lf = _length_factor(model, section.radius, length)
     return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
 
@@ -342,10 +383,13 @@ def _curve_factor(model, pressure, radius, wall_thickness, length, mu, alpha):
 
 
 @formula
-def _nylon_pressure(model, stroke, p_atm, solid):
+def _nylon_pressure(model, stroke, p_atm, solid, radius, wall_thickness, mu, alpha, chamber):
     """Chamber gauge pressure p(s) of a model variant [Pa]."""
     if model == INCOMPRESSIBLE_WALL:
         return _gauge_pressure_wall(stroke, p_atm, solid)[0]
+    if model == SEALED_CHAMBER:
+        return _sealed_pressure(stroke, radius, wall_thickness, mu, alpha, p_atm, 1.0,
+                                chamber)[0]
     return _gauge_pressure(stroke, p_atm)
 
 
@@ -431,7 +475,8 @@ def _thermal_values_at(length, pitch, perimeter, cos_wrap, voltage, temps, t_amb
 
 
 @formula
-def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm):
+def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm,
+                 chamber):
     """Integral of the nylon force over the stroke, int_0^s F_n(s') ds' [N].
 
     8-point Gauss-Legendre on [0, s] (F_n is smooth there: Boyle's pressure and the Ogden
@@ -442,19 +487,20 @@ def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha,
     for j in range(8):
         total += _WORK_W[j] * _nylon_force_model(model, half * (1.0 + _WORK_X[j]), radius,
                                                  wall_thickness, lever, solid, mu, alpha,
-                                                 p_atm)[0]
+                                                 p_atm, chamber)[0]
     return total * half
 
 
 @formula
-def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, thermal, voltage,
-                    temps, t_amb, tau):
+def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, chamber, thermal,
+                    voltage, temps, t_amb, tau):
     """cycle_time [s], cycle_rate [Hz], heating_energy [J], mechanical_work [J], efficiency.
 
     Of a design with usable stroke ``s_star`` [-], ``section`` (a
     :class:`~.records.Section`), ``lever`` [m], solid fraction ``solid`` [-]
     (``incompressible_wall``, else 0), silicone ``ogden`` (an :class:`~.records.Ogden`),
-    initial chamber pressure ``p_atm`` [Pa], its ``thermal`` values (the six of
+    initial chamber pressure ``p_atm`` [Pa], ``chamber`` (``sealed_chamber``'s
+    :class:`~.records.SealedCoefficients`), its ``thermal`` values (the six of
     :func:`_thermal_values`), working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
     ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s].
 
@@ -470,7 +516,7 @@ def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, thermal,
     cycle = heating + _cooling_time(temps[2], temps[1], t_amb, tau)
     energy = voltage * voltage / resistance * heating
     work = muscle_length * _stroke_work(model, s_star, section.radius, section.wall, lever,
-                                        solid, ogden.mu, ogden.alpha, p_atm)
+                                        solid, ogden.mu, ogden.alpha, p_atm, chamber)
     return cycle, 1.0 / cycle, energy, work, work / energy
 
 
@@ -527,7 +573,7 @@ def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, c
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
     s, limit, force = _stroke_limit(PAPER, force_limit, s_max, radius, wall_thickness, lever,
-                                    0.0, mu, alpha, p_atm, STROKE_RTOL)
+                                    0.0, mu, alpha, p_atm, _SEALED, STROKE_RTOL)
     p = _gauge_pressure(s, p_atm)
     moment = _pressure_moment(p, radius, base_thickness)
     if limit == 0:
@@ -592,7 +638,7 @@ def stroke_limit(radius, wall_thickness, coil_index, wrap_angle, base_thickness=
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
                   silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None,
-                  cooling=None):
+                  cooling=None, chamber=None):
     """Every design variable of the cube for one design or broadcastable arrays of them.
 
     The slow, obviously-right pure-Python loop the compiled engine is tested against.
@@ -622,6 +668,9 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     cooling : str, dict or Cooling, optional
         Cooling environment (``materials.COOLING_PARAMETERS``); None: the muscle set's
         ``heat_loss_per_length`` (docs/model.md s. 9).
+    chamber : dict or sequence, optional
+        ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) [-]; None: the
+        shipped ones (docs/model.md s. 22).
 
     Returns
     -------
@@ -648,6 +697,7 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
     if model not in MODELS:
         raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
     code = MODELS.index(model)
+    coef = sealed_coefficients(chamber)
     voltage = 0.0 if supply_voltage is None else float(
         check_input("supply_voltage", supply_voltage))
     ny = nylon_parameters(nylon)
@@ -680,13 +730,13 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         coil = CoilRow(force_limit, s_max, s_max / top, r_per_len,
                        ny.heat_capacity_per_length, loss_per_len, ny.thermal_force_coefficient)
         *state, closes, t_reach = _design_state(code, voltage, section, Li, pi, pitch, lever,
-                                                coil, shape, ogden, nodes, P_ATM)
+                                                coil, shape, ogden, nodes, P_ATM, coef)
         values = _design_values(*state, force_limit, Li)
         temps = _working_temperatures(code, values[0], t_reach, coil.scale, shape)
         thermal = _thermal_values(Li, pitch, section, pi, voltage, temps, shape.t_amb, coil)
         solid = _solid_fraction(ai, ti, bi) if code == INCOMPRESSIBLE_WALL else 0.0
-        dynamic = _dynamic_values(code, values[0], section, lever, solid, ogden, P_ATM, thermal,
-                                  voltage, temps, shape.t_amb,
+        dynamic = _dynamic_values(code, values[0], section, lever, solid, ogden, P_ATM, coef,
+                                  thermal, voltage, temps, shape.t_amb,
                                   coil.c_per_len / coil.loss_per_len)
         flags = _validity(values[5], state[4], section, stretch_max, Li / pitch, closes,
                           dynamic[4])
@@ -699,13 +749,14 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 
 
 def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=None,
-                     silicone="tc5005", model="paper"):
+                     silicone="tc5005", model="paper", chamber=None):
     """Free bend angle theta(p) = kappa(p) L of a model variant at a chamber pressure [rad].
 
     The variants differ here by the moment that bends the section (``lateral_pressure``:
     :func:`_model_moment`) or the stress it is balanced by
     (``cauchy_moment``); ``coupled_muscle``, ``paper_eq10`` and ``incompressible_wall``
-    change the muscle's side only and give the paper's angle (docs/model.md s. 16, 18).
+    change the muscle's side only and give the paper's angle (docs/model.md s. 16, 18);
+    ``sealed_chamber`` adds the squeeze of the stroke that holds p (s. 22).
 
     Parameters
     ----------
@@ -719,6 +770,8 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
         Material set.
     model : str
         One of :data:`MODELS`.
+    chamber : dict or sequence, optional
+        ``sealed_chamber``'s coefficients; None: the shipped ones (docs/model.md s. 22).
 
     Returns
     -------
@@ -728,6 +781,7 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
     if model not in MODELS:
         raise ValueError(f"model: must be one of {', '.join(MODELS)}, got {model!r}")
     code = MODELS.index(model)
+    coef = sealed_coefficients(chamber)
     p = check("pressure", pressure, 0.0, unit="Pa")
     a, t, b = check_section(radius, wall_thickness, base_thickness)
     L = check_input("length", length)
@@ -739,7 +793,9 @@ def model_bend_angle(pressure, radius, wall_thickness, length, base_thickness=No
     def one(p_, a_, t_, b_, l_):
         y, wy, wyy, work = _node_table(a_, t_, b_, *nodes)
         moment = _model_moment(code, p_, a_, t_, b_)
-        return _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL,
-                                cauchy) * l_ * _curve_factor(code, p_, a_, t_, l_, mu, alpha)
+        kappa = _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, 0.0, NEWTON_RTOL, cauchy)
+        kappa += _curve_squeeze(code, p_, Section(a_, t_, b_), Ogden(mu, alpha),
+                                NodeTable(y, wy, wyy, work), P_ATM, coef)[0]
+        return kappa * l_ * _curve_factor(code, p_, a_, t_, l_, mu, alpha)
 
     return scalar_or_array(np.vectorize(one, otypes=[float])(p, a, t, b, L))

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilRow", "NodeTable", "Nodes", "Ogden", "Section", "SolvedCurve", "StrokeShape"]
+__all__ = ["CoilRow", "NodeTable", "Nodes", "Ogden", "SealedCoefficients", "Section",
+           "SolvedCurve", "StrokeShape"]
 
 #: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
 #: (bottom layer) thickness b [m] (docs/model.md s. 1).
@@ -51,3 +52,9 @@ NodeTable = namedtuple("NodeTable", "y wy wyy work")
 #: dkappa/dp [1/(m Pa)] and ``rate2`` d2kappa/dp2 [1/(m Pa^2)]; the first ``n`` entries
 #: count (``n`` passed beside it).
 SolvedCurve = namedtuple("SolvedCurve", "pressure kappa rate rate2")
+
+#: ``sealed_chamber``'s coefficients (docs/model.md s. 22, :mod:`.sealed`), dimensionless:
+#: the chamber stiffness ``k0``, ``k1``, the rounding ``g0``, ``g1``, the squeeze ``c0``,
+#: ``c1`` and the blocked moment's ``cb``. Every formula takes it (the shipped one, or a
+#: sweep's ``chamber:``); the others' variants ignore it.
+SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb")

@@ -124,7 +124,7 @@ def shown_columns(res, fmt="table") -> tuple:
 
 def _band_notes(res, names) -> dict:
     """``{name: "   (models 1.20 .. 1.82 N)"}``: a one-design answer's range over the cube's
-    model spread (docs/model.md s. 22) of each value that has one; ``validity`` the flags of
+    model spread (docs/model.md s. 23) of each value that has one; ``validity`` the flags of
     any variant."""
     out = {}
     for name in names:

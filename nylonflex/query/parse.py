@@ -36,7 +36,7 @@ def missing_hint(name: str) -> str:
     if name in TRACKING:
         return "sweep a config with 'tracking:' (docs/model.md s. 19)"
     if name in SPREAD:
-        return "sweep a config with 'fidelity: spread' (docs/model.md s. 22)"
+        return "sweep a config with 'fidelity: spread' (docs/model.md s. 23)"
     return "sweep a config with 'requirements' (docs/uncertainty.md)"
 
 
@@ -263,7 +263,7 @@ def default_columns(available, asked=()) -> tuple:
     by), then :data:`HEADLINE` (each with its range over a model spread, where the cube has
     one); only the ``available`` ones, each once, ``model`` and ``cooling`` first."""
     out = []
-    # a headline value's range over a model spread follows it (docs/model.md s. 22)
+    # a headline value's range over a model spread follows it (docs/model.md s. 23)
     headline = [m for n in HEADLINE for m in (n, f"{n}_model_lo", f"{n}_model_hi")] + \
         ["validity_model_any"]
     for name in ("model", "cooling", *AXES, *asked, *headline):

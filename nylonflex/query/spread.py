@@ -1,4 +1,4 @@
-"""A query's model spread (``fidelity: spread``, docs/model.md s. 22): its columns between
+"""A query's model spread (``fidelity: spread``, docs/model.md s. 23): its columns between
 grid points.
 
 On the grid the cube's ``<var>_model_lo``/``_hi`` and ``validity_model_any`` are read like

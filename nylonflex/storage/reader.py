@@ -372,7 +372,7 @@ def cube_summary(path) -> list[str]:
         if "model" in sizes:
             out.append("models    " + ", ".join(
                 _text(m) for m in np.asarray(h5["model"][...]).reshape(-1)))
-        if "model_spread" in a:  # fidelity: spread (docs/model.md s. 22)
+        if "model_spread" in a:  # fidelity: spread (docs/model.md s. 23)
             out.extend(_spread_lines(a))
         if "cooling" in sizes:
             out.append("cooling   " + ", ".join(
