@@ -188,10 +188,10 @@ def _footer(fig, ds):
     # axes and legends whatever the layout
     fig.text(0.0, 1.0, note, ha="left", va="bottom", fontsize=7, color="0.4")
     missing = incomplete_text(ds)
-    if missing:  # a sweep stopped early: said in red, large, on every chart
-        fig.text(1.0, 1.0, missing.upper() + " (missing radii are blank)", ha="right",
-                 va="bottom", fontsize=9, weight="bold", color="#B00020",
-                 gid="nf-incomplete")
+    if missing:  # a sweep stopped early: the title's first line says so, in red
+        title = fig.get_suptitle()
+        fig.suptitle(f"{missing} (missing radii are blank)" + (f"\n{title}" if title else ""),
+                     fontsize=RC["figure.titlesize"], color="#B00020", gid="nf-incomplete")
 
 
 def _suptitle(fig, title, subtitle):
