@@ -273,7 +273,8 @@ def _flag_patch(ds, bits):
     from matplotlib.patches import Patch
 
     return Patch(fc=_FLAG_FILL, ec="k", hatch="\\\\",
-                 label=f"flagged design, greyed, not coloured: {_flag_text(ds, bits)}")
+                 label=f"flagged design: {_flag_text(ds, bits)} (grey, hatched, off the "
+                       "colour scale)")
 
 
 def _grey_flagged(ax, x, y, valid, values):

@@ -170,7 +170,7 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
         ax.plot(x, np.where(bad, np.nan, solid), color=colour, lw=2.0, zorder=3)
         if bad.any():
             bits |= int(np.bitwise_or.reduce(v_solid[bad]))
-            _grey_line(ax, x, solid, bad)
+            _grey_line(ax, x, solid, bad, c)
         if j_ref is None:
             continue
         # the supply's stroke (the wrap's muscle length sets T_ss) or where the muscle
@@ -184,7 +184,7 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
                     ls=(0, (4, 1.5)), zorder=3)
             if bad.any():
                 bits |= int(np.bitwise_or.reduce(v[j_ref][bad]))
-                _grey_line(ax, x, load, bad)
+                _grey_line(ax, x, load, bad, c)
     shown = _labelled_psis(psis)
     annotate = len(shown) <= 4  # more labels than that overprint: the legend names them
     for w, points in _cut_ins(ds, var, sel, coils, psis).items():
@@ -209,10 +209,12 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
     return load_drawn, bits
 
 
-def _grey_line(ax, x, y, bad):
-    """The flagged stretch of a curve: grey, thick, faded (no colour of the coils)."""
+def _grey_line(ax, x, y, bad, coil=None):
+    """The flagged stretch of a curve (of coil index ``coil``, named in its hidden label):
+    grey, thick, faded, no colour of the coils."""
     ax.plot(x, np.where(bad, y, np.nan), color=_FLAG_GREY, lw=5, alpha=0.6, marker="o",
-            ms=5, mew=0, solid_capstyle="round", zorder=2.5, gid="nf-flagged")
+            ms=5, mew=0, solid_capstyle="round", zorder=2.5, gid="nf-flagged",
+            label="_flagged" if coil is None else f"_flagged C = {coil:g}")
 
 
 def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
@@ -242,7 +244,7 @@ def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
                                     f"{_eq('wrap_angle', load_psi)}"))
     if flags:
         handles.append(Line2D([], [], color=_FLAG_GREY, lw=5, alpha=0.6,
-                              label=f"flagged design (grey, not coloured): {flags}"))
+                              label=f"flagged design: {flags} (grey, not coloured)"))
     fig.legend(handles=handles, loc="outside lower center",
                ncol=min(6, max(len(coils), len(shown) + (len(shown) < len(psis)))),
                title="coil index C: solid while the design has its full range of motion "
@@ -468,7 +470,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                 bottom.plot(x, np.where(bad, np.nan, rf), color=_coil_colour(one, c), lw=1.8)
                 if bad.any():
                     bits |= int(np.bitwise_or.reduce(v[bad]))
-                    _grey_line(bottom, x, rf, bad)
+                    _grey_line(bottom, x, rf, bad, c)
             bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)}" +
                              ("" if many else " (100 % = full range)"))
             bottom.set_xlabel(label(ds["radius"]) if w == len(walls) - 1 or not many else "")
