@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..design.report import reported_rows
 from ..storage.files import save_figure
 from ._common import new_figure, rc_context
 from ..variables import AXES, name_label, to_display
@@ -59,7 +60,9 @@ def front_figure(res):
                        s=6, c="0.75", lw=0, label=f"feasible grid designs ({res.scan.feasible})",
                        rasterized=True)
         grid = res.grid_front
-        refined = res.refined_front
+        # the rows the CLI reports, counted as it counts them (designs equal in every
+        # objective are one row): the chart and the table say the same number
+        refined = reported_rows(res)
         if len(objs) >= 2:
             if len(grid["radius"]):
                 _sorted_step(ax, to_display(xname, grid[xname]), to_display(yname, grid[yname]),
@@ -69,7 +72,7 @@ def front_figure(res):
                 _sorted_step(ax, to_display(xname, refined[xname]),
                              to_display(yname, refined[yname]), color="C3", marker=".",
                              ms=7, lw=1.2, ls="--",
-                             label=f"refined front ({len(refined['radius'])})")
+                             label=f"reported front ({len(refined['radius'])} designs)")
         else:
             for d in res.designs:
                 style = dict(color="C3", marker="*", ms=14) if d["source"] == "refined" \

@@ -13,7 +13,7 @@ from ..query import COLUMNS, cell_text, default_columns
 from ..query.format import INTEGERS
 from ..variables import VARIABLES, to_display
 
-__all__ = ["format_csv", "format_json", "format_table"]
+__all__ = ["format_csv", "format_json", "format_table", "reported_rows"]
 
 
 def _columns(res):
@@ -33,15 +33,33 @@ def _table_columns(res):
     return cols
 
 
-def _alternatives_text(alt) -> str:
-    """``"wrap_angle 5, 8, 20 deg"``: the values of the merged designs' differing axes."""
+def _alternatives_text(alt, steps=None) -> str:
+    """``"wrap_angle 5-15, 20 deg"``: the values of the axes over which the design is the
+    same; a run of consecutive multiples of the axis's resolution step (``steps``,
+    {axis: SI step}) as ``lo-hi``."""
     parts = []
     for name, values in alt.items():
         unit = VARIABLES[name].display
-        parts.append(f"{name} " + ", ".join(f"{float(to_display(name, v)):.6g}"
-                                            for v in values)
-                     + ("" if unit == "1" else f" {unit}"))
+        shown = [f"{float(to_display(name, v)):.6g}" for v in values]
+        step = (steps or {}).get(name)
+        runs, start = [], 0
+        for i in range(1, len(values) + 1):
+            if i < len(values) and step and \
+                    abs((values[i] - values[i - 1]) / step - 1.0) < 1e-6:
+                continue
+            runs.append(shown[start] if i - 1 == start else
+                        f"{shown[start]}, {shown[i - 1]}" if i - 1 == start + 1 else
+                        f"{shown[start]}-{shown[i - 1]}")
+            start = i
+        parts.append(f"{name} " + ", ".join(runs) + ("" if unit == "1" else f" {unit}"))
     return "; ".join(parts)
+
+
+def reported_rows(res) -> dict:
+    """The designs a result reports (one row each, as the table, JSON and CSV list them
+    and as the chart draws and counts them): ``{column: numpy.ndarray}`` [SI]."""
+    cols = _columns(res) if res.designs else list(COLUMNS)
+    return {k: np.array([float(d[k]) for d in res.designs], dtype=float) for k in cols}
 
 
 def _shown(name, x) -> str:
@@ -69,7 +87,7 @@ def summary(res) -> list:
     lines.append(f"grid: {scan.feasible} of {scan.total} designs feasible")
     for name, (g, b, rel) in res.improvement.items():
         if name == "hypervolume":
-            lines.append(f"refined front: {len(res.designs)} designs "
+            lines.append(f"refined front: {len(reported_rows(res)['radius'])} designs "
                          f"({sum(d['source'] == 'refined' for d in res.designs)} refined); "
                          f"it dominates or equals the grid front of "
                          f"{len(res.grid_front['radius'])}; dominated area +{100 * rel:.2f} %")
@@ -132,7 +150,7 @@ def format_table(res) -> str:
 
     def cell(h, d):
         if h == "alternatives":
-            return _alternatives_text(d.get("alternatives") or {})
+            return _alternatives_text(d.get("alternatives") or {}, res.spec.resolution)
         return cell_text(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
 
     cells = [[d["source"]] + [cell(h, d) for h in heads[1:]] for d in res.designs]
