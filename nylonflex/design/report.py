@@ -113,6 +113,10 @@ def summary(res) -> list:
                      f"exactly ({snapped['candidates']} on-resolution candidates met every "
                      "constraint" + (f"; {snapped['lost']} design(s) had no on-resolution "
                                      "neighbour that does" if snapped["lost"] else "") + ")")
+        if snapped.get("lattice_moves"):
+            lines.append(f"lattice search: {snapped['lattice_moves']} reported design(s) moved "
+                         "to a better buildable design a step or more away (the front "
+                         "re-optimised on the resolution)")
     if snapped.get("merged"):
         lines.append(f"{snapped['merged']} design(s) equal in every objective merged into "
                      "the row listing them under 'alternatives'")
