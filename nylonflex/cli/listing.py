@@ -66,18 +66,21 @@ def _charts(out):
 
 
 def _variables(out):
-    from ..variables import COORDS, CURVES, DESIGN, INPUTS
+    from ..variables import COORDS, CURVES, DESIGN, INPUTS, SPREAD
 
     for title, table in (("axes and curve coordinates", COORDS), ("design variables "
                          "(query --where/--sort)", DESIGN), ("curves", CURVES),
-                         ("other inputs", INPUTS)):
+                         ("other inputs", INPUTS),
+                         ("model spread (a sweep with 'fidelity: spread'; query "
+                          "--where/--sort)", SPREAD)):
         print(f"{title}:", file=out)
+        w = max(18, *(len(n) for n in table))
         for v in table.values():
             units = f"[{v.units}]" + (f", shown in {v.display}" if v.display != v.units
                                       else "")
-            print(f"  {v.name:<18} {units:<22} {v.long_name}: {v.description}", file=out)
+            print(f"  {v.name:<{w}} {units:<22} {v.long_name}: {v.description}", file=out)
             if v.dims and tuple(v.dims) != (v.name,):
-                print(f"  {'':<18} {'':<22} over ({', '.join(v.dims)})", file=out)
+                print(f"  {'':<{w}} {'':<22} over ({', '.join(v.dims)})", file=out)
         print(file=out)
 
 

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from ..variables import (AXES, CURVES, DESIGN, UNCERTAIN, VARIABLES, is_complete, to_display,
-                         validate)
+from ..variables import (AXES, CURVES, DESIGN, SPREAD, SPREAD_OF, UNCERTAIN, VARIABLES,
+                         is_complete, to_display, validate)
 from .cube import STORED_DIMS, require_filters
 from .journal import Journal
 
@@ -109,7 +109,8 @@ def open_cube(path, *, quiet: bool = False):
         if not quiet:
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
                           "computed; the rest is masked", stacklevel=2)
-        for name in [n for n in ds.data_vars if n in {**DESIGN, **CURVES, **UNCERTAIN}]:
+        for name in [n for n in ds.data_vars
+                     if n in {**DESIGN, **CURVES, **UNCERTAIN, **SPREAD}]:
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
@@ -324,6 +325,15 @@ def _check_dataset(path, name, dset, full):
     return out
 
 
+def _spread_lines(attrs) -> list[str]:
+    """``info``'s lines of a cube with a model spread: its variants and variables."""
+    variants = _text(attrs["model_spread"]).split()
+    return [f"spread    over {len(variants)} model variants (fidelity: spread): "
+            f"{', '.join(variants)}",
+            f"          <var>_model_lo/_hi of {', '.join(SPREAD_OF)}; validity_model_any: "
+            "their flags ORed"]
+
+
 def cube_summary(path) -> list[str]:
     """Lines that describe a cube: dims, ranges, variables, provenance, completeness.
 
@@ -362,6 +372,8 @@ def cube_summary(path) -> list[str]:
         if "model" in sizes:
             out.append("models    " + ", ".join(
                 _text(m) for m in np.asarray(h5["model"][...]).reshape(-1)))
+        if "model_spread" in a:  # fidelity: spread (docs/model.md s. 22)
+            out.extend(_spread_lines(a))
         if "cooling" in sizes:
             out.append("cooling   " + ", ".join(
                 _text(m) for m in np.asarray(h5["cooling"][...]).reshape(-1)))
