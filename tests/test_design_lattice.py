@@ -23,7 +23,7 @@ from helpers import write_cube
 
 import nylonflex as nf
 from nylonflex.design import load_spec, run_design
-from nylonflex.design.report import format_table, reported_rows
+from nylonflex.design.report import format_table
 from nylonflex.engine.provenance import cube_settings
 from nylonflex.storage import open_cube
 
@@ -112,7 +112,7 @@ def test_design_front_yaml_is_not_beaten_on_its_lattice(fig12):
 
     fig = front_figure(res)
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    n = len(reported_rows(res)["radius"])
+    n = len(res.reported_rows()["radius"])
     assert f"reported front ({n} designs)" in labels
     assert f"refined front: {n} designs" in format_table(res)
 

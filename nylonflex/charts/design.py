@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design.report import reported_rows
 from ..storage.files import save_figure
 from ._common import new_figure, rc_context
 from ..variables import AXES, name_label, to_display
@@ -62,7 +61,7 @@ def front_figure(res):
         grid = res.grid_front
         # the rows the CLI reports, counted as it counts them (designs equal in every
         # objective are one row): the chart and the table say the same number
-        refined = reported_rows(res)
+        refined = res.reported_rows()
         if len(objs) >= 2:
             if len(grid["radius"]):
                 _sorted_step(ax, to_display(xname, grid[xname]), to_display(yname, grid[yname]),

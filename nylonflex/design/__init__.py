@@ -77,6 +77,13 @@ class DesignResult:
     #: The model variant the designs were scanned, re-checked and refined under.
     model: str = "paper"
 
+    def reported_rows(self) -> dict:
+        """The designs reported, one row each, as the table, JSON and CSV list them and
+        the chart draws and counts them (one count everywhere): ``{column: array}`` [SI]."""
+        keys = [k for k in (self.designs[0] if self.designs else dict.fromkeys(COLUMNS))
+                if k not in ("source", "alternatives")]
+        return {k: np.array([float(d[k]) for d in self.designs], dtype=float) for k in keys}
+
     @property
     def feasible(self) -> bool:
         return bool(self.designs)

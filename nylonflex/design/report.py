@@ -13,7 +13,7 @@ from ..query import COLUMNS, cell_text, default_columns
 from ..query.format import INTEGERS
 from ..variables import VARIABLES, to_display
 
-__all__ = ["format_csv", "format_json", "format_table", "reported_rows"]
+__all__ = ["format_csv", "format_json", "format_table"]
 
 
 def _columns(res):
@@ -55,13 +55,6 @@ def _alternatives_text(alt, steps=None) -> str:
     return "; ".join(parts)
 
 
-def reported_rows(res) -> dict:
-    """The designs a result reports (one row each, as the table, JSON and CSV list them
-    and as the chart draws and counts them): ``{column: numpy.ndarray}`` [SI]."""
-    cols = _columns(res) if res.designs else list(COLUMNS)
-    return {k: np.array([float(d[k]) for d in res.designs], dtype=float) for k in cols}
-
-
 def _shown(name, x) -> str:
     unit = VARIABLES[name].display if name in VARIABLES else "1"
     return f"{float(to_display(name, x)) if name in VARIABLES else x:.4g}" + \
@@ -87,7 +80,7 @@ def summary(res) -> list:
     lines.append(f"grid: {scan.feasible} of {scan.total} designs feasible")
     for name, (g, b, rel) in res.improvement.items():
         if name == "hypervolume":
-            lines.append(f"refined front: {len(reported_rows(res)['radius'])} designs "
+            lines.append(f"refined front: {len(res.reported_rows()['radius'])} designs "
                          f"({sum(d['source'] == 'refined' for d in res.designs)} refined); "
                          f"it dominates or equals the grid front of "
                          f"{len(res.grid_front['radius'])}; dominated area +{100 * rel:.2f} %")
