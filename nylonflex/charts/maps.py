@@ -93,7 +93,9 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
 
         handles.append(Line2D([], [], ls="", marker="*", ms=10, mfc="gold", mec="k",
                               label="paper's worked example"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=8)
+    # one column under a single panel: two would run off the figure
+    fig.legend(handles=handles, loc="outside lower center", ncol=1 if ncols == 1 else 2,
+               fontsize=8)
     _suptitle(fig, "Design map: maximum tip force over radius and wall thickness",
               f"slice {_eq('length', length)}, {_eq('wrap_angle', psi)}; "
               "one panel per coil index")
