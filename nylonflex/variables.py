@@ -22,8 +22,8 @@ from .units import from_si
 
 __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SPREAD",
            "SPREAD_OF", "SUPPLY_ONLY", "THERMAL", "TRACKING", "UNCERTAIN", "VARIABLES",
-           "Variable", "label", "name_label", "quantile_name", "range_text",
-           "slab_done_attrs", "spread_name", "to_display", "validate"]
+           "Variable", "incomplete_text", "label", "name_label", "quantile_name",
+           "range_text", "slab_done_attrs", "spread_name", "to_display", "validate"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default.
@@ -360,6 +360,19 @@ def is_complete(attrs) -> bool:
         return int(np.asarray(value).reshape(-1)[0]) == 1
     except (TypeError, ValueError, IndexError):
         return False
+
+
+def incomplete_text(ds) -> str:
+    """``"incomplete: 5 of 9 slabs (radii) computed"`` for a cube whose sweep was interrupted (as
+    ``nylonflex info`` reports it: the ``slab_done`` radii of a cube not marked complete),
+    ``""`` for a complete one. ``ds``: an :class:`xarray.Dataset` (or a mapping with
+    ``attrs`` and ``slab_done``)."""
+    if is_complete(ds.attrs):
+        return ""
+    if "slab_done" in ds:
+        done = np.asarray(ds["slab_done"].values).astype(bool)
+        return f"incomplete: {int(done.sum())} of {done.size} slabs (radii) computed"
+    return "incomplete: the sweep did not finish"
 
 
 def slab_done_attrs() -> dict:

@@ -192,7 +192,7 @@ def test_html_is_offline_and_holds_the_cube(ds, tmp_path):
 
     text = build_html(synthetic(ds), source="cube.h5")
     assert not re.search(r"<script[^>]+src=|<link[^>]+href=\"?https?:", text)
-    assert "every design of the cube" in text and "outlined in orange" in text
+    assert "every design of the cube" in text and "Grey cells hatched / are flagged" in text
 
 
 def test_html_subset_is_bounded(ds, monkeypatch):
@@ -256,7 +256,7 @@ def test_offline_file_names_its_hover_colour_bar_and_validity(ds):
     assert '["value","@z' not in text
     assert '"title":"maximum tip force [N]"' in text  # the colour bar
     assert 'nf-validity' in text and "flagtext" in text
-    assert "colour scale is set by the unflagged designs" in text
+    assert "colour scale and the panels' ranges are set by the unflagged designs" in text
 
 
 def test_stand_in_materials_are_named(ds):
@@ -342,3 +342,48 @@ def test_a_page_without_a_fidelity_dataset_has_no_fidelity_part(cube, tmp_path):
     out = tmp_path / "page.html"
     assert main(["explore", str(cube), "--html", str(out)]) == 0
     assert "FE fidelity" not in out.read_text()
+
+
+# ---------------------------------------------------------------------------- issue 46
+def test_the_page_opens_on_a_valid_design_named_right(ds):
+    # it opened on a flagged self-contacting design (15/2/90 mm, 443 deg) that it called
+    # the paper's second worked example (7.5/2/70 mm, C 1.7, 8 deg; docs/model.md s. 8)
+    from nylonflex.explore import first_design
+
+    index, name = first_design(ds)
+    point = ds.isel(index)
+    assert name.startswith("the paper's second worked example (a 7.5 mm, t 2 mm, L 70 mm, "
+                           "C 1.7")
+    assert float(point["radius"]) == pytest.approx(7.5e-3)
+    assert float(point["length"]) == pytest.approx(70e-3)
+    assert float(point["validity"]) == 0
+    # flagged there: never opened on; the first example instead (20/6/90 mm, C 1.1)
+    flagged = ds.copy()
+    v = flagged["validity"].load().copy()
+    v[index] = 1
+    flagged["validity"] = v
+    index, name = first_design(flagged)
+    assert name.startswith("the paper's first worked example") and \
+        float(flagged["validity"].isel(index)) == 0
+    # a cube without either example: a valid design, described by its values
+    other = ds.isel(radius=[0, 2, 4, 6, 8])  # 5, 10, 15, 20, 25 mm
+    other = other.isel(wall_thickness=[0, 1])  # 2, 4 mm: not the first example's 6 mm
+    other = other.sel(radius=[5e-3, 10e-3, 15e-3, 25e-3], method="nearest")
+    index, name = first_design(other)
+    assert name.startswith("a valid design: a ") and "does not hold the paper's examples" \
+        in name
+    assert float(other["validity"].isel(index)) == 0
+
+
+def test_the_page_of_an_incomplete_cube_says_so(ds):
+    pytest.importorskip("bokeh")
+    from nylonflex.explore.page import build_html
+
+    part = ds.copy()
+    part.attrs = {**ds.attrs, "complete": 0}
+    done = part["slab_done"].load().copy()
+    done[5:] = 0
+    part["slab_done"] = done
+    text = build_html(part, source="cube.h5")
+    assert "incomplete: 5 of 9 slabs" in text and "nf-incomplete" in text
+    assert "nf-incomplete" not in build_html(ds, source="cube.h5")

@@ -31,9 +31,10 @@ pytestmark = pytest.mark.slow
 sync_api = pytest.importorskip("playwright.sync_api")
 pytest.importorskip("bokeh")
 
-# The page's default design: radius 15 mm, wall 2 mm, length 90 mm, C 1.7, psi 8 deg; the
-# tests move the length slider one grid step down (90 -> 70 mm) and pick bend_angle_max.
-DESIGN = {"radius": 15e-3, "wall_thickness": 2e-3, "length": 70e-3, "coil_index": 1.7,
+# The page opens on the paper's second worked example: radius 7.5 mm, wall 2 mm, length
+# 70 mm, C 1.7, psi 8 deg (issue 46); the tests move the length slider one grid step up
+# (70 -> 90 mm) and pick bend_angle_max.
+DESIGN = {"radius": 7.5e-3, "wall_thickness": 2e-3, "length": 90e-3, "coil_index": 1.7,
           "wrap_angle": math.radians(8.0)}
 
 
@@ -82,13 +83,13 @@ def _wait_for(page, variable, timeout=20.0):
     raise AssertionError(f"the page never showed {variable}: {_readout(page)}")
 
 
-def _move_length_down(page):
-    """Focus the length slider's handle (the third slider) and step it down once."""
+def _move_length_up(page):
+    """Focus the length slider's handle (the third slider) and step it up once."""
     handle = page.locator(".noUi-handle").nth(2)
     handle.focus()
-    page.keyboard.press("ArrowLeft")
+    page.keyboard.press("ArrowRight")
     end = time.monotonic() + 20
-    while time.monotonic() < end and "length 70 mm" not in page.locator(
+    while time.monotonic() < end and "length 90 mm" not in page.locator(
             "#nf-readout").inner_text():
         page.wait_for_timeout(200)
 
@@ -96,15 +97,15 @@ def _move_length_down(page):
 def _drive(page, cube, select_label):
     page.wait_for_selector("#nf-readout", timeout=60_000)
     var, value = _wait_for(page, "tip_force_max")
-    at90 = {**DESIGN, "length": 90e-3}
-    assert value == pytest.approx(_expected(cube, "tip_force_max", at90), rel=5e-4)
-    _move_length_down(page)
+    at70 = {**DESIGN, "length": 70e-3}
+    assert value == pytest.approx(_expected(cube, "tip_force_max", at70), rel=5e-4)
+    _move_length_up(page)
     var, value = _readout(page)
     assert value == pytest.approx(_expected(cube, "tip_force_max", DESIGN), rel=5e-4)
     page.locator("select").first.select_option(label=select_label)
     var, value = _wait_for(page, "bend_angle_max")
     assert value == pytest.approx(_expected(cube, "bend_angle_max", DESIGN), rel=5e-4)
-    assert "length 70 mm" in page.locator("#nf-readout").inner_text()
+    assert "length 90 mm" in page.locator("#nf-readout").inner_text()
     # the read-out says the design's validity by flag name (issue 25); the cube's value
     bits = _expected(cube, "validity", DESIGN)
     shown = page.locator("#nf-validity")
@@ -114,7 +115,7 @@ def _drive(page, cube, select_label):
     import re
 
     config = page.locator("#nf-config").text_content()
-    assert re.search(r"length:\s+values: \[70(\.0)?\]", config), config
+    assert re.search(r"length:\s+values: \[90(\.0)?\]", config), config
 
 
 @contextlib.contextmanager
@@ -164,9 +165,9 @@ def _click_map_and_check(page, cube):
     text = page.locator("#nf-readout").inner_text()
     assert "between grid points" in text and "no values between grid points" in text
     m = re.search(r"design: radius ([\d.]+) mm, wall_thickness ([\d.]+) mm", text)
-    at = {**DESIGN, "length": 90e-3, "radius": float(m[1]) * 1e-3,
+    at = {**DESIGN, "length": 70e-3, "radius": float(m[1]) * 1e-3,
           "wall_thickness": float(m[2]) * 1e-3}
-    assert (float(m[1]), float(m[2])) != (15.0, 2.0)
+    assert (float(m[1]), float(m[2])) != (7.5, 2.0)
     assert _readout(page)[1] == pytest.approx(_expected(cube, "tip_force_max", at), rel=5e-4)
 
 
@@ -342,3 +343,82 @@ def test_where_table_sorts_and_picks_a_design(cube, browser, tmp_path):
         assert float(ds["wall_thickness"].isel(wall_thickness=ix["wall_thickness"])) >= 4e-3
     value = float(page.locator("#nf-readout").get_attribute("data-value"))
     assert value == pytest.approx(min(rows), rel=1e-6)  # the smallest, first once sorted
+
+
+# ---------------------------------------------------------------------------- issue 46
+def test_first_view_is_a_valid_design_named_right_and_fits_1280_px(cube, browser, tmp_path):
+    # the page opened on a self-contacting design (443 deg, flagged) it called the paper's
+    # second worked example; its fixed 1,600 px layout cut the right panels off in a 1,280
+    # px window; bokeh logged "could not set initial ranges" 12 times
+    from nylonflex.storage import open_cube
+    from nylonflex.variables import AXES
+
+    out = tmp_path / "fig12.html"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                               ""))
+    subprocess.run([sys.executable, "-m", "nylonflex", "explore", str(cube), "--html",
+                    str(out), "--where", "tip_force_max >= 1 N"], env=env, check=True,
+                   capture_output=True)
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    messages = []
+    page.on("console", lambda m: messages.append((m.type, m.text)))
+    page.on("pageerror", lambda e: messages.append(("error", str(e))))
+    page.goto(out.as_uri())
+    page.wait_for_selector("#nf-readout", timeout=60_000)
+    page.wait_for_timeout(1000)
+    # the first view: the paper's second example (7.5/2/70 mm, C 1.7, 8 deg), valid
+    snap = _snapshot(page)
+    with open_cube(cube) as ds:
+        ix = _check_one_design(ds, snap)
+        point = ds.isel(ix)
+        got = {a: float(point[a]) for a in AXES}
+        assert got == pytest.approx({**DESIGN, "length": 70e-3}, rel=1e-9)
+        assert float(point["validity"]) == 0
+        assert float(point["bend_angle_max"]) * 180 / math.pi < 360
+        # the colour scale of the bend map: the valid designs of the slice only
+        page.locator("select").first.select_option(label="maximum bend angle [deg]")
+        _wait_for(page, "bend_angle_max")
+        cells = page.evaluate("() => { const d = Bokeh.documents[0].get_model_by_name("
+                              "'nf-map').data; return {z: Array.from(d.z), zc: Array.from("
+                              "d.zc.map(v => isFinite(v) ? v : null)), vf: Array.from(d.vf)};"
+                              " }")
+        high = page.evaluate("() => Bokeh.documents[0].get_model_by_name('nf-map-figure')"
+                             ".renderers[0].glyph.fill_color.transform.high")
+    flagged = [z for z, vf in zip(cells["z"], cells["vf"]) if vf != "valid"]
+    assert flagged and max(flagged) > high  # the flagged designs bend furthest ...
+    assert all(zc is None for zc, vf in zip(cells["zc"], cells["vf"]) if vf != "valid")
+    assert high == pytest.approx(max(z for z, vf in zip(cells["z"], cells["vf"])
+                                     if vf == "valid"), rel=1e-6)  # ... and set no colour
+    opened = page.locator("#nf-opened")
+    assert "the paper's second worked example" in opened.inner_text()
+    assert "a 7.5 mm, t 2 mm, L 70 mm, C 1.7" in opened.inner_text()
+    assert opened.get_attribute("data-design") == ",".join(str(ix[a]) for a in AXES)
+    # fits 1,280 px: no horizontal overflow, every panel inside the window
+    assert page.evaluate("document.documentElement.scrollWidth") <= 1280
+    for name in ("nf-map-figure", "nf-lines-figure"):
+        box = page.evaluate(_BOX, name)
+        assert box is not None and box[0] >= 0 and box[1] <= 1280, (name, box)
+    for canvas in page.locator("canvas").all():
+        b = canvas.bounding_box()
+        assert b["x"] >= 0 and b["x"] + b["width"] <= 1280 + 0.5, b
+    # the table headers: every title whole
+    for header in page.locator(".slick-header-column").all():
+        name = header.locator(".slick-column-name")
+        assert name.evaluate("e => e.scrollWidth <= e.clientWidth + 1"), name.inner_text()
+    page.screenshot(path=str(tmp_path / "first_view_1280.png"), full_page=True)
+    bad = [m for m in messages if m[0] in ("error", "warning")]
+    assert bad == [], bad
+
+
+_BOX = """(n) => {
+  function walk(view) {
+    if (view.model && view.model.name == n) { const r = view.el.getBoundingClientRect();
+                                               return [r.left, r.right]; }
+    for (const c of (view.child_views || [])) { const f = walk(c); if (f) return f; }
+    return null;
+  }
+  for (const v of Bokeh.index.values ? Bokeh.index.values() : Object.values(Bokeh.index)) {
+    const f = walk(v); if (f) return f;
+  }
+  return null;
+}"""

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..variables import VARIABLES, is_complete, to_display
+from ..variables import VARIABLES, incomplete_text, to_display
 
 #: Image formats a chart can be written in.
 FORMATS = ("png", "pdf", "svg")
@@ -184,11 +184,14 @@ def _footer(fig, ds):
     note = f"cube '{name}' (nylonflex {version}, {ds.attrs.get('silicone', '?')} / " \
            f"{ds.attrs.get('nylon', '?')})"
 
-    if not is_complete(ds.attrs):
-        note += " - INCOMPLETE cube: missing radii are blank"
     # above the canvas (savefig's tight bounding box takes it in): clear of titles,
     # axes and legends whatever the layout
     fig.text(0.0, 1.0, note, ha="left", va="bottom", fontsize=7, color="0.4")
+    missing = incomplete_text(ds)
+    if missing:  # a sweep stopped early: the title's first line says so, in red
+        title = fig.get_suptitle()
+        fig.suptitle(f"{missing} (missing radii are blank)" + (f"\n{title}" if title else ""),
+                     fontsize=RC["figure.titlesize"], color="#B00020", gid="nf-incomplete")
 
 
 def _suptitle(fig, title, subtitle):
@@ -229,3 +232,93 @@ def _flag_text(ds, bits) -> str:
     meanings = str(attrs.get("flag_meanings", "")).split()
     named = [f"{m} {n}" for m, n in zip(masks, meanings) if bits & m]
     return ", ".join(named) if named else f"validity {bits}"
+
+
+# ---------------------------------------------------------------------------- flagged designs
+def _valid(ds, **sel):
+    """Where the designs of ``ds`` (sliced by ``sel``) carry no validity flag: a bool
+    DataArray (all True for a cube without ``validity``)."""
+    if "validity" not in ds:
+        return None
+    v = ds["validity"].sel(**sel) if sel else ds["validity"]
+    return v.fillna(0) == 0
+
+
+def _valid_range(ds, name, **sel):
+    """``(lo, hi)`` of ``name`` in display units over the valid designs of the whole cube
+    (or its slice ``sel`` along a dimension a chart draws one figure per value of, the
+    model): a chart's colour scale is the same for every slice of one cube, and a flagged
+    design (``validity`` != 0) never sets it. ``(nan, nan)`` where no design is finite."""
+    da = ds[name].sel(**sel) if sel else ds[name]
+    ok = _valid(ds, **sel)
+    if ok is not None:
+        da = da.where(ok.broadcast_like(da) if set(ok.dims) <= set(da.dims) else ok)
+    values = np.asarray(to_display(name, da.values), float)
+    if not np.isfinite(values).any():
+        return math.nan, math.nan
+    return float(np.nanmin(values)), float(np.nanmax(values))
+
+
+def _coil_colour(ds, c):
+    """The colour of coil index ``c`` [-]: by its place on the cube's axis, so a coil index
+    keeps its colour whichever coil indices a chart is asked for (``--coil-index``)."""
+    values = np.asarray(ds["coil_index"].values, float)
+    k = int(np.argmin(np.abs(values - float(c))))
+    return _COLOURS[k % len(_COLOURS)]
+
+
+def _flag_patch(ds, bits):
+    """The legend entry of flagged designs (grey, hatched), naming the flags set in
+    ``bits``."""
+    from matplotlib.patches import Patch
+
+    return Patch(fc=_FLAG_FILL, ec="k", hatch="\\\\",
+                 label=f"flagged design: {_flag_text(ds, bits)} (grey, hatched, off the "
+                       "colour scale)")
+
+
+def _grey_flagged(ax, x, y, valid, values):
+    """Grey out the flagged cells of a map panel (``x`` across, ``y`` up, ``values`` [display
+    units] over (y, x), ``valid`` their validity bits, 0 clean, or None).
+
+    Each flagged cell (``validity`` != 0) is covered by an opaque grey hatched cell, and
+    its value is replaced by its nearest clean neighbour's, so that a filled contour of the
+    returned values never takes a flagged design's value: no flagged design shows in a
+    colour of the scale, nor does the interpolation beside it. Returns ``(values to
+    contour, OR of the flag bits)``; ``(values, 0)`` where nothing is flagged.
+    """
+    if valid is None:
+        return values, 0
+    bits_arr = np.nan_to_num(np.asarray(valid, float)).astype(int)
+    bad = bits_arr != 0
+    if not bad.any():
+        return values, 0
+    from matplotlib.collections import PolyCollection
+    from scipy.ndimage import distance_transform_edt
+
+    filled = np.array(values, float)
+    if (~bad).any():
+        near = distance_transform_edt(bad, return_distances=False, return_indices=True)
+        filled = filled[tuple(near)]
+    else:
+        filled[:] = np.nan
+    ex, ey = _cell_edges(x), _cell_edges(y)
+    rows, cols = np.nonzero(bad)
+    cells = [[(ex[c], ey[r]), (ex[c + 1], ey[r]), (ex[c + 1], ey[r + 1]), (ex[c], ey[r + 1])]
+             for r, c in zip(rows, cols)]
+    ax.add_collection(PolyCollection(cells, facecolors=[_FLAG_FILL[:3]], edgecolors="0.35",
+                                     linewidths=0.0, hatch="\\\\", zorder=2.5,
+                                     gid="nf-flagged"))
+    if len(x) > 1 and len(y) > 1:  # the span of the grid, as a filled contour has it
+        ax.set_xlim(min(x), max(x))
+        ax.set_ylim(min(y), max(y))
+    return filled, int(np.bitwise_or.reduce(bits_arr[bad]))
+
+
+def _cell_edges(x):
+    """Edges of the cells centred on the grid values ``x`` (halfway between neighbours)."""
+    x = np.asarray(x, float)
+    if x.size == 1:
+        return np.array([x[0] - 0.5, x[0] + 0.5])
+    mid = (x[1:] + x[:-1]) / 2
+    return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import DESIGN, VARIABLES, label, to_display
-from ._common import _COLOURS, _eq, _figure, _flag_text, _footer, _nearest, _suptitle
+from ._common import _COLOURS, _FLAG_GREY, _eq, _figure, _flag_text, _footer, _nearest, _suptitle
 
 # the paper's first worked example's slice (docs/model.md s. 8), SI
 _SLICE = (("wall_thickness", 6e-3), ("length", 90e-3), ("coil_index", 1.1),
@@ -72,16 +72,19 @@ def compare(ds, *, variable="tip_force_max", wall_thickness=None, length=None,
         one = cut.sel(model=m) if "model" in cut.dims else cut
         y = to_display(variable, one[variable].values)
         colour = _COLOURS[k % len(_COLOURS)]
-        ax.plot(r, y, linestyle=styles[k % len(styles)], color=colour, label=m)
-        if "validity" in one:
-            v = np.nan_to_num(np.asarray(one["validity"].values)).astype(int)
-            bad = v != 0
-            if bad.any():
-                bits |= int(np.bitwise_or.reduce(v[bad]))
-                ax.plot(r[bad], y[bad], "x", color=colour, ms=6, mew=1.5)
+        v = np.nan_to_num(np.asarray(one["validity"].values)).astype(int) \
+            if "validity" in one else np.zeros(y.shape, int)
+        bad = v != 0
+        # a flagged design keeps no model colour: grey, crossed
+        ax.plot(r, np.where(bad, np.nan, y), linestyle=styles[k % len(styles)], color=colour,
+                label=m)
+        if bad.any():
+            bits |= int(np.bitwise_or.reduce(v[bad]))
+            ax.plot(r, np.where(bad, y, np.nan), "x", ls=styles[k % len(styles)],
+                    color=_FLAG_GREY, ms=6, mew=1.5, gid="nf-flagged")
     if bits:
-        ax.plot([], [], "x", color="0.3", ms=6, mew=1.5,
-                label=f"flagged: {_flag_text(ds, bits)}")
+        ax.plot([], [], "x", color=_FLAG_GREY, ms=6, mew=1.5,
+                label=f"flagged (grey): {_flag_text(ds, bits)}")
     ax.set_xlabel(label(ds["radius"]))
     ax.set_ylabel(label(ds[variable]))
     ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
@@ -89,6 +92,6 @@ def compare(ds, *, variable="tip_force_max", wall_thickness=None, length=None,
     sub = ", ".join(_eq(n, v) for n, v in at.items())
     _suptitle(fig, f"Figure compare: {VARIABLES[variable].long_name} against radius, "
               "every model",
-              f"at {sub} (the paper's first example's slice)")
+              f"at {sub}\n(the paper's first example's slice)")
     _footer(fig, ds)
     return fig

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..variables import VARIABLES, label, to_display
-from ._common import (_COLOURS, _LENGTH_DEFAULT, _coils, _eq, _figure, _footer,
+from ._common import (_COLOURS, _FLAG_FILL, _FLAG_GREY, _LENGTH_DEFAULT, _coils, _eq, _figure, _footer,
                       _nearest, _pick_few, _range_text, _spread, _stroke_max, _suptitle)
 
 
@@ -51,18 +51,45 @@ def fig4(ds, *, coil_index=None):
     return fig
 
 
+#: The bend at which the tip runs into the base (docs/model.md s. 17, ``self_contact``).
+_CONTACT_DEG = 360.0
+#: Figure 6's bend axis ends this far above it: the rest of a curve is clipped.
+_CONTACT_TOP = 1.25 * _CONTACT_DEG
+
+
 def _curve_panel(ax, ds, var, name, values, fixed):
+    """Curves of ``var`` against pressure, one per value of ``name``. A bend angle past
+    360 deg (the tip runs into the base, the design's ``self_contact`` flag) is drawn
+    grey and dotted and the axis ends at 450 deg (clipped); returns whether any was."""
     pressure = to_display("pressure", ds["pressure"].values)
+    contact = False
     for i, v in enumerate(values):
-        y = ds[var].sel({name: v, **fixed}).values
-        ax.plot(pressure, to_display(var, y), color=_COLOURS[i % len(_COLOURS)],
-                label=_eq(name, v))
+        y = to_display(var, ds[var].sel({name: v, **fixed}).values)
+        over = y > _CONTACT_DEG if var == "bend_angle" else np.zeros(y.shape, bool)
+        # the coloured line stops at the last point short of contact; grey dotted on
+        cut = np.where(over, np.nan, y)
+        if over.any():
+            contact = True
+            joined = over | np.append(over[1:], False)  # from the point before
+            ax.plot(pressure, np.where(joined, y, np.nan), color=_FLAG_GREY, ls=":",
+                    lw=1.4, gid="nf-flagged")
+        ax.plot(pressure, cut, color=_COLOURS[i % len(_COLOURS)], label=_eq(name, v))
     ax.set_xlim(pressure[0], pressure[-1])
     ax.set_ylim(bottom=0)
+    if contact:
+        ax.axhspan(_CONTACT_DEG, _CONTACT_TOP, color=_FLAG_FILL, lw=0, zorder=0)
+        ax.set_ylim(0, _CONTACT_TOP)
+        ax.text(0.98, (_CONTACT_DEG + 0.5 * (_CONTACT_TOP - _CONTACT_DEG)) / _CONTACT_TOP,
+                "self-contact: past 360 deg the tip runs into the base\n(flagged; grey "
+                "dotted, clipped at 450 deg)", transform=ax.transAxes, ha="right",
+                va="center", fontsize=7.5, color="0.15")
     ax.set_xlabel(label(ds["pressure"]))
     ax.set_ylabel(label(ds[var]))
     ax.set_title(", ".join(_eq(k, v) for k, v in fixed.items()))
-    ax.legend(loc="upper left", title=VARIABLES[name].long_name)
+    # below the grey band where it is drawn
+    ax.legend(loc="upper left", title=VARIABLES[name].long_name,
+              bbox_to_anchor=(0, _CONTACT_DEG / _CONTACT_TOP) if contact else None)
+    return contact
 
 
 def _held_design(ds, radius, wall_thickness, length):

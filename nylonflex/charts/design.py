@@ -59,7 +59,9 @@ def front_figure(res):
                        s=6, c="0.75", lw=0, label=f"feasible grid designs ({res.scan.feasible})",
                        rasterized=True)
         grid = res.grid_front
-        refined = res.refined_front
+        # the rows the CLI reports, counted as it counts them (designs equal in every
+        # objective are one row): the chart and the table say the same number
+        refined = res.reported_rows()
         if len(objs) >= 2:
             if len(grid["radius"]):
                 _sorted_step(ax, to_display(xname, grid[xname]), to_display(yname, grid[yname]),
@@ -69,7 +71,7 @@ def front_figure(res):
                 _sorted_step(ax, to_display(xname, refined[xname]),
                              to_display(yname, refined[yname]), color="C3", marker=".",
                              ms=7, lw=1.2, ls="--",
-                             label=f"refined front ({len(refined['radius'])})")
+                             label=f"reported front ({len(refined['radius'])} designs)")
         else:
             for d in res.designs:
                 style = dict(color="C3", marker="*", ms=14) if d["source"] == "refined" \

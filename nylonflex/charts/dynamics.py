@@ -14,8 +14,9 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, label, to_display
-from ._common import (_COLOURS, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _footer,
-                      _nearest, new_figure)
+from ._common import (_COLOURS, _FLAG_GREY, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coil_colour,
+                      _coils, _eq, _flag_patch, _flag_text, _footer, _grey_flagged, _nearest,
+                      _valid, _valid_range, new_figure)
 
 __all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate", "tracking_map"]
 
@@ -128,19 +129,32 @@ def _map(ds, name, title, cmap, *, ax, x, y, **given):
             raise InputError(f"{name} map: x and y must be two of {', '.join(AXES)}, "
                              f"got {x!r} and {y!r}")
     fixed = _fixed(ds, (x, y), **given)
-    cut = ds[name].sel(**fixed).transpose(y, x).load()
+    names = [name, *(["validity"] if "validity" in ds else [])]
+    cut = ds[names].sel(**fixed).transpose(y, x).load()
     fig, ax = _axes(ax, (6.4, 4.6))
     xs, ys = to_display(x, ds[x].values), to_display(y, ds[y].values)
-    values = to_display(name, cut.values)
+    values = to_display(name, cut[name].values)
+    # flagged designs: greyed and hatched, never a colour of the scale; the scale is the
+    # cube's valid designs' range, the same for every slice
+    values, bits = _grey_flagged(ax, xs, ys, cut["validity"].values if "validity" in cut
+                                 else None, values)
+    lo, hi = _valid_range(ds, name)
+    if not (np.isfinite(lo) and hi > lo):
+        lo, hi = (lo, lo + 1.0) if np.isfinite(lo) else (0.0, 1.0)
     finite = np.isfinite(values)
-    if len(xs) > 1 and len(ys) > 1 and finite.all() and np.ptp(values) > 0:
-        filled = ax.contourf(xs, ys, values, levels=12, cmap=cmap)
-        lines = ax.contour(xs, ys, values, levels=filled.levels[2::3], colors="white",
+    if len(xs) > 1 and len(ys) > 1 and finite.sum() >= 4 and np.nanmax(values) > \
+            np.nanmin(values):
+        levels = np.linspace(lo, hi, 13)
+        filled = ax.contourf(xs, ys, values, levels=levels, cmap=cmap, extend="neither")
+        lines = ax.contour(xs, ys, values, levels=levels[2::3], colors="white",
                            linewidths=0.6)
         ax.clabel(lines, fmt="%.3g", fontsize=7.5)
     else:  # a line of designs, a flat field or gaps: cells, gaps left blank
         filled = ax.pcolormesh(xs, ys, np.ma.masked_invalid(values), cmap=cmap,
-                               shading="nearest")
+                               shading="nearest", vmin=lo, vmax=hi)
+    if bits:
+        ax.legend(handles=[_flag_patch(ds, bits)], loc="upper center",
+                  bbox_to_anchor=(0.5, -0.14), fontsize=7.5, frameon=False)
     fig.colorbar(filled, ax=ax, label=label(ds[name]))
     ax.set_xlabel(label(ds[x]))
     ax.set_ylabel(label(ds[y]))
@@ -175,17 +189,27 @@ def cycle_rate_lines(ds, *, ax=None, wall_thickness=None, length=None, wrap_angl
     fixed = _fixed(ds, ("radius", "coil_index"), wall_thickness=wall_thickness,
                    length=length, wrap_angle=wrap_angle)
     coils = _coils(ds, coil_index)
-    cut = ds[["cycle_rate", "limit"]].sel(**fixed).load()
+    names = ["cycle_rate", "limit", *(["validity"] if "validity" in ds else [])]
+    cut = ds[names].sel(**fixed).load()
     fig, ax = _axes(ax, (6.4, 4.4))
     x = to_display("radius", ds["radius"].values)
-    for i, c in enumerate(coils):
+    bits = 0
+    for c in coils:
         one = cut.sel(coil_index=c)
         rate = to_display("cycle_rate", one["cycle_rate"].values)
         lim = one["limit"].values
-        colour = _COLOURS[i % len(_COLOURS)]
-        ax.plot(x, rate, color=colour, label=_eq("coil_index", c))
+        colour = _coil_colour(ds, c)
+        v = np.nan_to_num(one["validity"].values).astype(int) if "validity" in one else \
+            np.zeros(rate.shape, int)
+        bad = v != 0
+        # a flagged design keeps no colour: its stretch of the line is grey
+        ax.plot(x, np.where(bad, np.nan, rate), color=colour, label=_eq("coil_index", c))
+        if bad.any():
+            bits |= int(np.bitwise_or.reduce(v[bad]))
+            ax.plot(x, np.where(bad, rate, np.nan), color=_FLAG_GREY, lw=1.2, ls=":",
+                    marker=".", gid="nf-flagged")
         for code, marker in ((1, "o"), (2, "x")):
-            hit = lim == code
+            hit = (lim == code) & ~bad
             if hit.any():
                 ax.plot(x[hit], rate[hit], ls="", marker=marker, ms=4, mfc="none",
                         color=colour)
@@ -195,6 +219,9 @@ def cycle_rate_lines(ds, *, ax=None, wall_thickness=None, length=None, wrap_angl
     handles += [Line2D([], [], ls="", marker="o", mfc="none", color="0.3",
                        label="strength-limited"),
                 Line2D([], [], ls="", marker="x", color="0.3", label="supply-limited")]
+    if bits:
+        handles.append(Line2D([], [], color=_FLAG_GREY, ls=":", marker=".",
+                              label=f"flagged design (grey): {_flag_text(ds, bits)}"))
     ax.legend(handles=handles, fontsize=8)
     ax.set_xlabel(label(ds["radius"]))
     ax.set_ylabel(label(ds["cycle_rate"]))
@@ -229,20 +256,32 @@ def force_rate(ds, *, ax=None, coil_index=None, length=None, wrap_angle=None):
     coils = _coils(ds, coil_index)
     sel = {k: _nearest(ds, k, v) for k, v in (("length", length), ("wrap_angle", wrap_angle))
            if v is not None}
-    cut = ds[["cycle_rate", "tip_force_max"]].sel(coil_index=coils, **sel).load()
+    names = ["cycle_rate", "tip_force_max", *(["validity"] if "validity" in ds else [])]
+    cut = ds[names].sel(coil_index=coils, **sel).load()
     fig, ax = _axes(ax, (6.4, 4.6))
-    all_rate, all_force = [], []
-    for i, c in enumerate(coils):
+    all_rate, all_force, bits = [], [], 0
+    for c in coils:
         one = cut.sel(coil_index=c)
         rate = to_display("cycle_rate", one["cycle_rate"].values.ravel())
         force = to_display("tip_force_max", one["tip_force_max"].values.ravel())
+        v = np.nan_to_num(one["validity"].values.ravel()).astype(int) if "validity" in one \
+            else np.zeros(rate.shape, int)
         ok = np.isfinite(rate) & np.isfinite(force)
-        ax.scatter(rate[ok], force[ok], s=4, alpha=0.35, color=_COLOURS[i % len(_COLOURS)],
+        bad = ok & (v != 0)
+        ok &= v == 0
+        ax.scatter(rate[ok], force[ok], s=4, alpha=0.35, color=_coil_colour(ds, c),
                    label=_eq("coil_index", c), rasterized=True, linewidths=0)
+        if bad.any():  # flagged designs: grey, and never on the front
+            bits |= int(np.bitwise_or.reduce(v[bad]))
+            ax.scatter(rate[bad], force[bad], s=4, alpha=0.35, color=_FLAG_GREY,
+                       rasterized=True, linewidths=0, gid="nf-flagged")
         all_rate.append(rate[ok])
         all_force.append(force[ok])
     rate, force = np.concatenate(all_rate), np.concatenate(all_force)
-    if rate.size:  # the front: the largest force among designs at least this fast
+    if bits:
+        ax.scatter([], [], s=4, color=_FLAG_GREY,
+                   label=f"flagged (grey, not on the front): {_flag_text(ds, bits)}")
+    if rate.size:  # the front: the largest force among valid designs at least this fast
         order = np.argsort(-rate)
         front = np.maximum.accumulate(force[order])
         ax.step(rate[order], front, where="post", color="k", lw=1.2,

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..variables import VARIABLES, label, quantile_name, to_display
 from ._common import (_COLOURS, _DASHES, _EXAMPLES, _FLAG_GREY, _LENGTH_DEFAULT,
-                      _WRAP_DEFAULT, _flag_text, _models, _one_model,
+                      _WRAP_DEFAULT, _coil_colour, _flag_text, _models, _one_model,
                       _coils, _eq, _example_point, _figure, _footer,
                       _labelled_psis, _nearest, _pick_few, _psi_colour, _stroke_max,
                       _suptitle, _text)
@@ -153,15 +153,25 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
     j_ref = None if psi_ref is None else \
         int(np.argmin(np.abs(ds["wrap_angle"].values - psi_ref)))
     load_drawn, bits = set(), 0
-    for k, c in enumerate(coils):
+    for c in coils:
+        colour = _coil_colour(ds, c)
         cut = ds.sel(coil_index=c)
         value = to_display(var, cut[var].transpose("wrap_angle", "radius").values)
         lim = cut["limit"].transpose("wrap_angle", "radius").values
+        v = np.nan_to_num(cut["validity"].transpose("wrap_angle", "radius").values) \
+            .astype(int) if flagged else np.zeros(lim.shape, int)
         # the whole stroke: the same for every wrap angle (s* = s_max(C))
         stroke_limited = lim == 0
-        solid = np.where(stroke_limited.any(axis=0), np.nanmax(
-            np.where(stroke_limited, value, -np.inf), axis=0), np.nan)
-        ax.plot(x, solid, color=_COLOURS[k % len(_COLOURS)], lw=2.0, zorder=3)
+        best = np.argmax(np.where(stroke_limited, value, -np.inf), axis=0)
+        solid = np.where(stroke_limited.any(axis=0),
+                         np.take_along_axis(value, best[None], 0)[0], np.nan)
+        v_solid = np.take_along_axis(v, best[None], 0)[0]
+        # a flagged design (docs/model.md s. 17) keeps no colour: grey, drawn apart
+        bad = (v_solid != 0) & np.isfinite(solid)
+        ax.plot(x, np.where(bad, np.nan, solid), color=colour, lw=2.0, zorder=3)
+        if bad.any():
+            bits |= int(np.bitwise_or.reduce(v_solid[bad]))
+            _grey_line(ax, x, solid, bad, c)
         if j_ref is None:
             continue
         # the supply's stroke (the wrap's muscle length sets T_ss) or where the muscle
@@ -170,17 +180,12 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
         load = np.where(short, value[j_ref], np.nan)
         if short.any():
             load_drawn |= {int(code) for code in lim[j_ref][short]}
-            ax.plot(x, load, color=_COLOURS[k % len(_COLOURS)], lw=1.5, ls=(0, (4, 1.5)),
-                    zorder=3)
-        if flagged:
-            drawn = np.where(np.isfinite(solid), solid, load)
-            v = np.nan_to_num(cut["validity"].transpose("wrap_angle", "radius").values[j_ref])
-            bad = (v != 0) & np.isfinite(drawn)
+            bad = (v[j_ref] != 0) & short
+            ax.plot(x, np.where(bad, np.nan, load), color=colour, lw=1.5,
+                    ls=(0, (4, 1.5)), zorder=3)
             if bad.any():
-                bits |= int(np.bitwise_or.reduce(v[bad].astype(int)))
-                ax.plot(x, np.where(bad, drawn, np.nan), color=_FLAG_GREY, lw=7,
-                        alpha=0.55, marker="o", ms=8, mew=0, solid_capstyle="round",
-                        zorder=2.5)
+                bits |= int(np.bitwise_or.reduce(v[j_ref][bad]))
+                _grey_line(ax, x, load, bad, c)
     shown = _labelled_psis(psis)
     annotate = len(shown) <= 4  # more labels than that overprint: the legend names them
     for w, points in _cut_ins(ds, var, sel, coils, psis).items():
@@ -205,6 +210,14 @@ def _limit_lines(ax, ds, var, sel, coils, psis, psi_ref=None, fixed=False):
     return load_drawn, bits
 
 
+def _grey_line(ax, x, y, bad, coil=None):
+    """The flagged stretch of a curve (of coil index ``coil``, named in its hidden label):
+    grey, thick, faded, no colour of the coils."""
+    ax.plot(x, np.where(bad, y, np.nan), color=_FLAG_GREY, lw=5, alpha=0.6, marker="o",
+            ms=5, mew=0, solid_capstyle="round", zorder=2.5, gid="nf-flagged",
+            label="_flagged" if coil is None else f"_flagged C = {coil:g}")
+
+
 def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
     """The fig. 12(b,c) legend; ``load_psi`` [rad]: supply- or load-limited lines (limit
     codes ``limits``) were drawn at that wrap angle; ``flags``: the names of the validity
@@ -212,8 +225,8 @@ def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
     from matplotlib.lines import Line2D
 
     shown = _labelled_psis(psis)
-    handles = [Line2D([], [], color=_COLOURS[k % len(_COLOURS)], lw=2.0,
-                      label=f"C = {c:g}") for k, c in enumerate(coils)]
+    handles = [Line2D([], [], color=colour, lw=2.0, label=f"C = {c:g}")
+               for c, colour in coils]
     handles += [Line2D([], [], color=_psi_colour(j, len(shown)),
                        ls=_DASHES[j % len(_DASHES)], lw=1.4, marker="o", ms=4, mfc="white",
                        mec=_psi_colour(j, len(shown)),
@@ -231,8 +244,8 @@ def _legend_12bc(fig, coils, psis, load_psi=None, flags="", limits=()):
                               label=f"{what} (muscle stops short), at "
                                     f"{_eq('wrap_angle', load_psi)}"))
     if flags:
-        handles.append(Line2D([], [], color=_FLAG_GREY, lw=7, alpha=0.55,
-                              label=f"flagged design: {flags}"))
+        handles.append(Line2D([], [], color=_FLAG_GREY, lw=5, alpha=0.6,
+                              label=f"flagged design: {flags} (grey, not coloured)"))
     fig.legend(handles=handles, loc="outside lower center",
                ncol=min(6, max(len(coils), len(shown) + (len(shown) < len(psis)))),
                title="coil index C: solid while the design has its full range of motion "
@@ -377,7 +390,8 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                 ax.set_ylim(bottom=0)
     if many:
         _row_limits(axes)
-    _legend_12bc(fig, coils, psis, psi_ref if load else None, _flag_text(ds, bits),
+    _legend_12bc(fig, [(c, _coil_colour(ds, c)) for c in coils], psis,
+                 psi_ref if load else None, _flag_text(ds, bits),
                  load)
     _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
               "any length (M* does not depend on L; tip force = M*/L)" +
@@ -454,17 +468,15 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             cut = one[names].sel(wrap_angle=psi, **sel).load()
             model_bands(bottom, one, "range_fraction", sel, coils, psi, scale=100.0,
                         everywhere=True, note_at=None)
-            for k, c in enumerate(coils):
+            for c in coils:
                 rf = 100 * cut["range_fraction"].sel(coil_index=c).values
-                bottom.plot(x, rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
-                if "validity" in cut:
-                    bad = np.nan_to_num(cut["validity"].sel(coil_index=c).values) != 0
-                    if bad.any():
-                        bits |= int(np.bitwise_or.reduce(
-                            cut["validity"].sel(coil_index=c).values[bad].astype(int)))
-                        bottom.plot(x, np.where(bad, rf, np.nan), color=_FLAG_GREY, lw=7,
-                                    alpha=0.55, marker="o", ms=8, mew=0,
-                                    solid_capstyle="round", zorder=1.5)
+                v = np.nan_to_num(cut["validity"].sel(coil_index=c).values).astype(int) \
+                    if "validity" in cut else np.zeros(rf.shape, int)
+                bad = v != 0
+                bottom.plot(x, np.where(bad, np.nan, rf), color=_coil_colour(one, c), lw=1.8)
+                if bad.any():
+                    bits |= int(np.bitwise_or.reduce(v[bad]))
+                    _grey_line(bottom, x, rf, bad, c)
             bottom.set_title(f"range of motion at {_eq('wrap_angle', psi)}" +
                              ("" if many else " (100 % = full range)"))
             bottom.set_xlabel(label(ds["radius"]) if w == len(walls) - 1 or not many else "")
@@ -472,7 +484,8 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             bottom.set_ylim(0, 105)
     if many:
         _row_limits(axes[0::2])
-    _legend_12bc(fig, coils, psis, psi if load else None, _flag_text(ds, bits), load)
+    _legend_12bc(fig, [(c, _coil_colour(ds, c)) for c in coils], psis,
+                 psi if load else None, _flag_text(ds, bits), load)
     _suptitle(fig, "Figure 12(c): maximum bend angle (range of motion) against radius",
               f"{_eq('length', length)} (the angle grows in proportion to L; "
               "the range fraction does not)" +
@@ -501,13 +514,16 @@ def _quantile_bands(ax, ds, var, sel, coils, wrap_angle=None, note_at=(0.99, 0.0
     lo, hi, q = _band_levels(ds)
     psi = _nearest(ds, "wrap_angle", _WRAP_DEFAULT if wrap_angle is None else wrap_angle)
     x = to_display("radius", ds["radius"].values)
-    for k, c in enumerate(coils):
+    for c in coils:
         cut = ds[qname].sel(coil_index=c, wrap_angle=psi, **sel).transpose("quantile",
                                                                            "radius").values
         lim = ds["limit"].sel(coil_index=c, wrap_angle=psi, **sel).values.astype(float)
         drawn = np.isfinite(lim) & (lim != 1)  # where the curve is (not strength-limited)
+        if "validity" in ds:  # no coloured band over a flagged (grey) design
+            drawn &= np.nan_to_num(ds["validity"].sel(coil_index=c, wrap_angle=psi, **sel)
+                                   .values) == 0
         ax.fill_between(x, to_display(var, cut[lo]), to_display(var, cut[hi]), where=drawn,
-                        color=_COLOURS[k % len(_COLOURS)], alpha=0.18, lw=0, zorder=2)
+                        color=_coil_colour(ds, c), alpha=0.18, lw=0, zorder=2)
     ax.text(*note_at, f"bands: {100 * q[lo]:g}-{100 * q[hi]:g} % at "
             f"{_eq('wrap_angle', psi)}", transform=ax.transAxes,
             ha="right" if note_at[0] > 0.5 else "left",

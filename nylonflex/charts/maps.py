@@ -9,9 +9,9 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import label, to_display
-from ._common import (_EXAMPLES, _FLAG_FILL, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq,
-                      _figure, _flag_text, _footer, _grid_value, _nearest,
-                      _pick_few, _suptitle)
+from ._common import (_EXAMPLES, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coils, _eq, _figure,
+                      _flag_patch, _footer, _grey_flagged, _grid_value, _nearest, _pick_few,
+                      _suptitle, _valid_range)
 
 
 # ---------------------------------------------------------------------------- design map
@@ -46,9 +46,9 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     names = ["tip_force_max", "limit", *(["validity"] if "validity" in ds else [])]
     cut = ds[names].sel(length=length, wrap_angle=psi).load()
     bits = 0
-    force = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=coils).values)
-    top = float(np.nanmax(force)) if np.isfinite(force).any() else 1.0
-    levels = _nice_levels(top)
+    # one colour scale for every slice of the cube, set by its valid designs only
+    top = _valid_range(ds, "tip_force_max")[1]
+    levels = _nice_levels(top if np.isfinite(top) and top > 0 else 1.0)
     x = to_display("radius", ds["radius"].values)
     y = to_display("wall_thickness", ds["wall_thickness"].values)
     mappable = None
@@ -58,25 +58,20 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
             continue
         c = coils[i]
         f = to_display("tip_force_max", cut["tip_force_max"].sel(coil_index=c)
-                  .transpose("wall_thickness", "radius").values)
+                       .transpose("wall_thickness", "radius").values)
         lim = cut["limit"].sel(coil_index=c).transpose("wall_thickness", "radius").values
+        # flagged designs (docs/model.md s. 17): no colour of the scale, greyed and hatched
+        f, flags = _grey_flagged(ax, x, y, _panel_validity(cut, c), f)
+        bits |= flags
         mappable = ax.contourf(x, y, f, levels=levels, cmap="viridis", extend="max")
         lines = ax.contour(x, y, f, levels=levels[2::2], colors="white", linewidths=0.6)
         ax.clabel(lines, fmt="%g N", fontsize=7.5)
-        strength = np.where(np.isnan(lim), np.nan, (lim == 1).astype(float))
+        strength = np.where(np.isnan(lim) | np.isnan(f), np.nan, (lim == 1).astype(float))
         if np.nanmax(np.nan_to_num(strength)) > 0:
             with rc_context({"hatch.color": "white", "hatch.linewidth": 0.8}):
                 ax.contourf(x, y, strength, levels=[0.5, 1.5], colors="none",
                             hatches=["///"])
             ax.contour(x, y, strength, levels=[0.5], colors="k", linewidths=1.6)
-        if "validity" in cut:  # flagged designs (docs/model.md s. 17): greyed, hatched
-            v = np.nan_to_num(cut["validity"].sel(coil_index=c)
-                              .transpose("wall_thickness", "radius").values)
-            if (v != 0).any():
-                bits |= int(np.bitwise_or.reduce(v[v != 0].astype(int)))
-                with rc_context({"hatch.color": "k", "hatch.linewidth": 0.6}):
-                    ax.contourf(x, y, (v != 0).astype(float), levels=[0.5, 1.5],
-                                colors=[_FLAG_FILL], hatches=["\\\\"])
         for example in _map_examples(ds, length, psi, c):
             ax.plot(to_display("radius", example[0]),
                     to_display("wall_thickness", example[1]), "*", ms=13, mfc="gold",
@@ -92,19 +87,27 @@ def design_map(ds, *, length=None, wrap_angle=None, coil_index=None):
                      label="strength-limited: nylon breaks first, range of motion cut short"),
                Patch(fc="#2a788e", ec="none", label="stroke-limited: full range of motion")]
     if bits:
-        handles.append(Patch(fc=_FLAG_FILL, ec="k", hatch="\\\\",
-                             label=f"flagged design: {_flag_text(ds, bits)}"))
+        handles.append(_flag_patch(ds, bits))
     if any(_map_examples(ds, length, psi, c) for c in coils):
         from matplotlib.lines import Line2D
 
         handles.append(Line2D([], [], ls="", marker="*", ms=10, mfc="gold", mec="k",
                               label="paper's worked example"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=8)
+    # one column under a single panel: two would run off the figure
+    fig.legend(handles=handles, loc="outside lower center", ncol=1 if ncols == 1 else 2,
+               fontsize=8)
     _suptitle(fig, "Design map: maximum tip force over radius and wall thickness",
               f"slice {_eq('length', length)}, {_eq('wrap_angle', psi)}; "
               "one panel per coil index")
     _footer(fig, ds)
     return fig
+
+
+def _panel_validity(cut, c):
+    """The validity bits of a map panel (coil index ``c``) over (wall, radius), or None."""
+    if "validity" not in cut:
+        return None
+    return cut["validity"].sel(coil_index=c).transpose("wall_thickness", "radius").values
 
 
 def _map_examples(ds, length, psi, coil):
@@ -169,7 +172,9 @@ def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
     nrows = math.ceil(len(coils) / ncols)
     fig, axes = _figure(nrows, ncols, size=(4.4 * ncols + 1.0, 3.6 * nrows + 1.0),
                         sharex=True, sharey=True)
-    cut = ds["feasibility"].sel(length=length, wrap_angle=psi)
+    names = ["feasibility", *(["validity"] if "validity" in ds else [])]
+    cut = ds[names].sel(length=length, wrap_angle=psi).load()
+    bits = 0
     x = to_display("radius", ds["radius"].values)
     y = to_display("wall_thickness", ds["wall_thickness"].values)
     levels = np.linspace(0.0, 1.0, 11)
@@ -179,9 +184,13 @@ def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
             ax.set_visible(False)
             continue
         c = coils[i]
-        p = cut.sel(coil_index=c).transpose("wall_thickness", "radius").values
+        p = cut["feasibility"].sel(coil_index=c).transpose("wall_thickness", "radius").values
+        # a flagged design is never green: greyed and hatched, whatever its probability
+        p, flags = _grey_flagged(ax, x, y, _panel_validity(cut, c), p)
+        bits |= flags
         mappable = ax.contourf(x, y, p, levels=levels, cmap="RdYlGn", vmin=0, vmax=1)
-        if np.nanmax(p) > 0.5 > np.nanmin(p) or np.nanmax(p) > 0.9 > np.nanmin(p):
+        if np.isfinite(p).any() and (np.nanmax(p) > 0.5 > np.nanmin(p)
+                                     or np.nanmax(p) > 0.9 > np.nanmin(p)):
             lines = ax.contour(x, y, p, levels=[0.5, 0.9], colors="k",
                                linewidths=[0.9, 1.6], linestyles=["--", "-"])
             ax.clabel(lines, fmt=lambda v: f"{100 * v:.0f} %", fontsize=7.5)
@@ -193,6 +202,8 @@ def feasibility_map(ds, *, length=None, wrap_angle=None, coil_index=None):
             ax.set_xlabel(label(ds["radius"]))
     fig.colorbar(mappable, ax=axes, label=label(ds["feasibility"]), shrink=0.9,
                  ticks=np.linspace(0, 1, 6))
+    if bits:
+        fig.legend(handles=[_flag_patch(ds, bits)], loc="outside lower center", fontsize=8)
     reqs = ds.attrs.get("requirements", "?")
     samples = ds.attrs.get("uncertainty_samples")
     how = f"{samples} samples" if samples else "nominal designs (no uncertainty)"

@@ -14,7 +14,7 @@ import textwrap
 import numpy as np
 
 from ..variables import VARIABLES, spread_name, to_display
-from ._common import _COLOURS, _eq
+from ._common import _coil_colour, _eq
 
 __all__ = ["example_range", "legend_text", "model_bands", "spread_variants"]
 
@@ -61,7 +61,8 @@ def model_bands(ax, ds, var, sel, coils, wrap_angle, *, scale=1.0, everywhere=Fa
     # the coil indices' bars side by side over half the gap between two bar radii
     gap = float(np.min(np.diff(x[pick]))) if pick.size > 1 else \
         (float(np.ptp(x)) or 1.0) / BARS
-    names = [spread_name(var, "lo"), spread_name(var, "hi"), "limit"]
+    names = [spread_name(var, "lo"), spread_name(var, "hi"), "limit",
+             *(["validity"] if "validity" in ds else [])]
     cut = ds[names].sel(wrap_angle=wrap_angle, **sel).isel(radius=pick).load()
     n = len(coils)
     for k, c in enumerate(coils):
@@ -72,10 +73,12 @@ def model_bands(ax, ds, var, sel, coils, wrap_angle, *, scale=1.0, everywhere=Fa
         keep = np.isfinite(lo) & np.isfinite(hi)
         if not everywhere:
             keep &= np.isfinite(lim) & (lim != 1)
+        if "validity" in one:  # no coloured bar over a flagged (grey) design (issue 46)
+            keep &= np.nan_to_num(one["validity"].values) == 0
         if not keep.any():
             continue
         at = x[pick][keep] + (k - (n - 1) / 2) * (0.5 * gap / max(n, 1))
-        colour = _COLOURS[k % len(_COLOURS)]
+        colour = _coil_colour(ds, c)  # as the curves: fixed per cube, not per slice
         ax.vlines(at, lo[keep], hi[keep], color=colour, lw=1.6, alpha=0.85, zorder=3.5)
         for edge in (lo[keep], hi[keep]):
             ax.plot(at, edge, ls="none", marker="_", ms=7, mew=1.6, color=colour,

@@ -26,8 +26,8 @@ from ..query import COLUMNS
 from ..storage import open_cube
 from ..storage.sweep import run_sweep
 from ..units import InputError
-from .refine import Model, evaluate_rows, meets, refine
-from .resolution import check_fixed, merge_equal, snap
+from .refine import Model, _bounds, evaluate_rows, meets, refine
+from .resolution import check_fixed, lattice_search, merge_equal, same_intervals, snap
 from .search import CUBE_ONLY, GridScan, nondominated, scan_grid
 from .spec import DesignSpec, Objective, load_spec, parse_spec
 
@@ -76,6 +76,13 @@ class DesignResult:
     snapped: dict = field(default_factory=dict)
     #: The model variant the designs were scanned, re-checked and refined under.
     model: str = "paper"
+
+    def reported_rows(self) -> dict:
+        """The designs reported, one row each, as the table, JSON and CSV list them and
+        the chart draws and counts them (one count everywhere): ``{column: array}`` [SI]."""
+        keys = [k for k in (self.designs[0] if self.designs else dict.fromkeys(COLUMNS))
+                if k not in ("source", "alternatives")]
+        return {k: np.array([float(d[k]) for d in self.designs], dtype=float) for k in keys}
 
     @property
     def feasible(self) -> bool:
@@ -224,6 +231,9 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
             improvement = _front_gain(F(grid), F(refined_front), spec)
     if multi or spec.resolution:
         designs, snapped["merged"] = merge_equal(designs, spec.objectives)
+    if spec.resolution and designs:
+        designs = same_intervals(model, spec, designs, _bounds(spec, scan.ranges, scan.fixed),
+                                 scan.fixed)
     return DesignResult(spec, designs, grid, refined_front, scan, model.evaluations,
                         dropped, improvement, snapped, model=model.model)
 
@@ -238,6 +248,20 @@ def _on_resolution(model, spec, scan, grid, new):
     moved = {k: np.concatenate([r[k], g[k][g_moved]]) for k in g}
     info = {"steps": dict(spec.resolution), "lost": g_lost + r_lost,
             "candidates": len(g["radius"]) + len(r["radius"])}
+    # the designs that would be reported, each moved to the best buildable design near it
+    # on the lattice (a rounded continuous optimum can be a step or two off it)
+    both = {k: np.concatenate([keep[k], moved[k]]) for k in g}
+    if len(both["radius"]):
+        signs = np.array([o.sign for o in spec.objectives])
+        F = np.column_stack([both[o.name] for o in spec.objectives]) * signs
+        if len(spec.objectives) > 1:
+            pick = np.flatnonzero(nondominated(F))
+        else:
+            pick = np.argsort(F[:, 0], kind="stable")[:3]
+        found, went = lattice_search(model, spec, {k: v[pick] for k, v in both.items()},
+                                     _bounds(spec, scan.ranges, scan.fixed), scan.fixed)
+        info["lattice_moves"] = int(went.sum())
+        moved = {k: np.concatenate([moved[k], found[k][went]]) for k in g}
     return keep, moved, info
 
 

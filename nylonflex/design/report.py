@@ -33,14 +33,25 @@ def _table_columns(res):
     return cols
 
 
-def _alternatives_text(alt) -> str:
-    """``"wrap_angle 5, 8, 20 deg"``: the values of the merged designs' differing axes."""
+def _alternatives_text(alt, steps=None) -> str:
+    """``"wrap_angle 5-15, 20 deg"``: the values of the axes over which the design is the
+    same; a run of consecutive multiples of the axis's resolution step (``steps``,
+    {axis: SI step}) as ``lo-hi``."""
     parts = []
     for name, values in alt.items():
         unit = VARIABLES[name].display
-        parts.append(f"{name} " + ", ".join(f"{float(to_display(name, v)):.6g}"
-                                            for v in values)
-                     + ("" if unit == "1" else f" {unit}"))
+        shown = [f"{float(to_display(name, v)):.6g}" for v in values]
+        step = (steps or {}).get(name)
+        runs, start = [], 0
+        for i in range(1, len(values) + 1):
+            if i < len(values) and step and \
+                    abs((values[i] - values[i - 1]) / step - 1.0) < 1e-6:
+                continue
+            runs.append(shown[start] if i - 1 == start else
+                        f"{shown[start]}, {shown[i - 1]}" if i - 1 == start + 1 else
+                        f"{shown[start]}-{shown[i - 1]}")
+            start = i
+        parts.append(f"{name} " + ", ".join(runs) + ("" if unit == "1" else f" {unit}"))
     return "; ".join(parts)
 
 
@@ -69,7 +80,7 @@ def summary(res) -> list:
     lines.append(f"grid: {scan.feasible} of {scan.total} designs feasible")
     for name, (g, b, rel) in res.improvement.items():
         if name == "hypervolume":
-            lines.append(f"refined front: {len(res.designs)} designs "
+            lines.append(f"refined front: {len(res.reported_rows()['radius'])} designs "
                          f"({sum(d['source'] == 'refined' for d in res.designs)} refined); "
                          f"it dominates or equals the grid front of "
                          f"{len(res.grid_front['radius'])}; dominated area +{100 * rel:.2f} %")
@@ -95,6 +106,10 @@ def summary(res) -> list:
                      f"exactly ({snapped['candidates']} on-resolution candidates met every "
                      "constraint" + (f"; {snapped['lost']} design(s) had no on-resolution "
                                      "neighbour that does" if snapped["lost"] else "") + ")")
+        if snapped.get("lattice_moves"):
+            lines.append(f"lattice search: {snapped['lattice_moves']} reported design(s) moved "
+                         "to a better buildable design a step or more away (the front "
+                         "re-optimised on the resolution)")
     if snapped.get("merged"):
         lines.append(f"{snapped['merged']} design(s) equal in every objective merged into "
                      "the row listing them under 'alternatives'")
@@ -132,7 +147,7 @@ def format_table(res) -> str:
 
     def cell(h, d):
         if h == "alternatives":
-            return _alternatives_text(d.get("alternatives") or {})
+            return _alternatives_text(d.get("alternatives") or {}, res.spec.resolution)
         return cell_text(h, d[h]) if h in VARIABLES else f"{d[h]:g}"
 
     cells = [[d["source"]] + [cell(h, d) for h in heads[1:]] for d in res.designs]

@@ -22,8 +22,8 @@ from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
 
-__all__ = ["Snapped", "axis_text", "design_config", "design_variables", "display_unit",
-           "flag_meanings", "snap", "stand_in_note", "to_display_any",
+__all__ = ["PAPER_EXAMPLES", "Snapped", "axis_text", "design_config", "design_variables",
+           "display_unit", "first_design", "flag_meanings", "snap", "stand_in_note", "to_display_any",
            "validity_names"]
 
 
@@ -198,3 +198,71 @@ def snap(ds, axis: str, value: float) -> Snapped:
     span = float(np.ptp(grid)) or 1.0
     return Snapped(axis, i, float(grid[i]), float(value),
                    bool(abs(grid[i] - value) <= 1e-9 * span))
+
+
+#: The paper's worked examples (section 4; docs/model.md s. 8), SI, psi = 8 deg; the
+#: second first: the explorer opens on it where the cube holds it.
+PAPER_EXAMPLES = (
+    ("the paper's second worked example", {"radius": 7.5e-3, "wall_thickness": 2e-3,
+                                           "length": 70e-3, "coil_index": 1.7,
+                                           "wrap_angle": float(np.radians(8.0))}),
+    ("the paper's first worked example", {"radius": 20e-3, "wall_thickness": 6e-3,
+                                          "length": 90e-3, "coil_index": 1.1,
+                                          "wrap_angle": float(np.radians(8.0))}))
+
+
+def _valid_at(ds, index) -> bool:
+    """Whether the grid design at ``index`` ({axis: grid index}) has no validity flag (the
+    first model of a cube of several) and a finite ``limit``."""
+    one = ds.isel(model=0) if "model" in ds.dims else ds
+    if "validity" in one:
+        v = float(one["validity"].isel(index).values)
+        if not (np.isfinite(v) and v == 0):
+            return False
+    if "limit" in one:
+        return bool(np.isfinite(float(one["limit"].isel(index).values)))
+    return True
+
+
+def first_design(ds, keep=None) -> tuple[dict, str]:
+    """The design the explorer opens on: ``({axis: grid index}, its name)``.
+
+    The paper's second worked example (then the first) where every one of its values is a
+    grid value of the cube (among the ``keep`` indices, {axis: [grid index]}, a page
+    carries) and it carries no validity flag; else the valid design nearest the second
+    example (by grid steps), named by its values. Never a flagged design, unless every
+    design of the cube is flagged (then the one nearest the example, so named).
+    """
+    keep = keep or {a: list(range(ds.sizes[a])) for a in AXES}
+    for name, at in PAPER_EXAMPLES:
+        snapped = {a: snap(ds, a, at[a]) for a in AXES}
+        index = {a: s.index for a, s in snapped.items()}
+        if all(s.exact for s in snapped.values()) and \
+                all(index[a] in keep[a] for a in AXES) and _valid_at(ds, index):
+            values = ", ".join(f"{_SYMBOL[a]} {axis_text(ds, a, at[a])}" for a in AXES)
+            return index, f"{name} ({values})"
+    target = PAPER_EXAMPLES[0][1]
+    centre = {a: keep[a].index(min(keep[a], key=lambda i: abs(float(ds[a].values[i])
+                                                               - target[a]))) for a in AXES}
+    one = ds.isel(model=0) if "model" in ds.dims else ds
+    kept = one.isel({a: keep[a] for a in AXES})
+    ok = np.ones(tuple(len(keep[a]) for a in AXES), bool)
+    if "validity" in kept:
+        v = kept["validity"].transpose(*AXES).values.astype(float)
+        ok &= np.isfinite(v) & (v == 0)
+    if "limit" in kept:
+        ok &= np.isfinite(kept["limit"].transpose(*AXES).values.astype(float))
+    grids = np.meshgrid(*[np.arange(len(keep[a])) for a in AXES], indexing="ij")
+    dist = sum((g - centre[a]) ** 2 for g, a in zip(grids, AXES)).astype(float)
+    any_ok = ok.any()
+    flat = int(np.argmin(np.where(ok, dist, np.inf))) if any_ok else int(np.argmin(dist))
+    j = np.unravel_index(flat, ok.shape)
+    index = {a: keep[a][int(k)] for a, k in zip(AXES, j)}
+    values = ", ".join(f"{_SYMBOL[a]} {axis_text(ds, a, ds[a].values[index[a]])}"
+                       for a in AXES)
+    what = "a valid design" if any_ok else "a flagged design (every design is flagged)"
+    return index, f"{what}: {values} (the cube does not hold the paper's examples)"
+
+
+_SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
+           "wrap_angle": "\u03c8"}

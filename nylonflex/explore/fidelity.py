@@ -67,7 +67,7 @@ def fidelity_widgets(ds, fid, source: str = "") -> list:
         columns.append(TableColumn(field=name, title=title,
                                    formatter=NumberFormatter(format=fmt, nan_format="-")))
     table = DataTable(source=ColumnDataSource(rows, name="nf-fidelity-rows"), columns=columns,
-                      width=1250, height=240, sortable=True, index_position=None,
+                      sizing_mode="stretch_width", height=240, sortable=True, reorderable=False, index_position=None,
                       name="nf-fidelity-table")
-    return [Div(width=1250, name="nf-fidelity-note", text=fidelity_summary_html(fid, source)),
+    return [Div(sizing_mode="stretch_width", name="nf-fidelity-note", text=fidelity_summary_html(fid, source)),
             table]

@@ -33,9 +33,10 @@ import numpy as np
 
 from ..query import parse_where
 from ..units import InputError
-from ..variables import AXES, label, name_label
-from .data import (design_config, design_variables, display_unit, flag_meanings, snap,
-                   stand_in_note, to_display_any, validity_names)
+from ..variables import AXES, incomplete_text, label, name_label
+from .data import (PAPER_EXAMPLES, design_config, design_variables, display_unit,
+                   first_design, flag_meanings, snap, stand_in_note, to_display_any,
+                   validity_names)
 from .fidelity import fidelity_widgets
 from .model_spread import spread_args
 
@@ -43,9 +44,12 @@ from .model_spread import spread_args
 MAX_DESIGNS = 120_000
 #: The most rows the table of designs matching ``--where`` lists.
 MAX_ROWS = 2000
-#: The default design: the paper's second worked example, at the nearest grid point [SI].
-DEFAULT_DESIGN = {"radius": 15e-3, "wall_thickness": 2e-3, "length": 90e-3,
-                  "coil_index": 1.7, "wrap_angle": math.radians(8.0)}
+#: The design a page prefers to open on [SI]: the paper's second worked example (7.5 mm,
+#: 2 mm, 70 mm, C 1.7, 8 deg); a page opens on it where the cube holds it, valid, else on
+#: the valid design nearest it (:func:`nylonflex.explore.data.first_design`).
+DEFAULT_DESIGN = dict(PAPER_EXAMPLES[0][1])
+#: Flagged designs (``validity`` != 0): grey, as on the charts.
+_FLAG_GREY = "#9e9e9e"
 _COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
             "#000000")
 _SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
@@ -159,6 +163,8 @@ def build_payload(ds, where=()):
                               .astype(float)) if "validity_model_any" in ds else None)
     grid = {a: part[a].values.astype(float) for a in AXES}
     p["grid"] = grid
+    first, p["first_name"] = first_design(ds, keep)
+    p["first"] = {a: keep[a].index(first[a]) for a in AXES}  # index among the kept values
     p["gx"] = {a: [float(v) for v in _f32(to_display_any(ds, a, grid[a]))] for a in AXES}
     p["edges"] = {a: _edges(p["gx"][a]).tolist() for a in AXES}
     p["labels"] = {a: [f"{float(to_display_any(ds, a, v)):.4g}"
@@ -229,8 +235,10 @@ def _header(ds, p, source, served):
                 f"{a}: {s} of {ds.sizes[a]} values" for a, s in zip(AXES, p["sizes"])
                 if s < ds.sizes[a]) + ")")
     flags = flag_meanings(ds)
-    flag_text = (" Cells outlined in orange are flagged: " + ", ".join(
-        m.replace("_", " ") for _, m in flags) + "." if flags else "")
+    flag_text = (" <b>Grey cells hatched / are flagged designs</b> (" + ", ".join(
+        m.replace("_", " ") for _, m in flags) + "; docs/model.md s. 17): they take no "
+        "colour of the scale, and the figure-12 panel draws them as grey dots." if flags
+        else "")
     form = ("Served page (127.0.0.1; everything is drawn in the browser)" if served else
             "Exported page: it works offline")
     text = (f"<h2 style='margin:0'>nylonflex explorer: cube "
@@ -241,7 +249,15 @@ def _header(ds, p, source, served):
             "nothing is interpolated; click the map to pick a design (the nearest grid point)."
             " <b>Hatched (x) cells are strength-limited</b>: the nylon breaks before the "
             f"muscle uses its full stroke, so the range of motion is cut short.{flag_text} "
-            "The colour scale is set by the unflagged designs; flagged ones are faded.</p>")
+            "The colour scale and the panels' ranges are set by the unflagged designs.</p>")
+    first = ",".join(str(p["first"][a]) for a in AXES)
+    text += (f"<p id='nf-opened' data-design='{first}' style='margin:0'>The page opened on "
+             f"<b>{html.escape(p['first_name'])}</b>.</p>")
+    missing = incomplete_text(ds)
+    if missing:
+        text += (f"<p id='nf-incomplete' style='color:#B00020;font-weight:bold;margin:0'>"
+                 f"{html.escape(missing)}: the sweep was interrupted; the missing radii are "
+                 "blank (nylonflex sweep CONFIG --resume finishes it).</p>")
     if stand_in_note(ds):
         text += (f"<p id='nf-stand-in' style='color:#a0522d'>{html.escape(stand_in_note(ds))}"
                  "</p>")
@@ -280,8 +296,8 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     from bokeh.layouts import column, row
     from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter,
                               DataTable, Div, HoverTool, LinearColorMapper, NumberFormatter,
-                              RadioButtonGroup, Select, Slider, Span, TableColumn, TapTool,
-                              Title)
+                              RadioButtonGroup, Range1d, Select, Slider, Span, TableColumn,
+                              TapTool, Title)
     from bokeh.plotting import figure
 
     conditions = _conditions(where)
@@ -292,39 +308,41 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
 
     # ---- widgets: the page's whole state
     default_var = variables.index("tip_force_max") if "tip_force_max" in variables else 0
-    variable = Select(title="variable (map, lines and read-out)", width=300,
+    variable = Select(title="variable (map, lines and read-out)", width=280,
                       options=[(str(i), label(ds[n])) for i, n in enumerate(variables)],
                       value=str(default_var), name="nf-variable")
     model = RadioButtonGroup(labels=models, active=0, name="nf-model") if models else None
     axis_options = [(a, label(ds[a])) for a in AXES]
-    map_x = Select(title="map across", options=axis_options, value="radius", width=145,
+    map_x = Select(title="map across", options=axis_options, value="radius", width=135,
                    name="nf-map-x")
-    map_y = Select(title="map up", options=axis_options, value="wall_thickness", width=145,
+    map_y = Select(title="map up", options=axis_options, value="wall_thickness", width=135,
                    name="nf-map-y")
     sliders = {}
     for j, a in enumerate(AXES):
-        start = int(np.argmin(np.abs(p["grid"][a] - DEFAULT_DESIGN[a])))
+        start = p["first"][a]
         fmt = CustomJSTickFormatter(args={"labels": p["labels"][a]},
                                     code="return labels[Math.round(tick)] || '';")
         sliders[a] = Slider(start=0, end=max(1, sizes[j] - 1), step=1, value=start,
-                            title=label(ds[a]).split(" [")[0], format=fmt, width=300,
+                            title=label(ds[a]).split(" [")[0], format=fmt, width=280,
                             disabled=sizes[j] < 2, name=f"nf-slider-{a}",
                             css_classes=[f"nf-slider-{a}"])
     # ---- the map (its cells are laid out by update.js for the chosen axes)
-    map_src = ColumnDataSource({k: [] for k in ("left", "right", "bottom", "top", "z", "h",
-                                                "lc", "fa", "vf", "xv", "yv")},
+    map_src = ColumnDataSource({k: [] for k in ("left", "right", "bottom", "top", "z", "zc",
+                                                "h", "hc", "vf", "xv", "yv")},
                                name="nf-map")
-    mapper = LinearColorMapper(palette="Viridis256", low=0, high=1)
-    map_fig = figure(width=540, height=400, tools="tap,reset,save", name="nf-map-figure",
+    # flagged cells: zc is NaN there, so they take the mapper's grey, never a scale colour
+    mapper = LinearColorMapper(palette="Viridis256", low=0, high=1, nan_color=_FLAG_GREY)
+    map_fig = figure(height=400, min_width=380, sizing_mode="stretch_width",
+                     tools="tap,reset,save", name="nf-map-figure",
                      x_axis_label=label(ds["radius"]), y_axis_label=label(ds["wall_thickness"]),
                      x_range=(p["edges"]["radius"][0], p["edges"]["radius"][-1]),
                      y_range=(p["edges"]["wall_thickness"][0],
                               p["edges"]["wall_thickness"][-1]))
     cells = map_fig.quad(source=map_src, left="left", right="right", bottom="bottom",
-                         top="top", fill_color={"field": "z", "transform": mapper},
-                         fill_alpha="fa", line_color="lc", line_width=2, hatch_pattern="h",
-                         hatch_color="white", hatch_alpha=0.8, hatch_scale=8,
-                         nonselection_fill_alpha="fa", selection_fill_alpha="fa")
+                         top="top", fill_color={"field": "zc", "transform": mapper},
+                         line_color=None, hatch_pattern="h", hatch_color="hc",
+                         hatch_alpha=0.8, hatch_scale=8, nonselection_fill_alpha=1.0,
+                         selection_fill_alpha=1.0)
     hover = HoverTool(renderers=[cells], tooltips=[(label(ds[variables[default_var]]),
                                                     "@z{0.000}")])
     map_fig.add_tools(hover)
@@ -341,8 +359,12 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                     line_color="black")
     map_fig.select_one(TapTool).mode = "replace"
     # ---- figure 12 style lines
-    lines_fig = figure(width=520, height=400, x_axis_label=label(ds["radius"]),
-                       tools="pan,box_zoom,reset,save")
+    # explicit ranges, set by update.js from the valid designs (an auto range would take
+    # in the flagged ones, and starts empty: "could not set initial ranges")
+    lines_fig = figure(height=400, min_width=380, sizing_mode="stretch_width",
+                       x_axis_label=label(ds["radius"]), tools="pan,box_zoom,reset,save",
+                       x_range=Range1d(p["gx"]["radius"][0], p["gx"]["radius"][-1]),
+                       y_range=Range1d(0, 1), name="nf-lines-figure")
     line_srcs, solid_srcs = [], []
     for k, c in enumerate(p["gx"]["coil_index"]):
         colour = _COLOURS[k % len(_COLOURS)]
@@ -351,6 +373,10 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         lines_fig.line("x", "y", source=line_srcs[-1], color=colour, line_dash="dashed",
                        legend_label=f"C = {c:.3g}")
         lines_fig.line("x", "y", source=solid_srcs[-1], color=colour, line_width=3)
+    flag_pts = ColumnDataSource({"x": [], "y": []}, name="nf-lines-flagged")
+    if p["validity"] is not None:
+        lines_fig.scatter("x", "y", source=flag_pts, size=7, color=_FLAG_GREY, alpha=0.8,
+                          legend_label="flagged design (grey)")
     lines_fig.legend.location = "top_left"
     lines_fig.add_layout(Title(text="solid: full range of motion; dashed: strength-limited",
                                text_font_style="italic", text_font_size="11px"), "above")
@@ -358,22 +384,26 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     titles = {"nylon_force": "nylon force vs stroke (dashed: its limit)",
               "bend_angle": "bend angle against chamber pressure",
               "tip_force": "tip force against chamber pressure"}
-    curve_figs, curve_srcs = [], {}
+    curve_figs, curve_srcs, curve_by_name = [], {}, {}
     for k, (name, (axis, _)) in enumerate(_CURVES.items()):
         if name not in p["curves"]:
             continue
-        f = figure(width=400, height=280, title=titles[name], x_axis_label=label(ds[axis]),
-                   y_axis_label=label(ds[name]), tools="pan,box_zoom,reset,save")
+        xs = p["curves"][name]["x"]
+        f = figure(height=280, min_width=300, sizing_mode="stretch_width", title=titles[name],
+                   x_axis_label=label(ds[axis]), y_axis_label=label(ds[name]),
+                   tools="pan,box_zoom,reset,save", x_range=Range1d(min(xs), max(xs)),
+                   y_range=Range1d(0, 1))
         src = ColumnDataSource({"x": [], "y": [], "design": []}, name=f"nf-curve-{name}")
         f.line("x", "y", source=src, color=_COLOURS[k], line_width=2)
         curve_figs.append(f)
         curve_srcs[name] = src
+        curve_by_name[name] = f
     flim_span = None
     if p["flim"] is not None and "nylon_force" in curve_srcs:
         flim_span = Span(location=0, dimension="width", line_dash="dashed", line_color="black")
         curve_figs[0].add_layout(flim_span)
-    readout = Div(width=640, name="nf-readout")
-    table = Div(width=420)
+    readout = Div(sizing_mode="stretch_width", name="nf-readout")
+    table = Div(min_width=300, sizing_mode="stretch_width")
     note = Div(text="", visible=False)
     hold = Div(text="", visible=False)
 
@@ -390,6 +420,7 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                 alabels={a: label(ds[a]) for a in AXES}, map_fig=map_fig,
                 map_xaxis=map_fig.xaxis[0], map_yaxis=map_fig.yaxis[0], lines_fig=lines_fig,
                 lines_yaxis=lines_fig.yaxis[0], line_srcs=line_srcs, solid_srcs=solid_srcs,
+                flag_pts=flag_pts, curve_figs=curve_by_name,
                 curves=p["curves"], curve_srcs=curve_srcs, flim=p["flim"],
                 flim_span=flim_span, readout=readout, table=table, note=note, hold=hold,
                 vnames=variables, vlabels=[label(ds[n]) for n in variables],
@@ -418,13 +449,17 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
             title = label(ds[n]) if n in ds.variables else name_label(n)
             fmt = {} if n in ("model", "validity") else \
                 {"formatter": NumberFormatter(format="0.[000]")}
-            columns.append(TableColumn(field=n, title=title, **fmt))
-        where_table = DataTable(source=rows_src, columns=columns, width=1250, height=260,
-                                sortable=True, index_position=None, name="nf-where-table")
+            # wide enough for its whole title (the table scrolls sideways, not the page)
+            columns.append(TableColumn(field=n, title=title, width=_title_width(title),
+                                       **fmt))
+        where_table = DataTable(source=rows_src, columns=columns, sizing_mode="stretch_width",
+                                height=260, autosize_mode="none", sortable=True,
+                                reorderable=False,
+                                index_position=None, name="nf-where-table")
         rows_src.selected.js_on_change("indices", CustomJS(args={**pick_args, "rows": rows_src},
                                                            code=_script("pick.js")))
         listed = min(rows["matching"], MAX_ROWS)
-        where_box = [Div(width=1250, name="nf-where-note", text=(
+        where_box = [Div(sizing_mode="stretch_width", name="nf-where-note", text=(
             f"<b>{rows['matching']:,} designs of this page meet --where "
             f"{html.escape(' and '.join(p['where']))}</b>"
             + (f" (the first {listed:,} in grid order listed; sorting sorts those)"
@@ -437,16 +472,31 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
         fidelity_box = fidelity_widgets(ds, fidelity[0], fidelity[1])
     controls = [variable] + ([Div(text="model variant"), model] if model else []) + \
         [row(map_x, map_y)] + list(sliders.values())
-    layout = column(Div(width=1250, text=_header(ds, p, source, served)),
-                    row(column(*controls, width=320),
-                        column(readout, row(map_fig, lines_fig))),
+    flag_key = Div(sizing_mode="stretch_width", name="nf-map-key", text=(
+        "<span style='font-size:12px'><span style='display:inline-block;width:14px;"
+        f"height:10px;background:{_FLAG_GREY};border:1px solid #555'></span> grey, hatched "
+        "/: flagged design (" + ", ".join(m.replace("_", " ") for _, m in
+                                          flag_meanings(ds)) + "), not on the colour scale"
+        "; x: strength-limited</span>") if p["validity"] is not None else "")
+    # fits a 1,280 px window: the controls keep 300 px, the rest stretches (issue 46)
+    layout = column(Div(sizing_mode="stretch_width", text=_header(ds, p, source, served)),
+                    row(column(*controls, width=300),
+                        column(readout, row(map_fig, lines_fig, sizing_mode="stretch_width"),
+                               flag_key, sizing_mode="stretch_width"),
+                        sizing_mode="stretch_width"),
                     *where_box,
-                    row(table, *curve_figs), note, hold, *fidelity_box)
+                    row(*curve_figs, sizing_mode="stretch_width"),
+                    table, note, hold, *fidelity_box, sizing_mode="stretch_width")
     doc = Document() if doc is None else doc
     doc.add_root(layout)
     doc.title = f"nylonflex explorer: {ds.attrs.get('name', '')}"
     doc.js_on_event("document_ready", update)
     return doc
+
+
+def _title_width(title) -> int:
+    """A table column wide enough for its title [px] (about 7 px a character)."""
+    return max(70, 7 * len(title) + 24)
 
 
 def build_html(ds, *, source: str = "", where=(), fidelity=None) -> str:

@@ -30,7 +30,7 @@ const held = (ks) => ks.map(k => names[k] + " = " + labels[k][st.ix[k]]).join(",
 
 // ---- the map: st.v over axes st.x (across) and st.y (up), the others held
 const X = st.x, Y = st.y, nx = N[AXES.indexOf(X)], ny = N[AXES.indexOf(Y)];
-const cols = {left: [], right: [], bottom: [], top: [], z: [], h: [], lc: [], fa: [], vf: [],
+const cols = {left: [], right: [], bottom: [], top: [], z: [], zc: [], h: [], hc: [], vf: [],
               xv: [], yv: []};
 const mx = [], my = [];
 let lo = Infinity, hi = -Infinity, alo = Infinity, ahi = -Infinity;
@@ -44,13 +44,14 @@ if (X != Y) {
     cols.bottom.push(edges[Y][b]); cols.top.push(edges[Y][b + 1]);
     cols.xv.push(gx[X][a]); cols.yv.push(gx[Y][b]);
     cols.z.push(z);
+    // a flagged design takes no colour of the scale: NaN is the mapper's grey
+    cols.zc.push(bad ? NaN : z);
     if (isFinite(z)) {
       alo = Math.min(alo, z); ahi = Math.max(ahi, z);
       if (!bad) { lo = Math.min(lo, z); hi = Math.max(hi, z); }
     }
-    cols.h.push(limit && limit[i] == 1 ? "x" : " ");
-    cols.lc.push(bad ? "#D55E00" : null);
-    cols.fa.push(bad ? 0.35 : 1.0);
+    cols.h.push(bad ? "/" : limit && limit[i] == 1 ? "x" : " ");
+    cols.hc.push(bad ? "#333333" : "white");
     cols.vf.push(flagtext(validity ? validity[i] : 0));
     if (match && match[i]) { mx.push(gx[X][a]); my.push(gx[Y][b]); }
   }
@@ -79,6 +80,8 @@ if (X != Y) {
 
 // ---- figure 12 style lines: st.v against radius, one line per coil index
 const R = AXES.indexOf("radius"), C = AXES.indexOf("coil_index");
+const fx = [], fy = [];
+let ltop = -Infinity, lbot = Infinity, above = 0;
 for (let c = 0; c < N[C]; c++) {
   const all = [], solid = [];
   const ix = Object.assign({}, st.ix);
@@ -86,13 +89,27 @@ for (let c = 0; c < N[C]; c++) {
   for (let r = 0; r < N[R]; r++) {
     ix.radius = r;
     const i = flat(ix);
-    all.push(arr[i]); solid.push(limit && limit[i] == 1 ? NaN : arr[i]);
+    // a flagged design is no point of its coil's line: a grey dot
+    const bad = validity && validity[i] != 0;
+    all.push(bad ? NaN : arr[i]);
+    solid.push(bad || (limit && limit[i] == 1) ? NaN : arr[i]);
+    if (bad && isFinite(arr[i])) { fx.push(gx.radius[r]); fy.push(arr[i]); }
+    else if (isFinite(arr[i])) { ltop = Math.max(ltop, arr[i]); lbot = Math.min(lbot, arr[i]); }
   }
   line_srcs[c].data = {x: gx.radius, y: all};
   solid_srcs[c].data = {x: gx.radius, y: solid};
 }
+flag_pts.data = {x: fx, y: fy};
+// the y range: the valid designs drawn (flagged ones beyond it are clipped, and counted)
+if (!isFinite(ltop)) { ltop = 1; lbot = 0; }
+const lpad = 0.06 * Math.max(ltop - Math.min(lbot, 0), 1e-12);
+lines_fig.y_range.start = Math.min(lbot, 0) - (lbot < 0 ? lpad : 0);
+lines_fig.y_range.end = ltop + lpad;
+for (const y of fy) if (y > lines_fig.y_range.end) above++;
+lines_fig.x_range.start = gx.radius[0]; lines_fig.x_range.end = gx.radius[N[R] - 1];
 lines_fig.title.text = "Figure 12 style at " +
-  held(["wall_thickness", "length", "wrap_angle"]) + mname;
+  held(["wall_thickness", "length", "wrap_angle"]) + mname +
+  (above ? " (" + above + " flagged above the range)" : "");
 lines_yaxis.axis_label = vlabels[st.v];
 
 // ---- the curves of the selected design; each source names the design it shows
@@ -105,6 +122,12 @@ for (const name in curve_srcs) {
   const y = [];
   for (let p = 0; p < P; p++) y.push(c.values[i * P + p]);
   curve_srcs[name].data = {x: c.x, y: y, design: y.map(() => design)};
+  // explicit ranges (set here, from the curve drawn)
+  let top = -Infinity, bot = 0;
+  for (const v of y) if (isFinite(v)) { top = Math.max(top, v); bot = Math.min(bot, v); }
+  if (name == "nylon_force" && flim_span) top = Math.max(top, flim[st.ix.coil_index]);
+  if (!isFinite(top) || !(top > bot)) top = bot + 1;
+  curve_figs[name].y_range.start = bot; curve_figs[name].y_range.end = top + 0.05 * (top - bot);
 }
 if (flim_span) flim_span.location = flim[st.ix.coil_index];
 
