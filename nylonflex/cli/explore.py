@@ -41,7 +41,7 @@ def add_arguments(p):
                         "'cooling' coordinate; nylonflex info lists them)")
 
 
-_NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explore]'"
+_NEEDS_EXTRA = "nylonflex explore: error: {what}: pip install 'nylonflex[explore]'"
 
 
 def _has(module: str) -> bool:
@@ -84,7 +84,7 @@ def run(args) -> int:
     ds, source = _one_cooling(ds, args.cooling, str(args.cube))
     if not _has("bokeh"):
         print(_NEEDS_EXTRA.format(what="the explorer needs Bokeh"), file=sys.stderr)
-        return 1
+        return 2  # the environment's: exit 2, one line (cli.environment_problem)
     from ..explore.page import build_html, serve
 
     fidelity = _fidelity(args.cube)
