@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import errno as errnos
 import importlib
 import os
 import signal
@@ -291,8 +292,6 @@ def environment_problem(exc, args=None) -> str | None:
     dependency not installed (its extra named, :data:`EXTRAS`), a cube whose chunk does not
     decode (the chunk named, by :func:`nylonflex.storage.check_cube`).
     """
-    import errno as errnos
-
     if type(exc).__name__ in ("MissingPlugin", "MissingExtra"):
         return one_line(exc)
     if isinstance(exc, ImportError):
