@@ -17,7 +17,9 @@ def add_arguments(s):
     s.add_argument("config", help="YAML config ('nylonflex init' writes examples to edit)")
     s.add_argument("--out", help="cube path (default sweeps/<name>/cube.h5)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a config key, e.g. grid.radius.num=81 (repeatable)")
+                   help="override a config key, e.g. grid.radius.num=81 or "
+                        "silicone.file=fits/my.yaml (repeatable; a file path is read from "
+                        "the current folder, one in the config from the config's folder)")
     s.add_argument("--resume", action="store_true", help="finish an interrupted run")
     s.add_argument("--overwrite", action="store_true",
                    help="replace a cube already at --out (the old one stays until the new "
