@@ -83,3 +83,17 @@ def test_progress_off_a_terminal_is_a_line_with_the_count_and_time(capsys):
         bar(1, 2)
         time.sleep(0.1)
     assert capsys.readouterr().err == ""  # --quiet: nothing
+
+
+def test_the_control_chart_says_amplitude_not_span():
+    # rms_error_fraction is of the reference's size: a sine's amplitude (config.simulate)
+    from nylonflex.charts.sim import figure9
+    from nylonflex.config.simulate import parse_sim_config
+    from nylonflex.sim import run_simulation
+
+    raw = {"name": "t", "time": {"duration": "20 s", "step": "10 ms"},
+           "reference": {"kind": "sine", "mean": "60 deg", "amplitude": "20 deg",
+                         "frequency": "0.04 Hz"}}
+    ds = run_simulation(parse_sim_config(raw))
+    title = figure9(ds).axes[0].get_title()
+    assert "% of the 20 deg amplitude)" in title and "span" not in title
