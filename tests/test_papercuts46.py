@@ -77,7 +77,7 @@ def test_progress_off_a_terminal_is_a_line_with_the_count_and_time(capsys):
             if "3 of 8" in err:
                 break
             time.sleep(0.05)
-    assert re.search(r"^nylonflex verify: verify: 3 of 8 designs \(38 %\), \d+ s elapsed, "
+    assert re.search(r"^nylonflex verify: 3 of 8 designs \(38 %\), \d+ s elapsed, "
                      r"about \d+ s left$", err, re.M), err
     with progress_bar("sweep", quiet=True, every=0.01) as bar:
         bar(1, 2)

@@ -292,7 +292,7 @@ def environment_problem(exc, args=None) -> str | None:
     dependency not installed (its extra named, :data:`EXTRAS`), a cube whose chunk does not
     decode (the chunk named, by :func:`nylonflex.storage.check_cube`).
     """
-    if type(exc).__name__ in ("MissingPlugin", "MissingExtra"):
+    if type(exc).__name__ in ("MissingPlugin", "DiskFull"):
         return one_line(exc)
     if isinstance(exc, ImportError):
         top = (getattr(exc, "name", None) or "").split(".")[0]

@@ -89,14 +89,15 @@ class progress_bar:
         """The progress as one line: ``nylonflex verify: 3 of 8 designs (38 %), 12 min
         elapsed, about 20 min left``."""
         elapsed = time.monotonic() - self._start
-        head = f"nylonflex {self.command}: {self.desc}"
+        head = f"nylonflex {self.command}" + (f": {self.desc}" if self.desc != self.command
+                                               else "")
         if not self.total:
             return f"{head}: running, {_duration(elapsed)} elapsed"
         part = self.done / self.total
         left = (f", about {_duration(elapsed * (1 - part) / part)} left"
                 if 0 < part < 1 else "")
-        return (f"{head}: {self.done:,} of {self.total:,} {self.unit}s ({100 * part:.0f} %), "
-                f"{_duration(elapsed)} elapsed{left}")
+        return (f"{head}: {_count(self.done)} of {_count(self.total)} {self.unit}s "
+                f"({100 * part:.0f} %), {_duration(elapsed)} elapsed{left}")
 
     def _tick(self):
         """The timer: a line every ``every`` seconds off a terminal; on a terminal, the
@@ -117,6 +118,11 @@ class progress_bar:
             self._bar.close()
             self._bar = None
         return False
+
+
+def _count(x) -> str:
+    """A count as read: ``1,234``; a fraction of one (an FE solve's progress) ``0.81``."""
+    return f"{int(x):,}" if float(x).is_integer() else f"{x:,.2f}"
 
 
 def _duration(seconds: float) -> str:
