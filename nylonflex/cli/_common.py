@@ -4,6 +4,7 @@ one progress report of every long command (a bar on a terminal, a line a minute 
 from __future__ import annotations
 
 import sys
+import threading
 import time
 import warnings
 
@@ -52,8 +53,6 @@ class progress_bar:
         self._stop = None
 
     def __enter__(self):
-        import threading
-
         self._start = time.monotonic()
         if not self.quiet:
             self._stop = threading.Event()
