@@ -78,8 +78,8 @@ def test_list_speaks_json(capsys, topic):
     elif topic == "materials":
         assert data["silicone"]["tc5005"]["fields"]["mu"]["units"] == "Pa"
     elif topic == "variables":
-        table = next(t for title, t in data.items() if title.startswith("design"))
-        assert table["tip_force_max"]["units"] == "N"
+        assert data["design"]["tip_force_max"]["units"] == "N"
+        assert data["tracking"]["tracking_rms_error"]["display"] == "deg"
 
 
 def test_info_speaks_json_in_si(tmp_path, capsys):

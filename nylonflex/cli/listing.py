@@ -141,25 +141,27 @@ def _charts(out):
 
 
 def _variable_tables():
+    """(JSON key, heading, registry table) of each group of variables."""
     from ..variables import COORDS, CURVES, DESIGN, INPUTS, TRACKING, UNCERTAIN
 
-    return (("axes and curve coordinates", COORDS),
-            ("design variables (query --where/--sort)", DESIGN),
-            ("curves", CURVES),
-            ("with uncertainty or requirements: (docs/uncertainty.md)",
+    return (("axes", "axes and curve coordinates", COORDS),
+            ("design", "design variables (query --where/--sort)", DESIGN),
+            ("curves", "curves", CURVES),
+            ("uncertainty", "with uncertainty or requirements: (docs/uncertainty.md)",
              {k: v for k, v in UNCERTAIN.items() if k == "feasibility"}),
-            ("with tracking: (docs/model.md s. 19; query --where/--sort)", TRACKING),
-            ("other inputs", INPUTS))
+            ("tracking", "with tracking: (docs/model.md s. 19; query --where/--sort)",
+             TRACKING),
+            ("inputs", "other inputs", INPUTS))
 
 
 def _variables_data():
-    return {title: {v.name: {"units": v.units, "display": v.display, "long_name": v.long_name,
-                             "description": v.description, "dims": list(v.dims)}
-                    for v in table.values()} for title, table in _variable_tables()}
+    return {key: {v.name: {"units": v.units, "display": v.display, "long_name": v.long_name,
+                           "description": v.description, "dims": list(v.dims)}
+                  for v in table.values()} for key, _, table in _variable_tables()}
 
 
 def _variables(out):
-    for title, table in _variable_tables():
+    for key, title, table in _variable_tables():
         print(f"{title}:", file=out)
         for v in table.values():
             units = f"[{v.units}]" + (f", shown in {v.display}" if v.display != v.units
@@ -167,7 +169,7 @@ def _variables(out):
             print(f"  {v.name:<24} {units:<22} {v.long_name}: {v.description}", file=out)
             if v.dims and tuple(v.dims) != (v.name,):
                 print(f"  {'':<24} {'':<22} over ({', '.join(v.dims)})", file=out)
-        if title.startswith("with uncertainty"):
+        if key == "uncertainty":
             print(f"  {'<variable>_quantile':<24} {'':<22} quantiles of each float design "
                   "variable, over (..., quantile)", file=out)
         print(file=out)
@@ -181,9 +183,7 @@ _DATA = {"materials": _materials_data, "models": _models_data, "charts": _charts
 
 def run(args) -> int:
     if args.format == "json":
-        data = {t: _DATA[t]() for t in ([args.topic] if args.topic else [])} \
-            if args.topic else {"topics": TOPICS}
-        sys.stdout.write(json_text(data[args.topic] if args.topic else data))
+        sys.stdout.write(json_text(_DATA[args.topic]() if args.topic else {"topics": TOPICS}))
         return 0
     if args.topic is None:
         print("nylonflex list TOPIC (--format json for a script):")
