@@ -3,6 +3,7 @@ the write, a missing extra, a damaged chunk named), and a closed output pipe (``
 list | head -1``) ends every command quietly with 0 (one mechanism, cli/__init__.py)."""
 
 import errno
+import os
 import subprocess
 import sys
 
@@ -42,8 +43,9 @@ def cube(tmp_path_factory):
                                          (errno.ENOSPC, "no space left on the device")])
 def test_a_folder_that_refuses_the_write_is_the_environment(code, words):
     exc = OSError(code, "x", "ro/cube.h5")
-    assert environment_problem(exc) == (f"cannot write ro/cube.h5: {words}; write somewhere "
-                                        "else (--out) or free the folder")
+    todo = "free some space there, or write somewhere else (--out)" \
+        if code == errno.ENOSPC else "write somewhere else (--out)"
+    assert environment_problem(exc) == f"cannot write ro/cube.h5: {words}; {todo}"
     assert environment_problem(OSError(errno.EIO, "x")) is None  # a real failure stays 1
     assert environment_problem(RuntimeError("bug")) is None
 
@@ -61,7 +63,28 @@ def test_a_sweep_into_a_read_only_folder_exits_2_with_one_line(tmp_path, capsys,
     rc, out, err = run(capsys, "sweep", cfg, "--out", tmp_path / "ro" / "c.h5", "--quiet")
     assert rc == 2 and len(err.strip().splitlines()) == 1
     assert err.strip() == (f"nylonflex sweep: error: cannot write {tmp_path}/ro/c.h5: "
-                           "permission denied; write somewhere else (--out) or free the folder")
+                           "permission denied; write somewhere else (--out)")
+
+
+def test_a_sweep_into_a_read_only_file_system_exits_2_with_one_line(tmp_path):
+    # a read-only tmpfs in a user namespace, where the platform allows it (root or not)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    probe = subprocess.run(["unshare", "-rm", "sh", "-c",
+                            f"mount -t tmpfs -o size=1m,ro tmpfs {ro} && echo ok"],
+                           capture_output=True, text=True)
+    if probe.stdout.strip() != "ok":
+        pytest.skip("no unprivileged read-only mount here")
+    cfg = write_config(tmp_path, TINY)
+    script = (f"mount -t tmpfs -o size=1m,ro tmpfs {ro} && {sys.executable} -m nylonflex "
+              f"sweep {cfg} --out {ro}/sub/cube.h5 --quiet --no-charts")
+    proc = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True,
+                          text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip().splitlines()[-1] == (
+        f"nylonflex sweep: error: cannot write {ro}/sub: a read-only file system; write "
+        "somewhere else (--out)")
 
 
 def test_a_missing_extra_names_what_to_install(tmp_path, capsys, monkeypatch):

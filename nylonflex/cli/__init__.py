@@ -305,8 +305,11 @@ def environment_problem(exc, args=None) -> str | None:
     code = errnos.errorcode.get(exc.errno or -1, "")
     if code in _ENV_ERRNOS:
         where = exc.filename or getattr(args, "out", None) or "the output"
-        return (f"cannot write {where}: {_ENV_ERRNOS[code]}; write somewhere else (--out) "
-                "or free the folder")
+        if os.path.basename(str(where)).startswith("."):  # a temporary beside the file
+            where = os.path.dirname(str(where)) or "."
+        todo = "free some space there, or write somewhere else (--out)" \
+            if code in ("ENOSPC", "EDQUOT") else "write somewhere else (--out)"
+        return f"cannot write {where}: {_ENV_ERRNOS[code]}; {todo}"
     if any(w in str(exc).lower() for w in _DAMAGED):
         return _damaged_chunk(getattr(args, "cube", None), exc)
     return None
