@@ -55,7 +55,8 @@ def unit_notes(ds, conditions, matched) -> list[str]:
         ``--where "radius <= 0.01": the bare 0.01 is read in mm (0.01 mm); the cube's
         radius spans 5 .. 25 mm; write '0.01m' for metres`` for each condition whose value
         was typed without a unit in a display unit other than SI, when nothing matched or
-        the value lies outside the cube's range.
+        the value lies outside the cube's range (checked for a design variable, whose range
+        costs a read of it, when none or every design matched).
     """
     notes = []
     for c in conditions:
@@ -66,6 +67,9 @@ def unit_notes(ds, conditions, matched) -> list[str]:
         v = VARIABLES[c.name]
         if typed is None or v.display == v.units or c.name not in ds:
             continue
+        every = int(np.prod([ds.sizes[d] for d in ds[c.name].dims]))
+        if c.name not in AXES and 0 < matched < every:
+            continue  # a design variable's range costs a read: only for none or all matched
         lo, hi = variable_range(ds, c.name)
         outside = np.isfinite(lo) and not lo <= c.value <= hi
         if not (matched == 0 or outside):
