@@ -20,9 +20,10 @@ import numpy as np
 
 from .units import from_si
 
-__all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SUPPLY_ONLY",
-           "THERMAL", "TRACKING", "UNCERTAIN", "VARIABLES", "Variable", "label", "name_label",
-           "quantile_name", "range_text", "slab_done_attrs", "to_display", "validate"]
+__all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS", "SPREAD",
+           "SPREAD_OF", "SUPPLY_ONLY", "THERMAL", "TRACKING", "UNCERTAIN", "VARIABLES",
+           "Variable", "label", "name_label", "quantile_name", "range_text",
+           "slab_done_attrs", "spread_name", "to_display", "validate"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
 #: s. 16); ``paper`` is the default. What each adds, where it holds and when to use it:
@@ -120,6 +121,7 @@ _FLAGS = {"limit": ((0, 1, 2, 3),
 _MASKS = {"validity": ((1, 2, 4, 8, 16),
                        "self_contact stretch_beyond_fit under_one_turn chamber_closes "
                        "efficiency_beyond_bound")}
+_MASKS["validity_model_any"] = _MASKS["validity"]  # the same bits, OR over a model spread
 
 #: Variables that are in a cube only when its config gives a supply.
 SUPPLY_ONLY = ("heating_time", "cycle_time", "cycle_rate", "heating_energy", "mechanical_work",
@@ -299,6 +301,40 @@ TRACKING = {v.name: v for v in [
        "s. 19)", "Hz", "frequency"),
 ]}
 
+#: The headline design variables whose range over model variants a sweep with
+#: ``fidelity: spread`` stores (docs/model.md s. 22): the torque of figure 12(b), the tip
+#: force, the bend angle and the range of motion of figure 12(c).
+SPREAD_OF = ("torque_max", "tip_force_max", "bend_angle_max", "range_fraction")
+
+
+def spread_name(name: str, side: str) -> str:
+    """``tip_force_max_model_lo``: the cube variable of the lowest (``side`` "lo") or
+    highest ("hi") value of a design variable over a sweep's model spread."""
+    if side not in ("lo", "hi"):
+        raise ValueError(f"side: must be 'lo' or 'hi', got {side!r}")
+    return f"{name}_model_{side}"
+
+
+def _spread_variable(v: Variable, side: str) -> Variable:
+    word = "lowest" if side == "lo" else "highest"
+    return Variable(spread_name(v.name, side), AXES, v.units, f"{v.long_name}, {word} model",
+                    f"the {word} {v.name} over the model variants of fidelity.spread (the "
+                    "cube attribute model_spread), flagged designs included (docs/model.md "
+                    f"s. 22); {v.description}", v.display, v.kind, by_model=True)
+
+
+#: Variables of a sweep with ``fidelity: spread`` (docs/model.md s. 22): the range of each
+#: of :data:`SPREAD_OF` over the named model variants, and the OR of their validity bits;
+#: the cube holds them only then. Never a ``model`` dimension of their own (they summarise
+#: it); ``by_model`` lets them follow their variable onto a ``cooling`` dimension.
+SPREAD = {v.name: v for v in [
+    *(_spread_variable(DESIGN[n], side) for n in SPREAD_OF for side in ("lo", "hi")),
+    _m("validity_model_any", AXES, "1", "validity flags of any model",
+       "validity bits set by at least one model variant of fidelity.spread (the OR of "
+       "their validity); 0 where every variant's design is clean (docs/model.md s. 17, 22)",
+       "1", "dimensionless", "int8"),
+]}
+
 #: The string coordinate of a cube of several model variants (docs/model.md s. 16).
 MODEL = _v("model", ["model"], "1", "model variant", "the model variant of each slice "
            "(docs/model.md s. 16)", "1", "dimensionless", "str")
@@ -312,7 +348,7 @@ COOLING = _v("cooling", ["cooling"], "1", "cooling environment", "the cooling se
 SLAB_DONE = _v("slab_done", ["radius"], "1", "radius computed",
                "1 where this radius's slab is in the cube", "1", "dimensionless", "int8")
 
-VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN, **TRACKING}
+VARIABLES = {**COORDS, **DESIGN, **CURVES, **UNCERTAIN, **TRACKING, **SPREAD}
 
 
 def is_complete(attrs) -> bool:

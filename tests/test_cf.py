@@ -26,6 +26,9 @@ KINDS = {
     "plain": {},
     "models_supply": {"model": ["paper", "coupled_muscle"], "supply": {"voltage": 12}},
     "coolings": {"cooling": ["still_air", "still_water"], "supply": {"voltage": 12}},
+    # a model spread over a cooling list: the range on its variables' cooling dimension
+    "spread": {"fidelity": {"spread": ["paper", "incompressible_wall"]},
+               "cooling": ["still_air", "still_water"], "supply": {"voltage": 12}},
     "uncertain": {"uncertainty": {"samples": 8, "seed": 1, "parameters": {
         "silicone.mu": {"rel_sd": 0.1}}}, "requirements": ["tip_force_max >= 0.1 N"]},
 }

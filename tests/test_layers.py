@@ -11,6 +11,8 @@ neither numba, xarray nor matplotlib. Imports sit at module top unless they are 
 """
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -150,6 +152,83 @@ def test_physics_imports_no_numba_xarray_matplotlib():
             for name in names:
                 assert name.split(".")[0] not in ("numba", "xarray", "matplotlib", "h5py",
                                                   "h5netcdf"), (path, name)
+
+
+#: Modules outside kernels/ that import Numba, each with its reason (none).
+NUMBA_OUTSIDE_KERNELS = set()
+
+
+def test_numba_is_imported_in_kernels_only():
+    """All of Numba sits behind kernels/ (the performance fence, docs/architecture.md):
+    a module elsewhere that imports it, even lazily inside a function, is listed here."""
+    found = set()
+    for path in PKG.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level \
+                else []
+            if any(n.split(".")[0] in ("numba", "llvmlite") for n in names):
+                found.add(path.relative_to(PKG.parent).as_posix())
+    outside = {p for p in found if not p.startswith("nylonflex/kernels/")}
+    assert outside == NUMBA_OUTSIDE_KERNELS
+
+
+def test_importing_the_package_changes_nothing_in_the_process():
+    """``import nylonflex`` (and reading its version) loads no Numba, registers no Numba
+    event listener and patches no module: a notebook that imports nylonflex beside its own
+    Numba code sees Numba as it was."""
+    code = ("import sys, nylonflex; nylonflex.__version__; dir(nylonflex); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('numba', 'llvmlite', 'scipy', 'xarray', 'matplotlib', 'h5py')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "[]"
+
+
+#: The most positional parameters a function of the package may take: past it, a record
+#: (kernels/records.py, physics/records.py) carries the group.
+MAX_POSITIONAL = 12
+#: Functions still past it, each to be given records.
+TOO_MANY_POSITIONAL = {"nylonflex/physics/limits.py:_design_state_nodes",
+                       "nylonflex/physics/bending.py:_curvature_of",
+                       "nylonflex/fe/solve.py:_increments"}
+
+
+def test_no_function_takes_more_than_twelve_positional_arguments():
+    found = set()
+    for path in PKG.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and \
+                    len(node.args.posonlyargs) + len(node.args.args) > MAX_POSITIONAL:
+                found.add(f"{path.relative_to(PKG.parent).as_posix()}:{node.name}")
+    assert found == TOO_MANY_POSITIONAL
+
+
+#: The longest body (docstring not counted) a function may have [lines].
+MAX_BODY_LINES = 120
+#: Compiled kernel bodies past it: each is one pass over its data (a slab's designs, a
+#: cell's quadrature points) with every intermediate a local, kept whole until a split is
+#: measured against ``nylonflex bench`` to cost nothing.
+LONG_KERNEL_BODIES = {"nylonflex/kernels/design.py:_design_slab",
+                      "nylonflex/kernels/ogden.py:ogden_points"}
+#: Functions past it still to be split.
+TOO_LONG = {"nylonflex/explore/page.py:build_document"}
+
+
+def test_no_function_body_is_longer_than_the_line():
+    found = set()
+    for path in PKG.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            lines = node.end_lineno - node.lineno + 1
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) and \
+                    isinstance(first.value.value, str):
+                lines -= first.end_lineno - first.lineno + 1
+            if lines > MAX_BODY_LINES:
+                found.add(f"{path.relative_to(PKG.parent).as_posix()}:{node.name}")
+    assert found == LONG_KERNEL_BODIES | TOO_LONG
 
 
 def test_charts_compute_no_physics():

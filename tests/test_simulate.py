@@ -22,6 +22,7 @@ import nylonflex.physics as ph
 from nylonflex.cli import main
 from nylonflex.materials import silicone_parameters
 from nylonflex.kernels.control import _switch, angle_table, estimate_angle, plant_angle
+from nylonflex.kernels.records import Ogden
 from nylonflex.physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from nylonflex.sim import (
     PLANT_TABLE_POINTS,
@@ -98,8 +99,8 @@ def _tables(points, p_top=24e3):
     dp = p_top / (points - 1)
     angle, slope = np.empty(points), np.empty(points)
     nodes = quadrature_nodes()
-    angle_table(dp, A, T, T, L, mu, alpha, *nodes, NEWTON_RTOL, node_scratch(nodes), angle,
-                slope)
+    angle_table(dp, A, T, T, L, Ogden(mu, alpha), nodes, NEWTON_RTOL, node_scratch(nodes),
+                angle, slope)
     return dp, angle, slope
 
 

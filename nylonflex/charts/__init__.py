@@ -121,11 +121,16 @@ def _slice_kwargs(func, chosen):
     return kw
 
 
+#: Attributes a chart reads whole (the model spread's variants: charts/model_spread.py, which
+#: bounds what it reads of it).
+_WHOLE_ATTRS = ("model_spread",)
+
+
 def _short_attrs(ds, limit=80):
     """``ds`` with every string attribute cut to ``limit`` characters (a shallow copy): a
     title or footer never lays out a huge attribute (a 10 MB ``name`` hung the chart)."""
-    attrs = {k: (v if not isinstance(v, str) or len(v) <= limit else v[:limit] + "...")
-             for k, v in ds.attrs.items()}
+    attrs = {k: (v if not isinstance(v, str) or len(v) <= limit or k in _WHOLE_ATTRS
+                 else v[:limit] + "...") for k, v in ds.attrs.items()}
     if all(attrs[k] is v for k, v in ds.attrs.items()):
         return ds
     ds = ds.copy(deep=False)

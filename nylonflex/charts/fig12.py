@@ -12,6 +12,7 @@ from ._common import (_COLOURS, _DASHES, _EXAMPLES, _FLAG_GREY, _LENGTH_DEFAULT,
                       _coils, _eq, _example_point, _figure, _footer,
                       _labelled_psis, _nearest, _pick_few, _psi_colour, _stroke_max,
                       _suptitle, _text)
+from .model_spread import example_range, legend_text, model_bands
 
 
 # ---------------------------------------------------------------------------- figure 12
@@ -260,18 +261,19 @@ def _examples(ax, ds, var, t, length=None, corner="upper left", coils=None, brie
         ax.plot(x, y, "*", ms=13, mfc="gold", mec="k", zorder=7)
         unit = VARIABLES[var].display
         if brief:  # a narrow panel of a model comparison: the value beside the star
-            ax.annotate(f"{y:.3g} {unit}", (x, y), xytext=(6, 4), textcoords="offset points",
+            ax.annotate(f"{y:.3g} {unit}{example_range(ds, var, at)}", (x, y), xytext=(6, 4), textcoords="offset points",
                         fontsize=7.5, zorder=7, bbox={"boxstyle": "round,pad=0.15",
                                                       "fc": "white", "ec": "0.6"})
             continue
         text = f"paper example: {_eq('radius', at['radius'])}, " \
                f"{_eq('coil_index', at['coil_index'])}, {_eq('wrap_angle', at['wrap_angle'])}" \
-               f"\n{VARIABLES[var].long_name} {y:.3g} {unit}"
+               f"\n{VARIABLES[var].long_name} {y:.3g} {unit}{example_range(ds, var, at)}"
         full = "full range of motion" if int(point["limit"]) == 0 else \
             "range of motion cut short"
         if length is None:
             text += f"\nat {_eq('length', at['length'])} tip force " \
-                    f"{float(point['tip_force_max']):.3g} N, {full}"
+                    f"{float(point['tip_force_max']):.3g} N" \
+                    f"{example_range(ds, 'tip_force_max', at)}, {full}"
         else:
             text += f", {full}"
         texts.append(text)
@@ -363,6 +365,7 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                                        fixed=wrap_angle is not None)
             load, bits = load | drew, bits | flags
             _quantile_bands(ax, one, "torque_max", sel, coils, psi_ref)
+            model_bands(ax, one, "torque_max", sel, coils, psi_ref, note_at=None)
             _examples(ax, one, "torque_max", t, coils=coils, brief=many)
             ax.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
                          f"{model}\n{_eq('wall_thickness', t)}",
@@ -379,7 +382,7 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
               "any length (M* does not depend on L; tip force = M*/L)" +
               (f"\none column per model ({len(models)}), one scale along each row"
-               if many else ""))
+               if many else "") + legend_text(ds, psi_ref))
     _footer(fig, ds)
     return fig
 
@@ -437,6 +440,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
             load, bits = load | drew, bits | flags
             _quantile_bands(top, one, "bend_angle_max", sel, coils, psi,
                             note_at=(0.02, 0.98))
+            model_bands(top, one, "bend_angle_max", sel, coils, psi, note_at=None)
             _examples(top, one, "bend_angle_max", t, length, corner="lower right",
                       coils=coils, brief=many)
             top.set_title(f"wall thickness {_eq('wall_thickness', t)}" if not many else
@@ -448,6 +452,8 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
                 top.set_ylim(bottom=0)
             names = ["range_fraction", *(["validity"] if "validity" in one else [])]
             cut = one[names].sel(wrap_angle=psi, **sel).load()
+            model_bands(bottom, one, "range_fraction", sel, coils, psi, scale=100.0,
+                        everywhere=True, note_at=None)
             for k, c in enumerate(coils):
                 rf = 100 * cut["range_fraction"].sel(coil_index=c).values
                 bottom.plot(x, rf, color=_COLOURS[k % len(_COLOURS)], lw=1.8)
@@ -471,7 +477,7 @@ def fig12c(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
               f"{_eq('length', length)} (the angle grows in proportion to L; "
               "the range fraction does not)" +
               (f"\none column per model ({len(models)}), one scale along each row"
-               if many else ""))
+               if many else "") + legend_text(ds, psi))
     _footer(fig, ds)
     return fig
 

@@ -142,7 +142,7 @@ def _charts(out):
 
 def _variable_tables():
     """(JSON key, heading, registry table) of each group of variables."""
-    from ..variables import COORDS, CURVES, DESIGN, INPUTS, TRACKING, UNCERTAIN
+    from ..variables import COORDS, CURVES, DESIGN, INPUTS, SPREAD, TRACKING, UNCERTAIN
 
     return (("axes", "axes and curve coordinates", COORDS),
             ("design", "design variables (query --where/--sort)", DESIGN),
@@ -151,6 +151,8 @@ def _variable_tables():
              {k: v for k, v in UNCERTAIN.items() if k == "feasibility"}),
             ("tracking", "with tracking: (docs/model.md s. 19; query --where/--sort)",
              TRACKING),
+            ("spread", "model spread (a sweep with 'fidelity: spread'; query --where/--sort)",
+             SPREAD),
             ("inputs", "other inputs", INPUTS))
 
 
@@ -163,14 +165,15 @@ def _variables_data():
 def _variables(out):
     for key, title, table in _variable_tables():
         print(f"{title}:", file=out)
+        w = max(18, *(len(n) for n in table))
         for v in table.values():
             units = f"[{v.units}]" + (f", shown in {v.display}" if v.display != v.units
                                       else "")
-            print(f"  {v.name:<24} {units:<22} {v.long_name}: {v.description}", file=out)
+            print(f"  {v.name:<{w}} {units:<22} {v.long_name}: {v.description}", file=out)
             if v.dims and tuple(v.dims) != (v.name,):
-                print(f"  {'':<24} {'':<22} over ({', '.join(v.dims)})", file=out)
+                print(f"  {'':<{w}} {'':<22} over ({', '.join(v.dims)})", file=out)
         if key == "uncertainty":
-            print(f"  {'<variable>_quantile':<24} {'':<22} quantiles of each float design "
+            print(f"  {'<variable>_quantile':<{w}} {'':<22} quantiles of each float design "
                   "variable, over (..., quantile)", file=out)
         print(file=out)
 

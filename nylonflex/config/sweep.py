@@ -22,7 +22,7 @@ from typing import Annotated, Any, Literal, Union
 
 import numpy as np
 import yaml
-from pydantic import BeforeValidator, ValidationError, field_validator, model_validator
+from pydantic import BeforeValidator, Field, ValidationError, field_validator, model_validator
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
 from ..query.parse import parse_requirements
@@ -121,6 +121,15 @@ class Limits(_Strict):
     gigabytes: Annotated[float, BeforeValidator(_no_bool)] = LIMITS["gigabytes"]
 
 
+class Spread(_Strict):
+    """``fidelity: {spread: [variant, ...]}``: the model variants whose range the cube
+    stores beside each headline value (docs/model.md s. 22)."""
+
+    # checked by _spread (one line naming the entry); the schema lists the variants
+    spread: list[str] = Field(json_schema_extra={"items": {"enum": list(MODELS)},
+                                                 "minItems": 2, "uniqueItems": True})
+
+
 class SweepConfig(_Strict):
     """The sweep config of docs/interface.md, as typed (not yet resolved to SI)."""
 
@@ -140,8 +149,25 @@ class SweepConfig(_Strict):
     supply: Supply | None = None
     tracking: Tracking | None = None
     cooling: Union[str, dict[str, Any], list[Union[str, dict[str, Any]]], None] = None
+    # "spread": the range over every variant (or over model's list); {spread: [...]}: over
+    # those (docs/model.md s. 22)
+    fidelity: Union[Literal["spread"], Spread, None] = None
 
     _name = field_validator("name")(classmethod(lambda cls, name: check_run_name(name)))
+
+    @field_validator("fidelity", mode="before")
+    @classmethod
+    def _fidelity_form(cls, value):
+        """One line for a fidelity of neither form (a union's first branch would name only
+        ``'spread'``)."""
+        if isinstance(value, dict) and set(value) - {"spread"}:
+            extra = sorted(str(k) for k in set(value) - {"spread"})[0]
+            raise ValueError(f"unknown key {short(extra)}; accepted: spread")
+        if value is None or value == "spread" or (
+                isinstance(value, dict) and isinstance(value.get("spread"), list)):
+            return value
+        raise ValueError("must be 'spread' or {spread: [variant, ...]} with at least two of "
+                         f"{', '.join(MODELS)}")
 
 
 @dataclass(frozen=True)
@@ -170,6 +196,9 @@ class ResolvedConfig:
     cooling: Cooling | None = None  # None: the nylon set's own heat loss (docs/model.md s. 9)
     # several cooling sets: the cube's string ``cooling`` dimension (then ``cooling`` is None)
     coolings: tuple[Cooling, ...] = ()
+    # ``fidelity: spread``: the model variants the cube's <var>_model_lo/_hi range over;
+    # () without a spread (docs/model.md s. 22)
+    spread: tuple[str, ...] = ()
 
     @property
     def cooling_names(self) -> tuple[str, ...]:
@@ -225,6 +254,8 @@ def canonical_yaml(cfg: ResolvedConfig) -> str:
         doc["cooling"] = cfg.cooling.to_dict()
     if cfg.coolings:
         doc["cooling"] = [c.to_dict() for c in cfg.coolings]
+    if cfg.spread:  # only then: cubes without a model spread keep their hash
+        doc["fidelity"] = {"spread": list(cfg.spread)}
     return yaml.safe_dump(doc, sort_keys=True, default_flow_style=None, width=100)
 
 
@@ -341,7 +372,8 @@ def parse_config(raw: dict, source: str = "config") -> ResolvedConfig:
                           requirements=requirements, models=models,
                           supply_voltage=voltage, tracking=tracking,
                           cooling=coolings[0] if len(coolings) == 1 else None,
-                          coolings=coolings if len(coolings) > 1 else ())
+                          coolings=coolings if len(coolings) > 1 else (),
+                          spread=_spread(cfg.fidelity, models))
 
 
 def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
@@ -376,6 +408,33 @@ def _models(model) -> tuple[str, ...]:
             raise InputError(f"{field_name}: must be one of {', '.join(MODELS)}, got {name!r}")
     if len(set(names)) != len(names):
         raise InputError(f"model: each variant once, got {', '.join(names)}")
+    return tuple(names)
+
+
+def _spread(fidelity, models: tuple[str, ...]) -> tuple[str, ...]:
+    """The model variants of a config's ``fidelity`` spread, checked: () without one;
+    ``"spread"``: the config's ``model`` list, or every variant when it names one; a list:
+    those, at least two, each once, holding every variant of ``model`` (the band is around
+    the cube's own values)."""
+    if fidelity is None:
+        return ()
+    if fidelity == "spread":
+        return tuple(models) if len(models) > 1 else tuple(MODELS)
+    names = list(fidelity.spread)
+    for i, name in enumerate(names):
+        if name not in MODELS:
+            raise InputError(f"fidelity.spread[{i}]: must be one of {', '.join(MODELS)}, "
+                             f"got {name!r}")
+    if len(set(names)) != len(names):
+        raise InputError(f"fidelity.spread: each variant once, got {', '.join(names)}")
+    if len(names) < 2:
+        raise InputError(f"fidelity.spread: needs at least two model variants (of "
+                         f"{', '.join(MODELS)}), got {len(names)}; a spread of one model "
+                         "is its value")
+    missing = [m for m in models if m not in names]
+    if missing:
+        raise InputError(f"fidelity.spread: must hold the cube's model {missing[0]!r} "
+                         f"(model:), the value the band is around; got {', '.join(names)}")
     return tuple(names)
 
 

@@ -77,9 +77,9 @@ def _versions() -> dict:
     ``model`` is the digest of the physics and kernel sources, so an edited formula on one
     side is caught even where the version number did not change.
     """
-    import numba
+    from importlib.metadata import version
 
-    return {"nylonflex": __version__, "model": source_digest(), "numba": numba.__version__,
+    return {"nylonflex": __version__, "model": source_digest(), "numba": version("numba"),
             "numpy": numpy.__version__}
 
 

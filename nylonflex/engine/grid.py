@@ -23,6 +23,7 @@ from ..physics.wrap import muscle_width, outer_perimeter
 from ..variables import COORDS, CURVES, DESIGN, SUPPLY_ONLY
 from .model_slab import coil_table, model_slab
 from .sampled import slab_statistics, uncertain_variables
+from .spread import extra_models, spread_arrays, spread_variables
 from .tracking import slab_tracking, tracking_variables
 
 __all__ = ["FLOAT_DESIGN", "bytes_per_radius", "coil_table", "compute_slab", "coords",
@@ -48,6 +49,9 @@ def cube_variables(cfg: ResolvedConfig) -> dict:
     out.update({n: (v, v.dims) for n, v in uncertain_variables(cfg).items()})
     # the closed loop of every design (docs/model.md s. 19)
     out.update({n: (v, v.dims) for n, v in tracking_variables(cfg).items()})
+    # the range over a model spread, on its variable's cooling dimension (docs/model.md s. 22)
+    out.update({n: (v, v.dims_for((), cfg.cooling_names, supply))
+                for n, v in spread_variables(cfg).items()})
     return out
 
 
@@ -203,9 +207,21 @@ def compute_slab(cfg: ResolvedConfig, i0: int, i1: int, parallel: bool = True,
     coolings = [cfg.with_cooling(c) for c in cfg.coolings] or [cfg]
     slabs = {(m, k): _compute_model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
              for m in cfg.models for k, one in enumerate(coolings)}
+    # a model spread's other variants: the kernel's rows alone, for the range
+    # (docs/model.md s. 22)
+    extra = {(m, k): model_slab(one, i0, i1, parallel, MODELS.index(m), pool)
+             for m in extra_models(cfg) for k, one in enumerate(coolings)}
+    variables = cube_variables(cfg)
+    spread = spread_variables(cfg)
     arrays = {}
-    for name, (v, dims) in cube_variables(cfg).items():
-        if dims[0] != "radius":
+    if spread:
+        arrays.update(spread_arrays(cfg, {**slabs, **extra},
+                                    {n: variables[n][1] for n in spread}))
+        if pool is not None:  # the range is taken: their arrays may serve the next slab
+            for rows in extra.values():
+                pool.give_back(rows)
+    for name, (v, dims) in variables.items():
+        if dims[0] != "radius" or name in spread:
             continue
         by_model, by_cooling = "model" in dims, "cooling" in dims
         ks = range(len(coolings))

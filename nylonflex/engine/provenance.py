@@ -95,7 +95,6 @@ def provenance(cfg: ResolvedConfig) -> dict:
     from importlib.metadata import version
 
     import h5py
-    import numba
 
     def material(m):
         d = {**m.to_dict(), "description": m.description, "sources": dict(m.sources)}
@@ -113,7 +112,7 @@ def provenance(cfg: ResolvedConfig) -> dict:
         "config_sha256": cfg.sha256,
         "nylonflex_version": __version__,
         "model_sources_sha256": source_digest(),
-        "numba_version": numba.__version__,
+        "numba_version": version("numba"),
         "numpy_version": np.__version__,
         # the reader's version, not imported by a sweep (importing it costs 0.4 s)
         "xarray_version": version("xarray"),
@@ -150,8 +149,9 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
     variants' names, space-separated); ``base_thickness`` [m] float64, only where b is not
     t; ``supply_voltage`` [V] float64, only with a supply; and, only with cooling,
     ``cooling`` and ``cooling_fluid`` (the sets' names and fluids, space-separated) with
-    ``cooling_speed`` [m/s] (a float64 array, one speed a set). :func:`cube_settings` reads
-    them back.
+    ``cooling_speed`` [m/s] (a float64 array, one speed a set); only with ``fidelity:
+    spread``, ``model_spread`` (the variants its ``<var>_model_lo``/``_hi`` range over,
+    space-separated). :func:`cube_settings` reads them back.
     """
     def numbers(material, names, kind):
         out = {}
@@ -175,6 +175,8 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
         out["cooling"] = " ".join(c.name for c in coolings)
         out["cooling_fluid"] = " ".join(c.fluid for c in coolings)
         out["cooling_speed"] = np.array([c.speed for c in coolings], np.float64)
+    if cfg.spread:  # fidelity: spread (docs/model.md s. 22)
+        out["model_spread"] = " ".join(cfg.spread)
     return out
 
 
@@ -199,6 +201,8 @@ class CubeSettings:
         The cube's one cooling set; None without one, or with several.
     coolings : tuple of Cooling
         Several cooling sets: the cube's ``cooling`` dimension; () otherwise.
+    spread : tuple of str
+        The variants of the cube's model spread (``fidelity: spread``); () without one.
     """
 
     silicone: Silicone
@@ -208,6 +212,7 @@ class CubeSettings:
     supply_voltage: float | None = None
     cooling: Cooling | None = None
     coolings: tuple[Cooling, ...] = ()
+    spread: tuple[str, ...] = ()
 
     def evaluate_kwargs(self, model: str | None = None, cooling: Cooling | None = None) -> dict:
         """Keyword arguments of :func:`nylonflex.evaluate` under one model variant and
@@ -288,7 +293,8 @@ def cube_settings(ds_or_attrs) -> CubeSettings:
         models=tuple(_text(attrs, "models").split()),
         supply_voltage=_number(attrs, "supply_voltage") if "supply_voltage" in attrs else None,
         cooling=coolings[0] if len(coolings) == 1 else None,
-        coolings=coolings if len(coolings) > 1 else ())
+        coolings=coolings if len(coolings) > 1 else (),
+        spread=tuple(_text(attrs, "model_spread").split()) if "model_spread" in attrs else ())
 
 
 def _value(attrs, key):
@@ -424,7 +430,7 @@ def runnable_config(attrs) -> str:
     where those decimals resolve to exactly the cube's coordinates, else as SI values;
     materials by set name (with the fields that differ), or by their fitted file where it
     is still there and unchanged, else every field; the model, supply, cooling, uncertainty,
-    requirements and tracking as the cube has them, and its codec. Sweeping it gives a cube whose
+    requirements, tracking and model spread as the cube has them, and its codec. Sweeping it gives a cube whose
     data equal this one's bit for bit (the slab size aside, which does not change them).
 
     Parameters
@@ -468,6 +474,8 @@ def runnable_config(attrs) -> str:
         out["requirements"] = list(doc["requirements"])
     if "tracking" in doc:  # docs/model.md s. 19
         out["tracking"] = tracking_section(doc["tracking"])
+    if isinstance(doc.get("fidelity"), dict):  # docs/model.md s. 22
+        out["fidelity"] = {"spread": [str(m) for m in doc["fidelity"]["spread"]]}
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
     out["charts"] = []

@@ -23,6 +23,7 @@ from ..kernels.rows import N_TRACKING, TRACKING_ROWS
 from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import stroke, stroke_scale
+from ..physics.records import Ogden
 from ..physics.thermal import coil_heat_loss_per_length, coil_resistance_per_length, \
     steady_temperature
 from ..physics.wrap import muscle_length
@@ -130,7 +131,7 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     kappa = np.empty((len(a), len(t), PLANT_POINTS))
     slope = np.empty_like(kappa)
     run_chunks(lambda q0, q1: kt.kappa_tables(
-        p_group, a, t, -1.0 if base is None else base, mu, alpha, *nodes, NEWTON_RTOL,
+        p_group, a, t, -1.0 if base is None else base, Ogden(mu, alpha), nodes, NEWTON_RTOL,
         node_scratch(nodes), kappa, slope, q0, q1), len(a) * len(t), parallel=parallel)
     t0 = ny.t_amb if spec.initial_temperature is None else spec.initial_temperature
     muscle = (np.ascontiguousarray(np.atleast_1d(coil_resistance_per_length(C, ny)), float),
@@ -149,9 +150,9 @@ def slab_tracking(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict,
     bandwidth = (0, 0.0, 1.0, 1.0, 0, 1) if b is None else \
         (1, b["error"], b["low"], b["high"], b["iterations"], b["periods"])
     out = np.empty((N_TRACKING, lm.size))
-    args = ((a, t, L, -1.0 if base is None else base), lm, p_top, scale, ref_scale, p_group,
-            kappa, slope, muscle, (mu, alpha), nodes, NEWTON_RTOL, settings, reference,
-            bandwidth, sensor_noise(spec, _longest_run(spec)), out)
+    args = ((a, t, L, -1.0 if base is None else base), (lm, p_top, scale, ref_scale),
+            (p_group, kappa, slope), muscle, Ogden(mu, alpha), nodes, NEWTON_RTOL,
+            (settings, reference, bandwidth, sensor_noise(spec, _longest_run(spec))), out)
     run_chunks(lambda q0, q1: kt.track_slab(*args, kt.track_scratch(nodes, spec.table_points),
                                             q0, q1), lm.size, parallel=parallel)
     wanted = tracking_variables(cfg)

@@ -53,12 +53,12 @@ def axis_text(ds, name: str, si) -> str:
 def design_variables(ds) -> list[str]:
     """The cube's design variables: those over every design axis, registry order first.
 
-    ``validity`` (a flag set) is left out; ``limit`` is included (0 stroke-, 1 strength-
+    ``validity`` and ``validity_model_any`` (flag sets) are left out; ``limit`` is included (0 stroke-, 1 strength-
     limited).
     """
     names = [n for n in ds.data_vars
              if set(AXES) <= set(ds[n].dims) and set(ds[n].dims) <= {*AXES, "model"}
-             and n != "validity"]
+             and n not in ("validity", "validity_model_any")]
     order = list(VARIABLES)
     return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
 

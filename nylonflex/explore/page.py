@@ -37,6 +37,7 @@ from ..variables import AXES, label, name_label
 from .data import (design_config, design_variables, display_unit, flag_meanings, snap,
                    stand_in_note, to_display_any, validity_names)
 from .fidelity import fidelity_widgets
+from .model_spread import spread_args
 
 #: The most designs a page carries (the rest of a larger cube is left out, and it says so).
 MAX_DESIGNS = 120_000
@@ -153,6 +154,9 @@ def build_payload(ds, where=()):
     p["validity"] = (_f32(np.nan_to_num(_full(part["validity"], order, models).values
                                         .astype(float), nan=np.nan))
                      if "validity" in ds else None)
+    # the flags of any variant of a model spread (explore/model_spread.py)
+    p["validity_any"] = (_f32(_full(part["validity_model_any"], order, models).values
+                              .astype(float)) if "validity_model_any" in ds else None)
     grid = {a: part[a].values.astype(float) for a in AXES}
     p["grid"] = grid
     p["gx"] = {a: [float(v) for v in _f32(to_display_any(ds, a, grid[a]))] for a in AXES}
@@ -390,7 +394,8 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
                 flim_span=flim_span, readout=readout, table=table, note=note, hold=hold,
                 vnames=variables, vlabels=[label(ds[n]) for n in variables],
                 vshort=[label(ds[n]).split(" [")[0] for n in variables],
-                vunits=[display_unit(ds, n) for n in variables])
+                vunits=[display_unit(ds, n) for n in variables],
+                vany=p["validity_any"], **spread_args(ds, variables))
     update = CustomJS(args=args, code=_script("update.js"))
     for w in (variable, map_x, map_y):
         w.js_on_change("value", update)

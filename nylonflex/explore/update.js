@@ -119,6 +119,16 @@ let text = '<div id="nf-readout" class="nf-readout" data-variable="' + vnames[st
   AXES.map(k => k + " " + labels[k][st.ix[k]]).join(", ") + mname + '</span>' +
   '<br><span id="nf-validity" data-value="' + bits + '">validity: <b>' + flagtext(bits) +
   '</b></span>';
+// a model spread: the shown variable's range over the variants (explore/model_spread.py)
+const band = bands[st.v];
+if (band) {
+  const blo = data[band[0]][sel], bhi = data[band[1]][sel];
+  text += '<br><span id="nf-spread" data-lo="' + blo + '" data-hi="' + bhi + '">models: <b>' +
+    fmt(blo) + ' .. ' + fmt(bhi) + (vunits[st.v] == "1" ? "" : " " + vunits[st.v]) +
+    '</b> <span style="color:#555">(' + spreadnote + ')</span></span>';
+}
+if (vany) text += '<br><span id="nf-validity-any" data-value="' + vany[sel] +
+  '">validity of any model: <b>' + flagtext(vany[sel]) + '</b></span>';
 // a map pick's note belongs to the design it picked (a later move makes it stale)
 if (note.tags.length == 2 && note.tags[1] == design) {
   text += '<br><span class="nf-snap" style="color:#a0522d">' + note.tags[0] + '</span>';

@@ -32,8 +32,8 @@ from ._compile import jit_kernel
 __all__ = ["angle_table", "closed_loop", "estimate_angle", "loop_state", "plant_angle"]
 
 
-def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, mu, alpha,
-                 x_base, w_base, phi_trig, w_phi, rtol, table, out_angle, out_slope):
+def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, silicone,
+                 nodes, rtol, table, out_angle, out_slope):
     """Bend angle theta(p_k) = kappa(p_k) L and its slope at p_k = k dp [rad], [rad/Pa].
 
     Parameters
@@ -42,9 +42,9 @@ def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, 
         Grid spacing dp [Pa].
     radius, wall_thickness, base_thickness, length : float
         a, t, b, L [m].
-    mu, alpha : ndarray
-        Ogden constants [Pa], [-].
-    x_base, w_base, phi_trig, w_phi : ndarray
+    silicone : Ogden
+        The Ogden constants ``mu`` [Pa] and ``alpha`` [-] (arrays of one entry a term).
+    nodes : Nodes
         Gauss-Legendre nodes and weights (``physics.bending.quadrature_nodes()``).
     rtol : float
         Tolerance of the curvature solve [-] (``physics.bending.NEWTON_RTOL``).
@@ -62,6 +62,8 @@ def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, 
     curvature is solved in it, warm-started from the previous point's, and its stiffness
     evaluated there.
     """
+    mu, alpha = silicone
+    x_base, w_base, phi_trig, w_phi = nodes
     y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
     _section_nodes(radius, wall_thickness, base_thickness, x_base, w_base, phi_trig, w_phi, y,
                    wy, wyy)

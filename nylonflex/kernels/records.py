@@ -9,15 +9,17 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-from ..physics.records import Nodes, Ogden
+from ..physics.records import Nodes, Ogden, Section
 
-__all__ = ["AngleTables", "CoilTable", "Control", "GridAxes", "GridOut", "Muscle", "Muscles",
-           "Nodes", "Ogden", "Options", "PointDesigns", "PointOut", "SimOut", "Supply"]
+__all__ = ["AngleTables", "CoilTable", "Control", "Estimator", "GridAxes", "GridOut",
+           "LoopControl", "LoopMuscle", "LoopPlant", "LoopReference", "Muscle", "Muscles",
+           "Nodes", "Ogden", "Options", "PointDesigns", "PointOut", "Section",
+           "SimOut", "Supply", "TableSpec"]
 
 # Ogden (``mu`` [Pa], ``alpha`` [-], one entry per term; the pointwise kernel takes 2-D
-# arrays (sample, term) with one row or one row a design) and Nodes (the quadrature of the
-# material moment) are the physics layer's records (:mod:`nylonflex.physics.records`),
-# which the formulas take too.
+# arrays (sample, term) with one row or one row a design), Nodes (the quadrature of the
+# material moment) and Section (``radius``, ``wall``, ``base`` [m]) are the physics layer's
+# records (:mod:`nylonflex.physics.records`), which the formulas take too.
 
 #: The axes of a slab of the design grid: ``radius`` (the slab's radii), ``wall``,
 #: ``length``, ``wrap`` [m, m, m, rad]; ``base_thickness`` [m] (<= 0: b = t); the curve axes
@@ -92,3 +94,35 @@ Control = namedtuple("Control", "half_band filter_keep reference noise kind gain
 #: Outputs (n, m): temperature, stroke, pressure, angle, estimate, voltage, current, power.
 SimOut = namedtuple("SimOut", "temperature stroke pressure angle estimate voltage current "
                               "power")
+
+# ------------------------------------------------- one design's loop in a tracking sweep
+#: One design's muscle in its closed loop (floats): the supply ``voltage`` [V], ``p_atm``
+#: the initial chamber pressure [Pa], the muscle's ``length`` [m], ``r_per_len`` r'
+#: [ohm/m], ``c_per_len`` c' [J/(K m)], ``loss_per_len`` lambda' [W/(K m)], ``t_amb`` and
+#: ``t_start`` [K], ``stroke_scale`` s_max(C)/s_ref(T_max) [-], and eq. (2)'s ``gamma``
+#: [1/K], ``beta`` [-], ``t_g`` and ``sigma_g`` [K].
+LoopMuscle = namedtuple("LoopMuscle", "voltage p_atm length r_per_len c_per_len loss_per_len "
+                                      "t_amb t_start stroke_scale gamma beta t_g sigma_g")
+
+#: One design's plant: the actuator's ``length`` L [m] and its curvature table (the angle
+#: is kappa L): ``step`` [Pa], ``kappa`` [1/m] and ``slope`` d kappa/dp [1/(m Pa)].
+LoopPlant = namedtuple("LoopPlant", "length step kappa slope")
+
+#: The estimator's table: ``step`` [Pa] and ``angles`` [rad].
+Estimator = namedtuple("Estimator", "step angles")
+
+#: The controller: ``kind`` (int, 0 bang-bang, 1 PI), ``half_band`` [rad], the PI's
+#: ``gain`` [1/rad] and ``integral_step`` dt/T_i [-], the estimate's ``filter_keep`` [-].
+LoopControl = namedtuple("LoopControl", "kind half_band gain integral_step filter_keep")
+
+#: The reference: ``kind`` (int, 0 the sine mean + amplitude sin(2 pi frequency t +
+#: phase), 1 the step from ``initial`` to ``final`` at ``at`` [s]), angles [rad]; the RMS
+#: error counts the samples from ``rms_from`` [s].
+LoopReference = namedtuple("LoopReference", "kind mean amplitude frequency phase initial "
+                                            "final at rms_from")
+
+#: The estimator table of one design: its ``section`` (a :class:`Section` [m]), the top
+#: pressure ``p_top`` [Pa] (NaN: no loop), its ``points``, the ``silicone``
+#: (:class:`Ogden`), the quadrature ``nodes`` (:class:`Nodes`) and the curvature solve's
+#: ``rtol`` [-].
+TableSpec = namedtuple("TableSpec", "section p_top points silicone nodes rtol")

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..variables import AXES, CATEGORIES, COOLING, DESIGN, MODEL, VARIABLES, to_display
+from ..variables import AXES, CATEGORIES, COOLING, DESIGN, MODEL, SPREAD, VARIABLES, to_display
 from .parse import EXACT, OPTIONAL, default_columns
 
 
@@ -58,7 +58,7 @@ def flag_names(x) -> str:
 
 
 #: Variables that hold whole numbers (flags and bit fields): printed as integers.
-INTEGERS = ("limit", "validity")
+INTEGERS = ("limit", "validity", "validity_model_any")
 
 
 def _integer(x):
@@ -73,7 +73,7 @@ def cell_text(name, x) -> str:
     variable in its display unit to 3 significant digits."""
     if name in CATEGORIES:
         return str(x)
-    if name == "validity":
+    if name in ("validity", "validity_model_any"):
         return flag_names(x)
     if name == "limit":
         return {0.0: "stroke", 1.0: "strength", 2.0: "supply", 3.0: "load"}.get(
@@ -122,6 +122,22 @@ def shown_columns(res, fmt="table") -> tuple:
     return tuple(n for n in names if not _all_nan(res, n))
 
 
+def _band_notes(res, names) -> dict:
+    """``{name: "   (models 1.20 .. 1.82 N)"}``: a one-design answer's range over the cube's
+    model spread (docs/model.md s. 22) of each value that has one; ``validity`` the flags of
+    any variant."""
+    out = {}
+    for name in names:
+        lo, hi = f"{name}_model_lo", f"{name}_model_hi"
+        if lo in names and hi in names:
+            unit = "" if _unit(name) == "1" else f" {_unit(name)}"
+            out[name] = (f"   (models {cell_text(lo, res.data[lo][0])} .. "
+                         f"{cell_text(hi, res.data[hi][0])}{unit})")
+    if "validity" in names and "validity_model_any" in names:
+        out["validity"] = f"   (any model: {cell_text('validity_model_any', res.data['validity_model_any'][0])})"
+    return out
+
+
 def format_table(res) -> str:
     """Aligned text in display units: a key/value list for one design, else a table."""
     out = io.StringIO()
@@ -130,9 +146,11 @@ def format_table(res) -> str:
         print(f"design at {_describe_at(res)}", file=out)
         names = [*DESIGN, *(c for c in res.columns if c in OPTIONAL)] \
             if res.chosen is None else [c for c in res.chosen if c not in AXES]
+        # a model spread: each range beside its value, not on lines of its own
+        band = {} if res.chosen is not None else _band_notes(res, names)
         for name in names:
-            if res.chosen is None and _all_nan(res, name):
-                continue  # heating_time without a supply
+            if res.chosen is None and (_all_nan(res, name) or name in SPREAD):
+                continue  # heating_time without a supply; a range shown beside its value
             x = res.data[name][0]
             unit = _unit(name)
             text = cell_text(name, x)
@@ -145,7 +163,7 @@ def format_table(res) -> str:
                         }[text]
             elif unit != "1":
                 text += f" {unit}"
-            print(f"  {name:<16} {text}", file=out)
+            print(f"  {name:<16} {text}{band.get(name, '')}", file=out)
         return out.getvalue()
     if res.at:
         print(f"at {_describe_at(res)}", file=out)
@@ -278,8 +296,9 @@ def format_json(res) -> str:
         attrs = VARIABLES["limit"].attrs()
         flags["limit"] = dict(zip((str(int(v)) for v in attrs["flag_values"]),
                                   attrs["flag_meanings"].split()))
-    if "validity" in columns:
-        flags["validity"] = {str(k): v for k, v in _flag_meanings("validity").items()}
+    for name in ("validity", "validity_model_any"):
+        if name in columns:
+            flags[name] = {str(k): v for k, v in _flag_meanings("validity").items()}
     if flags:
         doc["flags"] = flags
     return json.dumps(doc, indent=1) + "\n"

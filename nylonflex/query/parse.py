@@ -8,12 +8,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..units import InputError, parse_quantity
-from ..variables import AXES, DESIGN, TRACKING, VARIABLES
+from ..variables import AXES, DESIGN, SPREAD, TRACKING, VARIABLES
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
-#: Columns a cube has only when its sweep asked for them (``requirements``, ``tracking:``).
-OPTIONAL = ("feasibility", *TRACKING)
+#: Columns a cube has only when its sweep asked for them (``requirements``, ``tracking:``,
+#: ``fidelity: spread``).
+OPTIONAL = ("feasibility", *TRACKING, *SPREAD)
 _FIELDS = ", ".join(COLUMNS + OPTIONAL)
 #: What a table shows after the axes and the variables a query tests or sorts by (the
 #: limit, the two headline performance numbers and the validity flags, by name).
@@ -28,6 +29,15 @@ _LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limit
 #: slice of a cube (not a Condition); a cooling set's name may carry its speed
 #: (``forced_air 5 m/s``).
 _CATEGORY_WHERE = re.compile(r"^\s*(model|cooling)\s*(==|=)\s*([A-Za-z0-9_][A-Za-z0-9_ ./]*?)\s*$")
+
+
+def missing_hint(name: str) -> str:
+    """What sweep gives a cube the optional column ``name`` (for a refusal naming it)."""
+    if name in TRACKING:
+        return "sweep a config with 'tracking:' (docs/model.md s. 19)"
+    if name in SPREAD:
+        return "sweep a config with 'fidelity: spread' (docs/model.md s. 22)"
+    return "sweep a config with 'requirements' (docs/uncertainty.md)"
 
 
 def _quantity(name, text, field):
@@ -250,10 +260,13 @@ def parse_columns(text):
 
 def default_columns(available, asked=()) -> tuple:
     """A table's columns: the axes, the ``asked`` names (tested by ``--where`` or sorted
-    by), then :data:`HEADLINE`; only the ``available`` ones, each once, ``model`` and
-    ``cooling`` first."""
+    by), then :data:`HEADLINE` (each with its range over a model spread, where the cube has
+    one); only the ``available`` ones, each once, ``model`` and ``cooling`` first."""
     out = []
-    for name in ("model", "cooling", *AXES, *asked, *HEADLINE):
+    # a headline value's range over a model spread follows it (docs/model.md s. 22)
+    headline = [m for n in HEADLINE for m in (n, f"{n}_model_lo", f"{n}_model_hi")] + \
+        ["validity_model_any"]
+    for name in ("model", "cooling", *AXES, *asked, *headline):
         if name in available and name not in out:
             out.append(name)
     return tuple(out)

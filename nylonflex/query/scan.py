@@ -12,9 +12,10 @@ import numpy as np
 
 from ..physics import design_limits
 from ..units import InputError, from_si
-from ..variables import CATEGORIES, AXES, DESIGN, VARIABLES
+from ..variables import CATEGORIES, AXES, DESIGN, SPREAD, VARIABLES
 from .parse import (_CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
-                    _parse_sort, parse_at, parse_columns, parse_condition)
+                    _parse_sort, missing_hint, parse_at, parse_columns, parse_condition)
+from .spread import PER_LENGTH, TIMES_LENGTH, exact_spread, spread_variants
 
 # Values this close (relative to the axis span) to a grid value are that grid value.
 _GRID_RTOL = 1e-6
@@ -106,25 +107,30 @@ def slab_rows(ds, at_loc, r0, r1):
             continue
         a, b = sub.isel({name: 0}), sub.isel({name: 1})
         mixed = (a["limit"] != b["limit"]) | a["limit"].isnull() | b["limit"].isnull()
+        forces = [n for n in TIMES_LENGTH if n in sub]  # with a model spread's range
+        angles = [n for n in PER_LENGTH if n in sub]
         if name == "length":
             # F* = M*/L and theta* = kappa(p*) L (docs/model.md s. 8): interpolate the
             # length-free M* and kappa*, exact along this axis, then scale back (for
             # fe_calibrated kappa* carries (L/a)^c2, docs/model.md s. 21: smooth, not exact)
             la, lb = (float(ds["length"].values[k]) for k in at_loc["length"][:2])
             length = la * (1.0 - w) + lb * w
-            a["tip_force_max"], b["tip_force_max"] = (a["tip_force_max"] * la,
-                                                      b["tip_force_max"] * lb)
-            a["bend_angle_max"], b["bend_angle_max"] = (a["bend_angle_max"] / la,
-                                                        b["bend_angle_max"] / lb)
+            for n in forces:
+                a[n], b[n] = a[n] * la, b[n] * lb
+            for n in angles:
+                a[n], b[n] = a[n] / la, b[n] / lb
         sub = a * (1.0 - w) + b * w
         if name == "length":
-            sub["tip_force_max"] = sub["tip_force_max"] / length
-            sub["bend_angle_max"] = sub["bend_angle_max"] * length
+            for n in forces:
+                sub[n] = sub[n] / length
+            for n in angles:
+                sub[n] = sub[n] * length
         # a flag is never interpolated: between two grid points it is known only where
         # both agree (query_cube then takes it from the exact model where it can)
         sub["limit"] = a["limit"].where(~mixed)
-        if "validity" in sub:
-            sub["validity"] = a["validity"].where(a["validity"] == b["validity"])
+        for flag in ("validity", "validity_model_any"):
+            if flag in sub:
+                sub[flag] = a[flag].where(a[flag] == b[flag])
     # a cube of several models (cooling sets): the model, then the cooling set, are the
     # last (fastest) axes of the rows
     cats = [d for d in CATEGORIES if d in sub.dims]
@@ -374,26 +380,27 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     columns = (*(c for c in CATEGORIES if c in ds.dims), *columns)
     for name in [c.name for c in conditions] + [sort_name]:
         if name in OPTIONAL and name not in ds:
-            raise InputError(f"{name}: the cube has no {name}; sweep a config with "
-                             "'requirements' (docs/uncertainty.md)")
+            raise InputError(f"{name}: the cube has no {name}; {missing_hint(name)}")
     if limit is not None and limit < 0:
         raise InputError(f"--limit: must be 0 or more, got {limit}")
     for name in chosen or ():
         if name in OPTIONAL and name not in ds:
-            raise InputError(f"--columns: the cube has no {name}; sweep a config with "
-                             "'requirements' (docs/uncertainty.md)")
+            raise InputError(f"--columns: the cube has no {name}; {missing_hint(name)}")
     at_loc = {name: locate(ds, name, value) for name, value in at.items()}
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
     settings = _exact_settings(ds) if exact else None
+    # a model spread off the grid: every variant through the exact model (query/spread.py)
+    variants = spread_variants(ds) if exact else ()
     if exact:  # the exact model gives the design variables, not the sampled or tracked ones
         for name in [c.name for c in conditions] + [sort_name] + list(chosen or ()):
-            if name in OPTIONAL:
+            if name in OPTIONAL and not (variants and name in SPREAD):
                 raise InputError(f"{name}: not computed off the grid (the exact model gives "
                                  "the design variables; the sweep sampled or simulated "
                                  f"{name} on the grid): use --interpolate, or grid values "
                                  f"for {', '.join(off_grid)}")
-        columns = tuple(c for c in columns if c not in OPTIONAL)
+        columns = tuple(c for c in columns
+                        if c not in OPTIONAL or (variants and c in SPREAD))
     flags = None
     if off_grid and interpolate:  # the flags from the exact model, when it can be had
         try:
@@ -422,6 +429,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
         n_where = None
         if exact:
             rows = _exact_rows(ds, at, at_loc, r0, r1, settings, evaluate)
+            if variants:
+                rows.update(exact_spread(rows, settings, evaluate, variants))
         elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
             # variable by variable (a cube of several models or cooling sets is read
             # whole, per slab)

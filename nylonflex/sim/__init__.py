@@ -40,7 +40,7 @@ from ..config.simulate import (  # noqa: F401 - the config layer's names, import
     parse_sim_config,
     top_temperature,
 )
-from ..kernels.records import AngleTables, Control, Muscles, SimOut, Supply
+from ..kernels.records import AngleTables, Control, Muscles, Ogden, SimOut, Supply
 from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
@@ -175,7 +175,7 @@ def _tables(a: ActuatorSpec, p_top: float):
 
     mu, alpha = a.silicone.arrays()
     nodes = quadrature_nodes()
-    geom = (a.radius, a.wall_thickness, a.base_thickness, a.length, mu, alpha, *nodes,
+    geom = (a.radius, a.wall_thickness, a.base_thickness, a.length, Ogden(mu, alpha), nodes,
             NEWTON_RTOL, node_scratch(nodes))
     dp_plant = p_top / (PLANT_TABLE_POINTS - 1)
     plant = np.empty(PLANT_TABLE_POINTS)

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..units import InputError
-from ..variables import (AXES, CURVES, DESIGN, UNCERTAIN, VARIABLES, is_complete, to_display,
-                         validate)
+from ..variables import (AXES, CURVES, DESIGN, SPREAD, SPREAD_OF, UNCERTAIN, VARIABLES,
+                         is_complete, to_display, validate)
 from .cube import STORED_DIMS, require_filters
 from .journal import Journal
 
@@ -110,7 +110,8 @@ def open_cube(path, *, quiet: bool = False):
         if not quiet:
             warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
                           "computed; the rest is masked", stacklevel=2)
-        for name in [n for n in ds.data_vars if n in {**DESIGN, **CURVES, **UNCERTAIN}]:
+        for name in [n for n in ds.data_vars
+                     if n in {**DESIGN, **CURVES, **UNCERTAIN, **SPREAD}]:
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
@@ -327,6 +328,14 @@ def _check_dataset(path, name, dset, full):
     return out
 
 
+def _spread_lines(variants) -> list[str]:
+    """``info``'s lines of a cube with a model spread: its variants and variables."""
+    return [f"spread    over {len(variants)} model variants (fidelity: spread): "
+            f"{', '.join(variants)}",
+            f"          <var>_model_lo/_hi of {', '.join(SPREAD_OF)}; validity_model_any: "
+            "their flags ORed"]
+
+
 def cube_description(path) -> dict:
     """A cube described as data (``nylonflex info --format json``): dims, ranges (SI and
     the display unit), variables, flags, provenance and completeness.
@@ -362,6 +371,8 @@ def cube_description(path) -> dict:
         for cat in ("model", "cooling"):
             if cat in sizes:
                 d[cat] = [_text(m) for m in np.asarray(h5[cat][...]).reshape(-1)]
+        if "model_spread" in a:  # fidelity: spread (docs/model.md s. 22)
+            d["model_spread"] = _text(a["model_spread"]).split()
         supply = a.get("supply_voltage", "none")  # [V] float64; text before cube format 2
         if supply != "none":
             d["supply_voltage"] = supply
@@ -409,6 +420,8 @@ def summary_lines(d: dict) -> list[str]:
                                                            for ax, n in d["shape"].items()))
     if "model" in d:
         out.append("models    " + ", ".join(d["model"]))
+    if "model_spread" in d:
+        out.extend(_spread_lines(d["model_spread"]))
     if "cooling" in d:
         out.append("cooling   " + ", ".join(d["cooling"]))
     if "supply_voltage" in d:
