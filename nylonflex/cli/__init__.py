@@ -24,6 +24,7 @@ import threading
 import warnings
 
 from .. import __version__
+from ._common import say
 
 EXIT_OK, EXIT_FAILURE, EXIT_INPUT = 0, 1, 2
 
@@ -346,8 +347,8 @@ class _compile_notices:
         self._show = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
-            if category.__name__ == "CompileWarning":
-                print(f"nylonflex {self.command}: {message}", file=sys.stderr, flush=True)
+            if category.__name__ == "CompileWarning":  # above a progress bar, never in it
+                say(f"nylonflex {self.command}: {message}")
             else:
                 self._show(message, category, filename, lineno, file, line)
 
@@ -366,8 +367,9 @@ def one_line(exc) -> str:
 
 
 def warn(command: str, message: str):
-    """One warning line on stderr, ``nylonflex COMMAND: warning: ...``."""
-    print(f"nylonflex {command}: warning: {message}", file=sys.stderr)
+    """One warning line on stderr, ``nylonflex COMMAND: warning: ...`` (above a progress
+    bar, never in it)."""
+    say(f"nylonflex {command}: warning: {message}")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,12 +17,24 @@ def open_cube_for(command: str, path):
         warnings.simplefilter("always")
         ds = open_cube(path)
     for w in caught:
-        print(f"nylonflex {command}: warning: {w.message}", file=sys.stderr)
+        say(f"nylonflex {command}: warning: {w.message}")
     return ds
 
 
 #: Seconds between the progress lines of a command whose stderr is not a terminal.
 LINE_EVERY = 60.0
+
+#: The progress report showing now (messages go above its bar), or None.
+ACTIVE = None
+
+
+def say(message: str):
+    """One message line on stderr: above the progress bar while one shows (tqdm.write),
+    never into it; the warnings and compile notices of every command come through here."""
+    if ACTIVE is not None:
+        ACTIVE.write(message)
+    else:
+        print(message, file=sys.stderr, flush=True)
 
 
 class progress_bar:
@@ -53,6 +65,8 @@ class progress_bar:
         self._stop = None
 
     def __enter__(self):
+        global ACTIVE
+        self._previous, ACTIVE = ACTIVE, self
         self._start = time.monotonic()
         if not self.quiet:
             self._stop = threading.Event()
@@ -111,6 +125,8 @@ class progress_bar:
                     self._bar.refresh()
 
     def __exit__(self, *exc):
+        global ACTIVE
+        ACTIVE = self._previous
         if self._stop is not None:
             self._stop.set()
         if self._bar is not None:

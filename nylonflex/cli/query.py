@@ -75,8 +75,7 @@ def run(args) -> int:
                              where=where, sort=args.sort,
                              limit=args.limit, interpolate=args.interpolate,
                              columns=args.columns,
-                             progress=bar, log=lambda m: print(f"nylonflex query: {m}",
-                                                               file=sys.stderr))
+                             progress=bar, log=lambda m: bar.write(f"nylonflex query: {m}"))
         if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
             raise InputError("--at: this design is not in the cube yet (an incomplete "
                              "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
