@@ -10,7 +10,8 @@ import math
 import re
 import reprlib
 
-__all__ = ["UNITS", "InputError", "json_text", "parse_quantity", "short", "to_si", "from_si",
+__all__ = ["UNITS", "InputError", "bare_angle_error", "bare_number", "json_text",
+           "parse_quantity", "plainly_degrees", "short", "slip_hint", "to_si", "from_si",
            "unit_kind"]
 
 
@@ -209,3 +210,50 @@ def parse_quantity(text, field: str, kind: str, default_unit: str):
                          f"({', '.join(_units_of(kind))}), got {short(text)}")
     number, unit = m.groups()
     return to_si(float(number), unit or default_unit, field, kind)
+
+
+def bare_number(raw):
+    """The float of a number typed without a unit (``0.14``, ``"0.14"``), else None."""
+    if isinstance(raw, bool):
+        return None
+    if isinstance(raw, (int, float)):
+        return float(raw)
+    m = _NUMBER.match(raw) if isinstance(raw, str) and len(raw) < 200 else None
+    return float(m.group(1)) if m and not m.group(2) else None
+
+
+#: The rule for a bare angle in a config (docs/interface.md, "Units"): it is read as
+#: degrees only when it is *plainly* degrees, i.e. larger than the largest angle the field
+#: accepts, read as radians (so that it cannot be radians): wrap_angle takes up to 80 deg =
+#: 1.40 rad, so ``[5, 8, 12]`` is plainly degrees while ``[0.14, 0.21]`` and ``[1]`` are
+#: refused; 0 is 0 in either unit. The config states the unit instead with ``units: deg``
+#: (an axis) or ``8deg`` / ``0.14rad`` (a value).
+def plainly_degrees(value: float, hi_rad: float) -> bool:
+    """Whether a bare angle ``value`` can only be degrees: 0, or larger in magnitude than
+    ``hi_rad`` [rad], the largest angle its field accepts (so as radians it is refused)."""
+    return value == 0.0 or abs(value) > hi_rad
+
+
+def bare_angle_error(field: str, value: float) -> InputError:
+    """The refusal of a bare angle that is not :func:`plainly_degrees`: one line naming the
+    field, the unit it would read in and the likely slip (radians)."""
+    deg = math.degrees(value)
+    return InputError(f"{field}: {value:g} has no unit; it reads as {value:g} deg - did you "
+                      f"mean {value:g} rad ({deg:.3g} deg)? write '{deg:.3g}deg' or "
+                      f"'{value:g}rad' ('{value:g}deg' if degrees are meant)")
+
+
+def slip_hint(value: float, kind: str, unit: str, lo, hi) -> str:
+    """For a bare ``value`` read in ``unit`` and refused (outside [lo, hi], SI): the text
+    naming the SI unit of its kind when the value would be in range there (the slip of
+    typing SI where the display unit is read: ``0.0075`` read as mm, ``"; did you mean
+    0.0075 m (7.5 mm)? write '7.5mm'"``), or ""."""
+    shown = _canonical(unit)
+    si_unit = next((u for u, (k, f, o) in UNITS.items() if k == kind and f == 1.0 and
+                    o == 0.0), None)
+    if si_unit is None or si_unit == shown or value == 0.0:
+        return ""
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        return ""
+    typed = from_si(value, shown)
+    return f"; did you mean {value:g} {si_unit} ({typed:.4g} {shown})? write '{typed:.4g}{shown}'"

@@ -26,7 +26,8 @@ __all__ = ["AXES", "CATEGORIES", "COORDS", "CURVES", "DESIGN", "INPUTS", "MODELS
            "range_text", "slab_done_attrs", "spread_name", "to_display", "validate"]
 
 #: Model variants, in the order of their integer codes in the kernels (docs/model.md
-#: s. 16); ``paper`` is the default.
+#: s. 16); ``paper`` is the default. What each adds, where it holds and when to use it:
+#: :data:`nylonflex.variants.VARIANTS` (``nylonflex list models``), one record a name.
 MODELS = ("paper", "coupled_muscle", "paper_eq10", "incompressible_wall", "cauchy_moment",
           "lateral_pressure", "fe_calibrated", "sealed_chamber")
 

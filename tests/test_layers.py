@@ -30,6 +30,7 @@ NAMED_LAYERS = (
     ("foundation", ("_version", "units")),
     ("files", ("config.safe_yaml", "storage.files", "examples")),
     ("registry", ("variables",)),
+    ("variant notes", ("variants",)),
     ("material files", ("config.material_files",)),
     ("materials", ("materials",)),
     ("condition grammar", ("query.parse",)),
@@ -390,7 +391,8 @@ def test_no_private_name_is_imported_across_packages():
 
 
 #: The modules the package root holds (issue 28); everything else lives in a subpackage.
-ROOT = {"__init__", "__main__", "_version", "errors", "materials", "units", "variables"}
+ROOT = {"__init__", "__main__", "_version", "errors", "materials", "units", "variables",
+        "variants"}  # variants: the model variants' records beside MODELS (issue 46)
 
 #: The subpackages the package root holds (issue 28). The benchmarks and the slow reference
 #: are not among them: they live in the repository's benchmarks/ and tests/naive.py.

@@ -80,8 +80,8 @@ def test_explore_html_without_the_extra_says_how_to_install(one_cube, tmp_path, 
     from nylonflex.cli import explore
 
     monkeypatch.setattr(explore, "_has", lambda module: False)
-    rc, out, err = run(capsys, "explore", one_cube, "--html", tmp_path / "x.html")
-    assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
+    rc, out, err = run(capsys, "explore", one_cube, "--html", tmp_path / "x.html")  # issue 46: 2
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert "pip install 'nylonflex[explore]'" in err and "Traceback" not in err
     assert not (tmp_path / "x.html").exists()
 

@@ -374,7 +374,7 @@ def test_cli_gripper_draws_pressures(tmp_path, capsys):
     ({"reference": {"kind": "sine", "mean": 20, "amplitude": 30, "frequency": 0.04}},
      "reference.amplitude"),
     ({"reference": {"kind": "ramp"}}, "reference.kind"),
-    ({"reference": {"kind": "schedule", "times": [0, 5, 3], "angles": [0, 1, 2]}},
+    ({"reference": {"kind": "schedule", "times": [0, 5, 3], "angles": [0, 10, 20]}},
      "reference.times"),
     ({"time": {"duration": "10 s", "step": "-1 ms"}}, "time.step"),
     ({"supply": {"voltage": "200 V"}}, "supply.voltage"),

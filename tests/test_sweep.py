@@ -328,7 +328,7 @@ def test_sel_finds_grid_points_typed_in_si_or_with_units():
         **SMALL["grid"], "radius": {"start": 5, "stop": 25, "num": 41, "units": "mm"}}}))
     for mm in np.arange(5, 25.01, 0.5):  # every grid point by its decimal, no 'nearest'
         ds.sel(radius=float(f"{mm / 1000:.4g}"))
-    one = ds.nf.sel(radius="10.5 mm", wall_thickness=3, wrap_angle="20deg")
+    one = ds.nf.sel(radius="10.5 mm", wall_thickness=0.003, wrap_angle="20deg")  # bare: SI
     assert float(one["radius"]) == 0.0105 and float(one["wall_thickness"]) == 0.003
     # the display-unit copy for plots: values and units attrs converted, SI cube untouched
     shown = one["torque_max"].nf.display()
@@ -339,3 +339,12 @@ def test_sel_finds_grid_points_typed_in_si_or_with_units():
 
     with pytest.raises(InputError, match="stroke_max: not an axis"):
         ds.nf.sel(stroke_max=1)
+    # issue 46: a bare number is SI; a miss names how it was read and the nearest values
+    with pytest.raises(KeyError, match=r"radius=7\.5 \(read in SI 7\.5 m\) is not a grid "
+                       r"value; nearest: 0\.0245 m \(24\.5 mm\), 0\.025 m \(25 mm\); a bare "
+                       r"number is SI \(m\): write '7\.5mm'"):
+        ds.nf.sel(radius=7.5)
+    with pytest.raises(InputError, match=r"read as 0\.0103 m\) is not a grid value; "
+                       r"nearest: 0\.01 m \(10 mm\), 0\.0105 m"):
+        ds.nf.sel(radius="10.3mm")
+    assert float(ds.nf.sel(radius=0.0075)["radius"]) == 0.0075

@@ -390,9 +390,19 @@ def _silicone_result(sol, model, test, lam, stress, scale, table, name, n_terms)
                          f"solution (R^2 = {r2:.3g} < {MIN_R2}); is this a loading curve?")
     notes = []
     if sol.method == "ar1":
+        # issue 46: [0, 48 kPa] beside R^2 0.997 read as a failed fit; say what each means
+        # the effective number of independent points of n AR(1) errors (of their mean)
+        k = np.arange(1, len(lam))
+        n_eff = len(lam) / (1.0 + 2.0 * np.sum((1.0 - k / len(lam)) * sol.rho ** k))
         notes.append(f"intervals allow for residuals correlated along the pull: AR(1) "
                      f"lag-1 correlation {sol.rho:.3g} (likely {sol.rho_set[0]:.3g}-"
-                     f"{sol.rho_set[1]:.3g}; the widest interval over that range)")
+                     f"{sol.rho_set[1]:.3g}; the widest interval over that range); R^2 "
+                     f"{r2:.4g} says the curve is fitted well, the intervals say how far a "
+                     f"second specimen's parameters may lie: the residuals are one smooth "
+                     f"misfit, so the {len(lam)} points weigh like about {n_eff:.2g} "
+                     f"independent ones; an interval ending at 0 is cut at the bound "
+                     f"(mu_i alpha_i >= 0); more specimens narrow them "
+                     f"(docs/calibration.md)")
     return FitResult(
         kind="silicone", model=model, test=test, name=name, parameters=params,
         stderr=stderr, ci95=ci95, parameter_order=order, covariance=cov,

@@ -92,6 +92,6 @@ def compare(ds, *, variable="tip_force_max", wall_thickness=None, length=None,
     sub = ", ".join(_eq(n, v) for n, v in at.items())
     _suptitle(fig, f"Figure compare: {VARIABLES[variable].long_name} against radius, "
               "every model",
-              f"at {sub}\n(the paper's first example's slice)")
+              f"at {sub}\n(the paper's first example's slice)")  # one line was clipped
     _footer(fig, ds)
     return fig

@@ -80,8 +80,12 @@ def figure9(ds):
         title = f"Step response: rise time (10-90 %) {rise_s}, overshoot " \
                 f"{100 * a.get('overshoot', math.nan):.2f} %"
     else:
-        title = f"Tracking: RMS error {math.degrees(a.get('rms_error', math.nan)):.2f} deg " \
-                f"({100 * a.get('rms_error_fraction', math.nan):.1f} % of the span)"
+        # the fraction is of the reference's size: a sine's amplitude, a schedule's range
+        size = {"sine": "amplitude", "schedule": "range"}.get(kind, "reference's size")
+        rms, frac = a.get("rms_error", math.nan), a.get("rms_error_fraction", math.nan)
+        of = f"{math.degrees(rms / frac):.0f} deg {size}" if frac > 0 else size
+        title = f"Tracking: RMS error {math.degrees(rms):.2f} deg " \
+                f"({100 * frac:.1f} % of the {of})"
     ax.set_title(f"{_design_line(ds)}\n{title}", fontsize=10)
     ax.legend(loc="lower right", fontsize=8)
     power = ds["power"].values

@@ -2,9 +2,11 @@
 
 Each command is a module of this package with ``HELP`` (one line), ``add_arguments(parser)``
 and ``run(args) -> int``; it calls library functions that return values and prints them. No
-science lives here. Exit status: 0 done, 2 bad input (one line naming the field), 1 other
-failure, 128 + the signal for a run a signal stopped (130 Ctrl-C, 143 SIGTERM). A
-traceback is printed only with ``--debug``.
+science lives here. Exit status: 0 done (also when the reader of the output has gone:
+``nylonflex list | head -1``), 2 bad input (one line naming the field) or a problem of the
+environment (a read-only or full folder, a missing extra, a damaged chunk: one line naming
+it, :func:`environment_problem`), 1 other failure, 128 + the signal for a run a signal
+stopped (130 Ctrl-C, 143 SIGTERM). A traceback is printed only with ``--debug``.
 
 Command modules import nothing heavy at module level, so ``nylonflex --help`` stays light.
 """
@@ -13,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import errno as errnos
 import importlib
 import os
 import signal
@@ -21,6 +24,7 @@ import threading
 import warnings
 
 from .. import __version__
+from ._common import say
 
 EXIT_OK, EXIT_FAILURE, EXIT_INPUT = 0, 1, 2
 
@@ -106,6 +110,10 @@ def run():
     """
     _block_unused_dask(_command(sys.argv[1:]))
     code = main()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:  # the last of the output, into a closed pipe
+        code = closed_output()
     try:
         sys.stdout.flush()
         sys.stderr.flush()
@@ -231,6 +239,8 @@ def _main(argv=None) -> int:
     except KeyboardInterrupt:
         print("nylonflex: interrupted", file=sys.stderr)
         return interrupted_status()
+    except BrokenPipeError:  # `nylonflex list | head -1`: the reader has all it wanted
+        return closed_output()
     except Exception as exc:  # noqa: BLE001 - one line for the user, --debug for the rest
         if args.debug:
             raise
@@ -240,9 +250,89 @@ def _main(argv=None) -> int:
         if isinstance(exc, ValueError):  # InputError and the physics' range checks
             print(f"nylonflex {args.command}: error: {one_line(exc)}", file=sys.stderr)
             return EXIT_INPUT
+        problem = environment_problem(exc, args)
+        if problem:  # the machine's, not the program's: a read-only folder, an extra
+            print(f"nylonflex {args.command}: error: {problem}", file=sys.stderr)
+            return EXIT_INPUT
         print(f"nylonflex {args.command}: failed: {type(exc).__name__}: {one_line(exc)}",
               file=sys.stderr)
         return EXIT_FAILURE
+
+
+def closed_output() -> int:
+    """The reader of stdout has gone (a pipe into ``head``): stop quietly with status 0.
+
+    Python's own advice (the signal module's docs, "Note on SIGPIPE"): point stdout at
+    /dev/null, so that the interpreter's last flush does not fail again.
+    """
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return EXIT_OK
+
+
+#: Optional dependencies by the module a command imports: ImportError -> what to install.
+EXTRAS = {"felupe": "fe", "bokeh": "explore", "zstandard": "zstd", "hdf5plugin": "zstd",
+          "distributed": "dask", "dask": "dask"}
+
+#: errno values of an OSError that is the machine's state, not the program's fault.
+_ENV_ERRNOS = {"EACCES": "permission denied", "EPERM": "not permitted",
+               "EROFS": "a read-only file system", "ENOSPC": "no space left on the device",
+               "EDQUOT": "the disk quota is exceeded"}
+
+#: The words of HDF5's error for a chunk whose bytes do not decode.
+_DAMAGED = ("filter returned failure", "can't synchronously read data", "can't read data")
+
+
+def environment_problem(exc, args=None) -> str | None:
+    """One line for an exception that is the environment's (exit 2), else None.
+
+    A folder or disk that refuses the write (permission, read-only, full), an optional
+    dependency not installed (its extra named, :data:`EXTRAS`), a cube whose chunk does not
+    decode (the chunk named, by :func:`nylonflex.storage.check_cube`).
+    """
+    if type(exc).__name__ in ("MissingPlugin", "DiskFull"):
+        return one_line(exc)
+    if isinstance(exc, ImportError):
+        top = (getattr(exc, "name", None) or "").split(".")[0]
+        if top in EXTRAS:
+            return (f"needs the optional package {top}: pip install "
+                    f"'nylonflex[{EXTRAS[top]}]'")
+        return None
+    if not isinstance(exc, OSError):
+        return None
+    code = errnos.errorcode.get(exc.errno or -1, "")
+    if code in _ENV_ERRNOS:
+        where = exc.filename or getattr(args, "out", None) or "the output"
+        if os.path.basename(str(where)).startswith("."):  # a temporary beside the file
+            where = os.path.dirname(str(where)) or "."
+        todo = "free some space there, or write somewhere else (--out)" \
+            if code in ("ENOSPC", "EDQUOT") else "write somewhere else (--out)"
+        return f"cannot write {where}: {_ENV_ERRNOS[code]}; {todo}"
+    if any(w in str(exc).lower() for w in _DAMAGED):
+        return _damaged_chunk(getattr(args, "cube", None), exc)
+    return None
+
+
+def _damaged_chunk(cube, exc) -> str:
+    """The damaged chunk of ``cube`` named (the first :func:`check_cube` finds)."""
+    found = []
+    if cube:
+        try:
+            from ..storage import check_cube
+
+            found = check_cube(cube, full=True)
+        except Exception:  # noqa: BLE001 - the original error is reported instead
+            found = []
+    if found:
+        more = f" (and {len(found) - 1} more: nylonflex info {cube} --check)" \
+            if len(found) > 1 else ""
+        return f"{found[0]}{more}"
+    return (f"{cube or 'the cube'}: a chunk cannot be read ({one_line(exc)}); the cube is "
+            f"damaged: 'nylonflex info {cube or 'CUBE'} --check' names it; sweep it again "
+            "with --overwrite")
 
 
 class _compile_notices:
@@ -257,8 +347,8 @@ class _compile_notices:
         self._show = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
-            if category.__name__ == "CompileWarning":
-                print(f"nylonflex {self.command}: {message}", file=sys.stderr, flush=True)
+            if category.__name__ == "CompileWarning":  # above a progress bar, never in it
+                say(f"nylonflex {self.command}: {message}")
             else:
                 self._show(message, category, filename, lineno, file, line)
 
@@ -277,8 +367,9 @@ def one_line(exc) -> str:
 
 
 def warn(command: str, message: str):
-    """One warning line on stderr, ``nylonflex COMMAND: warning: ...``."""
-    print(f"nylonflex {command}: warning: {message}", file=sys.stderr)
+    """One warning line on stderr, ``nylonflex COMMAND: warning: ...`` (above a progress
+    bar, never in it)."""
+    say(f"nylonflex {command}: warning: {message}")
 
 
 if __name__ == "__main__":  # pragma: no cover

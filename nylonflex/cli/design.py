@@ -22,13 +22,15 @@ def add_arguments(p):
     p.add_argument("--cube", metavar="PATH", help="start from this cube instead of the spec's")
     p.add_argument("--format", choices=["table", "json", "csv"], default="table")
     p.add_argument("--chart", metavar="DIR", help="draw the Pareto front into DIR")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress (a bar on a terminal, else a line a minute)")
 
 
 def run(args) -> int:
     from ..design import run_design
     from ..design.report import format_csv, format_json, format_table, summary
 
-    with progress_bar("refine", unit="start") as bar:
+    with progress_bar("refine", unit="start", quiet=args.quiet, command="design") as bar:
         res = run_design(args.spec, cube=args.cube, progress=bar)
     fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
     sys.stdout.write(fmt(res))

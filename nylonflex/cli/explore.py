@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..units import InputError
 from . import warn
-from ._common import open_cube_for
+from ._common import open_cube_for, progress_bar
 
 HELP = "explore a cube in a local web page (or write one offline HTML file)"
 DESCRIPTION = """\
@@ -32,6 +32,8 @@ def add_arguments(p):
     p.add_argument("--html", metavar="OUT.html", help="write one offline HTML file and exit")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --html file")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.add_argument("--quiet", action="store_true",
+                   help="--html: no progress (a bar on a terminal, else a line a minute)")
     p.add_argument("--where", action="append", default=[], metavar="EXPR",
                    help="mark the designs that meet EXPR (as query --where, e.g. "
                         "\"tip_force_max >= 0.5 N\"; repeat to AND) and list them in a "
@@ -41,7 +43,7 @@ def add_arguments(p):
                         "'cooling' coordinate; nylonflex info lists them)")
 
 
-_NEEDS_EXTRA = "nylonflex explore: failed: {what}: pip install 'nylonflex[explore]'"
+_NEEDS_EXTRA = "nylonflex explore: error: {what}: pip install 'nylonflex[explore]'"
 
 
 def _has(module: str) -> bool:
@@ -84,14 +86,15 @@ def run(args) -> int:
     ds, source = _one_cooling(ds, args.cooling, str(args.cube))
     if not _has("bokeh"):
         print(_NEEDS_EXTRA.format(what="the explorer needs Bokeh"), file=sys.stderr)
-        return 1
+        return 2  # the environment's: exit 2, one line (cli.environment_problem)
     from ..explore.page import build_html, serve
 
     fidelity = _fidelity(args.cube)
     if args.html:
         from ..storage.files import write_atomic
 
-        text = build_html(ds, source=source, where=where, fidelity=fidelity)
+        with progress_bar("explore --html", unit="s", quiet=args.quiet, command="explore"):
+            text = build_html(ds, source=source, where=where, fidelity=fidelity)
         write_atomic(out, text.encode("utf-8"), "--html", inputs=[args.cube])
         print(f"{out}  {len(text) / 1e6:.1f} MB  offline explorer of {args.cube}")
         return 0

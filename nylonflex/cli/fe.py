@@ -136,5 +136,9 @@ def run(args) -> int:
         print(f"{p / 1e3:9.3f} {fe_text} {err_text} " + " ".join(f"{c:>16}" for c in cells))
     if not np.all(np.isfinite(res["bend_angle"])):
         print("-: not reached: the FE solve stalled (at large bends; docs/fidelity.md, status)")
+    from ..variants import VARIANTS
+
+    print("models: " + "; ".join(f"{n}: {VARIANTS[n].short}" if n in VARIANTS else n
+                                 for n in names) + " (nylonflex list models)")
     sys.stdout.flush()
     return 0

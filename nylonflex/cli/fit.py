@@ -65,6 +65,8 @@ def add_arguments(p):
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     p.add_argument("--chart", metavar="DIR", help="draw data, fit and residuals into DIR")
     p.add_argument("--format", choices=["table", "json"], default="table")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress (a bar on a terminal, else a line a minute)")
     p.add_argument("--designs", type=int, default=48,
                    help="fe: training designs (default 48, at most 500)")
     p.add_argument("--workers", type=int, default=1, help="fe: local processes (default 1)")
@@ -194,7 +196,7 @@ def run_fe(args) -> int:
     require_felupe()
     plan = training_plan(args.designs, args.seed, args.mesh)
     parts = out.with_name(out.name + ".parts")
-    with progress_bar("fit fe", unit="design", quiet=False, delay=0.0) as bar:
+    with progress_bar("fit fe", unit="design", quiet=args.quiet, delay=0.0) as bar:
         done = run_training(parts, plan, workers=args.workers, progress=bar,
                             log=lambda m: print(f"nylonflex fit fe: {m}", file=sys.stderr))
     res = fit_correction(plan, done)
@@ -315,7 +317,8 @@ def run(args) -> int:
         refuse_special(Path(args.out), "--out", inputs)
         if os.path.lexists(args.out) and not args.overwrite:
             raise InputError(f"--out {args.out}: exists; give --overwrite to replace it")
-    res = fit(args)
+    with progress_bar(f"fit {args.kind}", unit="s", quiet=args.quiet, command="fit"):
+        res = fit(args)  # the time elapsed (a fit has no count to show)
     if args.out:
         write_material_file(res, args.out, name=args.name or None, overwrite=args.overwrite,
                             inputs=inputs)

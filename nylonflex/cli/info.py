@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ..units import InputError
+from ..units import InputError, json_text
 from ._common import progress_bar
 
 HELP = "describe a cube"
@@ -15,6 +15,8 @@ def add_arguments(i):
     i.add_argument("--check", action="store_true",
                    help="read every chunk of every variable (bounded memory) and list the "
                         "unreadable ones; exit 1 if any")
+    i.add_argument("--format", choices=["text", "json"], default="text",
+                   help="text (display units) or json (SI, with each axis's display unit)")
     i.add_argument("--config", action="store_true",
                    help="print the cube's config as a runnable YAML (nylonflex info CUBE "
                         "--config > c.yaml && nylonflex sweep c.yaml recomputes it)")
@@ -34,6 +36,8 @@ def run(args) -> int:
         print(runnable_config(attrs), end="")
         return 0
 
+    if args.format == "json":
+        return _json(args)
     lines = cube_summary(args.cube)
     for line in lines:
         print(line)
@@ -50,6 +54,20 @@ def run(args) -> int:
               if problems else "check     every chunk of every variable read")
         damaged = damaged or bool(problems)
     return 1 if damaged else 0
+
+
+def _json(args) -> int:
+    """``info --format json``: the cube's description as one JSON object (SI values)."""
+    from ..storage import check_cube, cube_description
+    d = cube_description(args.cube)
+    fidelity = _fidelity_lines(args.cube)
+    if fidelity:
+        d["fidelity"] = [line.strip() for line in fidelity]
+    if args.check:
+        with progress_bar("check", unit="variable") as bar:
+            d["unreadable_chunks"] = check_cube(args.cube, full=True, progress=bar)
+    sys.stdout.write(json_text(d))
+    return 1 if d["damaged"] or d.get("unreadable_chunks") else 0
 
 
 def _fidelity_lines(cube) -> list[str]:

@@ -40,8 +40,10 @@ def add_arguments(q):
                    help="between grid points, interpolate the cube linearly instead of "
                         "evaluating the exact model")
     q.add_argument("--where", action="append", default=[], metavar="EXPR",
-                   help='filter, e.g. "tip_force_max >= 0.5 N" (repeatable, ANDed); '
-                        "OP one of <, <=, ==, !=, >=, >")
+                   help='filter, e.g. "tip_force_max >= 0.5 N", "radius <= 10mm", '
+                        '"bend_angle_max >= 180deg" (repeatable, ANDed); OP one of <, <=, '
+                        "==, !=, >=, >; a bare number is in the display unit (mm, deg, kPa, "
+                        "N mm, ...: nylonflex list variables)")
     q.add_argument("--sort", metavar="NAME",
                    help=f"order by one of: {', '.join(COLUMNS)} (-NAME or NAME:desc for "
                         "descending)")
@@ -63,22 +65,27 @@ def run(args) -> int:
     from ..query import (format_csv, format_json, format_table, held_back, parse_at,
                          parse_where, query_cube)
 
+    from ..query.notes import unit_notes
+
     ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
     try:
+        where = parse_where(args.where)
         with progress_bar("query", unit="slab", quiet=args.quiet) as bar:
             res = query_cube(ds, at=parse_at(args.at) if args.at else None,
-                             where=parse_where(args.where), sort=args.sort,
+                             where=where, sort=args.sort,
                              limit=args.limit, interpolate=args.interpolate,
                              columns=args.columns,
-                             progress=bar, log=lambda m: print(f"nylonflex query: {m}",
-                                                               file=sys.stderr))
+                             progress=bar, log=lambda m: bar.write(f"nylonflex query: {m}"))
         if res.single and len(res) == 1 and np.isnan(res.data["tip_force_max"][0]):
             raise InputError("--at: this design is not in the cube yet (an incomplete "
                              "cube); finish the sweep with 'nylonflex sweep CONFIG --resume'")
+        notes = unit_notes(ds, where, res.matched) if not res.point else []
     finally:
         ds.close()
     fmt = {"table": format_table, "json": format_json, "csv": format_csv}[args.format]
     sys.stdout.write(fmt(res))
+    for note in notes:  # a bare number read in mm or deg where the answer hints at m or rad
+        print(f"nylonflex query: note: {note}", file=sys.stderr)
     hidden = held_back(res)
     if hidden and args.format == "csv":  # a table and JSON say so themselves
         print(f"nylonflex query: {len(res)} rows of {res.matched} matching; {hidden} held "

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..units import InputError, json_text
+from ._common import progress_bar
 
 HELP = "Sobol' sensitivity of design variables to the uncertain parameters"
 DESCRIPTION = """Sobol' first-order and total indices (SALib, Saltelli sampling, 95 %
@@ -39,6 +40,8 @@ def add_arguments(p):
                    help="override a config key")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument("--chart", metavar="DIR", help="write the bar chart sensitivity.png there")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress (a bar on a terminal, else a line a minute)")
 
 
 def run(args) -> int:
@@ -51,8 +54,9 @@ def run(args) -> int:
     at = parse_at(args.at) if args.at else {}
     if args.designs < 1:
         raise InputError(f"--designs: must be 1 or more, got {args.designs}")
-    res = sobol_indices(cfg, tuple(args.output), at=at, base_samples=args.samples,
-                        max_designs=args.designs)
+    with progress_bar("sensitivity", unit="step", quiet=args.quiet) as bar:
+        res = sobol_indices(cfg, tuple(args.output), at=at, base_samples=args.samples,
+                            max_designs=args.designs, progress=bar)
     if args.chart:
         path = Path(args.chart) / "sensitivity.png"
         from ..charts.sensitivity import sensitivity_chart

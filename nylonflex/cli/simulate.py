@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ._common import progress_bar
+
 HELP = "simulate the closed loop in time"
 
 
@@ -11,6 +13,8 @@ def add_arguments(m):
     m.add_argument("config", help="YAML simulation config (configs/control.yaml)")
     m.add_argument("--out", help="output file (default sweeps/<name>/sim.h5)")
     m.add_argument("--no-charts", action="store_true", help="skip the chart")
+    m.add_argument("--quiet", action="store_true",
+                   help="no progress (a bar on a terminal, else a line a minute)")
 
 
 def run(args) -> int:
@@ -21,7 +25,8 @@ def run(args) -> int:
     from ..storage.files import refuse_special
 
     refuse_special(out, "--out", inputs=[args.config])  # before the work
-    ds = run_simulation(cfg)
+    with progress_bar("simulate", unit="s", quiet=args.quiet):  # the time elapsed
+        ds = run_simulation(cfg)
     write_simulation(ds, out, inputs=[args.config])
     written = [str(out)]
     if not getattr(args, "no_charts", False):

@@ -17,7 +17,9 @@ def add_arguments(s):
     s.add_argument("config", help="YAML config ('nylonflex init' writes examples to edit)")
     s.add_argument("--out", help="cube path (default sweeps/<name>/cube.h5)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a config key, e.g. grid.radius.num=81 (repeatable)")
+                   help="override a config key, e.g. grid.radius.num=81 or "
+                        "silicone.file=fits/my.yaml (repeatable; a file path is read from "
+                        "the current folder, one in the config from the config's folder)")
     s.add_argument("--resume", action="store_true", help="finish an interrupted run")
     s.add_argument("--overwrite", action="store_true",
                    help="replace a cube already at --out (the old one stays until the new "
@@ -32,28 +34,6 @@ def add_arguments(s):
                         "estimated time (measured on a small sample); write nothing")
 
 
-class _NoBar:
-    """The bar when there is no terminal (or --quiet): tqdm is not even imported."""
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
-    def update(self, n):
-        pass
-
-
-def _progress(total, quiet):
-    if quiet or not sys.stderr.isatty():
-        return _NoBar()
-    from tqdm import tqdm
-
-    return tqdm(total=total, unit="design", unit_scale=True, desc="sweep", smoothing=0.1,
-                dynamic_ncols=True)
-
-
 def run(args) -> int:
     return _run(args, charts=not (args.no_charts or args.dry_run))
 
@@ -61,9 +41,11 @@ def run(args) -> int:
 def _run(args, charts: bool) -> int:
     from ..storage.files import refuse_special
 
+    bar = None  # while the sweep's bar shows, a message goes above it, never into it
+
     def log(msg):
         if not args.quiet:
-            print(msg, file=sys.stderr)
+            bar.write(msg) if bar is not None else print(msg, file=sys.stderr)
 
     # from the kernels' loading to the sweep's end, Ctrl-C and SIGTERM are recorded, never
     # raised inside a finaliser where Python would drop them (Numba's loading runs them):
@@ -85,10 +67,13 @@ def _run(args, charts: bool) -> int:
             prepare(cfg, workers=args.workers, scheduler=args.scheduler, log=log,
                     meanwhile=_chart_libraries if charts and cfg.charts and not unchanged
                     else None)
-        with _progress(cfg.n_designs, args.quiet) as bar:
+        with progress_bar("sweep", unit="design", quiet=args.quiet, delay=0.0,
+                          unit_scale=True) as bar:
+            bar(0, cfg.n_designs)
             sweep_file(cfg, out, resume=args.resume, workers=args.workers,
                        scheduler=args.scheduler, progress=bar.update, log=log,
                        overwrite=args.overwrite)
+        bar = None
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if not charts or not cfg.charts:
         return 0

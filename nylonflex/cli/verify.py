@@ -54,7 +54,7 @@ def run(args) -> int:
         path = run_verify(args.cube, args.designs, workers=args.workers,
                           scheduler=args.scheduler, mesh=args.mesh, seed=args.seed,
                           progress=bar,
-                          log=lambda m: print(f"nylonflex verify: {m}", file=sys.stderr))
+                          log=lambda m: bar.write(f"nylonflex verify: {m}"))
     with xr.open_dataset(path, engine="h5netcdf") as fid:
         fid.load()
     chart = path.with_name(path.name.removesuffix(".nc") + "_map.png")

@@ -13,7 +13,8 @@ import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Tag, ValidationError
 
 from ..materials import Cooling, Nylon, cooling_parameters
-from ..units import InputError, from_si, parse_quantity, short
+from ..units import (InputError, bare_angle_error, bare_number, from_si, parse_quantity,
+                     plainly_degrees, short, slip_hint)
 
 __all__ = ["Count", "Number", "check_range", "check_run_name", "range_error", "resolve_cooling",
            "valid_name"]
@@ -116,7 +117,7 @@ def range_error(field: str, lo, hi, display_unit: str, got, lo_open: bool = Fals
 
 def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
                 display_unit: str | None = None, *, lo_open: bool = False,
-                hi_open: bool = False, slack: float = 0.0) -> float:
+                hi_open: bool = False, slack: float = 0.0, unit_stated: bool = False) -> float:
     """Parse a quantity (``"7.5 mm"`` or a bare number in ``unit``) to SI and check its range.
 
     Parameters
@@ -137,6 +138,11 @@ def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
         Whether the bound itself is refused.
     slack : float
         Tolerance on a closed bound, SI; a value within it is clamped onto the bound.
+    unit_stated : bool
+        The config states ``unit`` for a bare number (an axis's ``units: deg``). Otherwise a
+        bare angle is read as degrees only when it is plainly degrees
+        (:func:`nylonflex.units.plainly_degrees`: 0, or beyond ``hi`` read as radians), and
+        refused naming the radians slip else.
 
     Returns
     -------
@@ -146,8 +152,14 @@ def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
     Raises
     ------
     InputError
-        Not a number, a unit of another kind, or out of range: one line naming ``field``.
+        Not a number, a unit of another kind, a bare angle that may be radians, or out of
+        range: one line naming ``field`` (and, for a bare number that would be in range in
+        another unit, that unit: 0.0075 typed for mm reads as 7.5 um; did you mean m?).
     """
+    bare = bare_number(raw)
+    if kind == "angle" and bare is not None and not unit_stated and \
+            not plainly_degrees(bare, 2 * math.pi if hi is None else hi):
+        raise bare_angle_error(field, bare)
     value = float(parse_quantity(raw, field, kind, unit))
     ok = math.isfinite(value)
     if lo is not None:
@@ -155,7 +167,10 @@ def check_range(raw, field: str, kind: str, unit: str, lo=None, hi=None,
     if hi is not None:
         ok = ok and (value < hi if hi_open else value <= hi + slack)
     if not ok:
-        raise range_error(field, lo, hi, display_unit or unit, value, lo_open, hi_open)
+        err = range_error(field, lo, hi, display_unit or unit, value, lo_open, hi_open)
+        hint = slip_hint(bare, kind, unit, lo, hi) if bare is not None and \
+            math.isfinite(value) else ""
+        raise InputError(f"{err}{hint}") if hint else err
     if lo is not None and not lo_open:
         value = max(value, lo)
     if hi is not None and not hi_open:

@@ -38,7 +38,7 @@ from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_par
 from ..physics.nylon import stroke
 from ..physics.thermal import cooled_nylon, muscle_resistance, steady_temperature
 from ..physics.wrap import muscle_length
-from ..units import InputError, from_si
+from ..units import InputError, bare_number, from_si, plainly_degrees
 from .base import _no_bool, _pydantic_message, _Strict, check_range, check_run_name, \
     range_error, resolve_cooling
 from .material_files import anchor_material_files
@@ -394,8 +394,8 @@ def _reference(ref, path: str, duration: float) -> Reference:
     if ref is None:
         raise InputError(f"{path}: missing; give kind: sine, step or schedule")
 
-    def angle(raw, key, lo=0.0, hi=_FULL_TURN):
-        return check_range(raw, f"{path}.{key}", "angle", "deg", lo, hi)
+    def angle(raw, key, lo=0.0, hi=_FULL_TURN, stated=False):
+        return check_range(raw, f"{path}.{key}", "angle", "deg", lo, hi, unit_stated=stated)
 
     if ref.kind == "sine":
         p = {"mean": angle(ref.mean, "mean"),
@@ -420,7 +420,10 @@ def _reference(ref, path: str, duration: float) -> Reference:
             raise InputError(f"{path}.{key}: must be a non-empty list, got []")
     times = [check_range(v, f"{path}.times[{i}]", "time", "s")
              for i, v in enumerate(ref.times)]
-    angles = [angle(v, f"angles[{i}]") for i, v in enumerate(ref.angles)]
+    # a schedule of bare angles is degrees when one of them is plainly degrees: [0, 40, 0]
+    plain = any((b := bare_number(v)) is not None and b != 0.0 and
+                plainly_degrees(b, _FULL_TURN) for v in ref.angles)
+    angles = [angle(v, f"angles[{i}]", stated=plain) for i, v in enumerate(ref.angles)]
     if len(times) != len(angles):
         raise InputError(f"{path}.angles: needs one angle per time ({len(times)}), "
                          f"got {len(angles)}")

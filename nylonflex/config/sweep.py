@@ -28,7 +28,8 @@ from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_par
 from ..query.parse import parse_requirements
 from .material_files import anchor_material_files, read_chamber_file
 from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
-from ..units import InputError, decimal_to_si, parse_decimal, short, to_si
+from ..units import (InputError, bare_number, decimal_to_si, parse_decimal, plainly_degrees,
+                     short, to_si)
 from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES
 from .charts import CHART_REGISTRY
 from .base import (
@@ -278,8 +279,16 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
     if name == "coil_index":
         lo, hi = nylon.coil_index_range
 
+    # a bare angle is degrees when the axis says so, or when one of its values is plainly
+    # degrees (beyond the largest angle, read as radians): [5, 8, 12] (units.plainly_degrees)
+    typed = axis.values if axis.values is not None else (axis.start, axis.stop)
+    stated = axis.units is not None or (kind == "angle" and any(
+        (b := bare_number(t)) is not None and b != 0.0 and plainly_degrees(b, hi)
+        for t in typed))
+
     def value(text, field):
-        return check_range(text, field, kind, units, lo, hi, shown, slack=1e-12)
+        return check_range(text, field, kind, units, lo, hi, shown, slack=1e-12,
+                           unit_stated=stated)
 
     if axis.values is not None:
         if len(axis.values) == 0:

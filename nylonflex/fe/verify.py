@@ -223,23 +223,34 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     return path
 
 
-def fidelity_stats(fid) -> list[dict]:
-    """Per model of a fidelity dataset, model/FE over every design and pressure where the FE
-    reached it: ``model``, ``median``, ``min``, ``max`` [1], ``within`` (how many within
-    10 %) and ``n``; models with no finite ratio are left out."""
+def fidelity_stats(fid, level=None) -> list[dict]:
+    """Per model of a fidelity dataset, model/FE where the FE reached it, over every design
+    at ``level`` (a fraction of p*; None: every level): ``model``, ``median``, ``min``,
+    ``max`` [1], ``within`` (how many within 10 %) and ``n``; models with no finite ratio
+    are left out. The numbers of :func:`nylonflex.charts.fidelity.ratio_stats`, which the
+    map's titles use too."""
+    from ..charts.fidelity import ratio_stats
+
     out = []
     for model in fid["model"].values:
-        r = fid["ratio"].sel(model=model).values.ravel()
-        r = r[np.isfinite(r)]
-        if r.size:
-            out.append({"model": str(model), "median": float(np.median(r)),
-                        "min": float(r.min()), "max": float(r.max()),
-                        "within": int(np.sum(np.abs(r - 1.0) <= 0.1)), "n": int(r.size)})
+        r = fid["ratio"].sel(model=model)
+        if level is not None:
+            r = r.sel(level=level, method="nearest")
+        st = ratio_stats(r.values)
+        if st is not None:
+            out.append({"model": str(model), **st})
     return out
 
 
 def fidelity_summary(fid) -> list[str]:
-    """One line a model of a fidelity dataset: model/FE over every design and pressure."""
-    return [f"{s['model']:<17} model/FE median {s['median']:.3f}, range "
-            f"{s['min']:.3f}-{s['max']:.3f}, within 10 %: {100 * s['within'] / s['n']:.0f} % "
-            f"({s['n']} FE angles)" for s in fidelity_stats(fid)]
+    """One line a model and pressure level of a fidelity dataset (at p*, the map's level,
+    the same numbers as the map's titles), then over every level."""
+    levels = sorted((float(x) for x in fid["level"].values), reverse=True)
+    lines = []
+    for lv in levels + ([None] if len(levels) > 1 else []):
+        at = "every level" if lv is None else "at p*" if lv == 1.0 else f"at {lv:g} p*"
+        lines += [f"{s['model']:<17} {at:<11} model/FE median {s['median']:.3f}, range "
+                  f"{s['min']:.3f}-{s['max']:.3f}, within 10 %: "
+                  f"{100 * s['within'] / s['n']:.0f} % ({s['n']} FE angles)"
+                  for s in fidelity_stats(fid, lv)]
+    return lines

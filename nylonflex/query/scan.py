@@ -42,8 +42,9 @@ def locate(ds, name, value):
         unit = "" if v.display == "1" else f" {v.display}"
         shown = ", ".join(f"{x:g}" for x in from_si(grid, v.display)) if grid.size <= 8 \
             else f"{from_si(lo, v.display):g} .. {from_si(hi, v.display):g}"
+        bare = f" (a bare number is read in {v.display})" if unit else ""
         raise InputError(f"--at: {name}={from_si(value, v.display):g}{unit} is outside the "
-                         f"cube's grid; {name} takes {shown}{unit}")
+                         f"cube's grid; {name} takes {shown}{unit}{bare}")
     if np.any(np.diff(grid) <= 0):  # a grid the sweep wrote is increasing; be safe
         raise InputError(f"--at: the cube's {name} axis is not increasing; cannot interpolate")
     i1 = int(np.searchsorted(grid, value))

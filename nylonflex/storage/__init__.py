@@ -20,6 +20,7 @@ _WHERE = {
     "CubeFile": ".cube",
     "Journal": ".journal", "exclusive": ".journal",
     "check_cube": ".reader", "cube_attrs": ".reader", "cube_summary": ".reader",
+    "cube_description": ".reader",
     "open_cube": ".reader",
     "CubeSink": ".run", "DiskFull": ".run", "Interrupted": ".run", "sweep_to_file": ".run",
 }

@@ -6,18 +6,39 @@ Dataset. The cube itself stays SI; these give display-unit copies for plots and 
 
     ds = nf.open_cube("sweeps/fig12/cube.h5")
     ds.nf.sel(radius="10.5 mm", wrap_angle="8 deg")     # sel with units (exact grid values)
+    ds.nf.sel(radius=0.0105)                             # a bare number is SI, as in Python
     ds["tip_force_max"].nf.display()                     # N -> N, torque N m -> N mm, ...
     ds.nf.display()["radius"]                            # every registered variable
 """
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
-from ..units import InputError, parse_quantity
+from ..units import InputError, from_si, parse_quantity
 from ..variables import VARIABLES, to_display
 
-__all__ = ["CubeAccessor", "VariableAccessor"]
+__all__ = ["CubeAccessor", "NotOnGrid", "VariableAccessor"]
+
+
+class NotOnGrid(InputError, KeyError):
+    """A value ``ds.nf.sel`` does not find on the grid (a KeyError, as xarray's miss)."""
+
+    __str__ = Exception.__str__
+
+
+def _miss(name, typed, si, grid, v) -> str:
+    """One line: the value not on the grid, how it was read, the nearest grid values."""
+    near = grid[np.argsort(np.abs(grid - si))[:2]] if len(grid) else grid
+    show = ", ".join(f"{x:.6g} {v.units} ({from_si(x, v.display):.4g} {v.display})"
+                     for x in sorted(near))
+    read = "read in SI" if isinstance(typed, (int, float)) else "read as"
+    unit = "" if v.units == "1" else f" {v.units}"
+    return (f"{name}={typed!r} ({read} {si:.6g}{unit}) is not a grid value; nearest: {show}"
+            + (f"; a bare number is SI ({v.units}): write '{typed}{v.display}' for "
+               f"{v.display}" if isinstance(typed, (int, float)) and v.units != v.display
+               else ""))
 
 
 def _display(da: xr.DataArray, name: str | None = None) -> xr.DataArray:
@@ -55,16 +76,18 @@ class CubeAccessor:
         self._ds = ds
 
     def sel(self, **at) -> xr.Dataset:
-        """``ds.sel`` with values that carry units (``radius="10.5 mm"``; a bare number
-        is in the axis's display unit, as on the command line). Exact: the grid's
+        """``ds.sel`` with values in SI (``radius=0.0105`` [m], as everywhere in Python) or
+        with a unit (``radius="10.5 mm"``, ``wrap_angle="8deg"``). Exact: the grid's
         coordinates are the floats nearest their decimal values, and so is a value typed.
 
         Raises
         ------
         nylonflex.units.InputError
             A name that is not an axis of the cube, or a unit of the wrong kind.
-        KeyError
-            The value is not a grid value (xarray's own error).
+        NotOnGrid
+            The value is not a grid value: one line with the nearest grid values, in SI and
+            in the display unit (an :class:`~nylonflex.units.InputError` and a ``KeyError``,
+            as xarray's own miss is).
         """
         si = {}
         for name, value in at.items():
@@ -72,7 +95,10 @@ class CubeAccessor:
             if name not in self._ds.dims or v is None:
                 raise InputError(f"{name}: not an axis of this cube; axes: "
                                  f"{', '.join(d for d in self._ds.dims if d in VARIABLES)}")
-            si[name] = parse_quantity(value, name, v.kind, v.display)
+            si[name] = parse_quantity(value, name, v.kind, v.units)  # bare: SI
+            grid = self._ds[name].values
+            if not np.any(grid == si[name]):
+                raise NotOnGrid(_miss(name, value, si[name], grid, v))
         return self._ds.sel(si)
 
     def display(self) -> xr.Dataset:

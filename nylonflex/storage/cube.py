@@ -95,7 +95,7 @@ def _zstd(raw: bytes) -> bytes:
         try:
             import zstandard
         except ImportError:
-            raise RuntimeError(ZSTD_EXTRA) from None
+            raise MissingPlugin(ZSTD_EXTRA) from None
         compressor = _per_thread.zstd = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
     return compressor.compress(raw)
 

@@ -14,7 +14,8 @@ from .cube import STORED_DIMS, require_filters
 from .journal import Journal
 
 __all__ = ["MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_cube", "check_chunk_sizes",
-           "cube_attrs", "cube_summary", "logical_dims", "open_cube"]
+           "cube_attrs", "cube_description", "cube_summary", "logical_dims", "open_cube",
+           "summary_lines"]
 
 #: The largest chunk of a cube read [bytes]: a chunk is decoded whole, and nylonflex writes
 #: chunks of about 2 MB (a crafted 2^29-element chunk made ``info`` allocate 4 GiB).
@@ -147,33 +148,35 @@ def portable_encoding(encoding: dict) -> dict:
     return out
 
 
-def _validity_lines(f, h5, done) -> list[str]:
+def _validity_counts(f, h5, done) -> dict | None:
     """How many designs carry each validity bit (docs/model.md s. 17), per model.
 
     ``f`` is the open cube (h5netcdf), ``h5`` the same file in h5py (its data reads
     fast), ``done`` the radii computed (bool). Counted from a
     histogram of the flag bytes, radius slab by radius slab (one chunk row at a time): no
-    copy of the flags wider than a byte, memory bounded by one slab.
+    copy of the flags wider than a byte, memory bounded by one slab. None without flags.
     """
     if "validity" not in f.variables:
-        return []
+        return None
     var = f.variables["validity"]
     counts = _byte_histogram(h5["validity"], var.dimensions[:1] == ("radius",), done)
-    n_values = int(counts.sum())
-    n = n_values or 1
     meanings = str(var.attrs.get("flag_meanings", "")).split()
     bits = [int(x) for x in np.atleast_1d(var.attrs.get("flag_masks", []))]
     values = np.arange(256, dtype=np.uint8)  # each byte's value as the variable stores it
     values = (values.view(np.int8) if np.dtype(var.dtype).kind == "i" else values) \
         .astype(np.int64)
-    parts = [f"{name} {int(counts[(values & bit) > 0].sum()):,}"
-             for bit, name in zip(bits, meanings)]
-    flagged = int(counts[values > 0].sum())
-    over = [w for d, w in (("model", "model"), ("cooling", "cooling set"))
-            if d in var.dimensions]
-    per = f" (counted over every {' and '.join(over)})" if over else ""
-    return [f"flagged   {flagged:,} of {n_values:,} design values ({100 * flagged / n:.1f} %)"
-            f"{per}: " + ", ".join(parts)]
+    return {"flagged": int(counts[values > 0].sum()), "values": int(counts.sum()),
+            "over": [w for d, w in (("model", "model"), ("cooling", "cooling set"))
+                     if d in var.dimensions],
+            "by_flag": {name: int(counts[(values & bit) > 0].sum())
+                        for bit, name in zip(bits, meanings)}}
+
+
+def _validity_line(v) -> str:
+    per = f" (counted over every {' and '.join(v['over'])})" if v["over"] else ""
+    return (f"flagged   {v['flagged']:,} of {v['values']:,} design values "
+            f"({100 * v['flagged'] / (v['values'] or 1):.1f} %){per}: "
+            + ", ".join(f"{name} {n:,}" for name, n in v["by_flag"].items()))
 
 
 def flag_histogram(flags, piece: int = 1 << 18) -> np.ndarray:
@@ -325,20 +328,20 @@ def _check_dataset(path, name, dset, full):
     return out
 
 
-def _spread_lines(attrs) -> list[str]:
+def _spread_lines(variants) -> list[str]:
     """``info``'s lines of a cube with a model spread: its variants and variables."""
-    variants = _text(attrs["model_spread"]).split()
     return [f"spread    over {len(variants)} model variants (fidelity: spread): "
             f"{', '.join(variants)}",
             f"          <var>_model_lo/_hi of {', '.join(SPREAD_OF)}; validity_model_any: "
             "their flags ORed"]
 
 
-def cube_summary(path) -> list[str]:
-    """Lines that describe a cube: dims, ranges, variables, provenance, completeness.
+def cube_description(path) -> dict:
+    """A cube described as data (``nylonflex info --format json``): dims, ranges (SI and
+    the display unit), variables, flags, provenance and completeness.
 
     Read through h5netcdf (the netCDF-4 layout, no xarray, pandas or dask): the
-    coordinates, the attributes, ``slab_done`` and the flag bytes (:func:`_validity_lines`).
+    coordinates, the attributes, ``slab_done`` and the flag bytes (:func:`_validity_counts`).
     """
     import h5netcdf
     import h5py
@@ -352,63 +355,95 @@ def cube_summary(path) -> list[str]:
                          "written by 'nylonflex sweep')")
     check_chunk_sizes(path)
     require_filters(a.get("compression"))
-    out = []
+    d = {"cube": str(path), "name": str(a.get("name"))[:80],
+         "config_sha256": str(a.get("config_sha256", ""))}
     complete = is_complete(a)
     with h5py.File(path, "r") as h5, h5netcdf.File(h5, "r") as f:
         sizes = {name: int(size) for name, size in
                  ((n, f.dimensions[n].size) for n in f.dimensions)}
         done_flags = np.asarray(h5["slab_done"][...]).astype(bool)
-        done = int(np.sum(done_flags, dtype=np.int64))
-        out.append(f"cube      {path}")
         # a spot check: the first chunk of each variable read ('info --check' reads all)
-        damaged = check_cube(path, full=False)
-        out.append(f"name      {str(a.get('name'))[:80]}   "
-                   f"config sha256 {str(a.get('config_sha256', ''))[:16]}")
-        state = "DAMAGED" if damaged else "complete" if complete else "INCOMPLETE"
-        out.append(f"status    {state} ({done}/{sizes['radius']} radii)")
-        out.extend(f"damaged   {line}" for line in damaged)
-        n = int(np.prod([sizes[d] for d in AXES]))
-        out.append(f"designs   {n:,} = " + " x ".join(f"{sizes[d]} {d}" for d in AXES))
-        if "model" in sizes:
-            out.append("models    " + ", ".join(
-                _text(m) for m in np.asarray(h5["model"][...]).reshape(-1)))
+        d["damaged"] = check_cube(path, full=False)
+        d["status"] = "DAMAGED" if d["damaged"] else "complete" if complete else "INCOMPLETE"
+        d["radii_done"], d["radii"] = int(np.sum(done_flags, dtype=np.int64)), sizes["radius"]
+        d["shape"] = {ax: sizes[ax] for ax in AXES}
+        d["designs"] = int(np.prod(list(d["shape"].values())))
+        for cat in ("model", "cooling"):
+            if cat in sizes:
+                d[cat] = [_text(m) for m in np.asarray(h5[cat][...]).reshape(-1)]
         if "model_spread" in a:  # fidelity: spread (docs/model.md s. 23)
-            out.extend(_spread_lines(a))
-        if "cooling" in sizes:
-            out.append("cooling   " + ", ".join(
-                _text(m) for m in np.asarray(h5["cooling"][...]).reshape(-1)))
+            d["model_spread"] = _text(a["model_spread"]).split()
         supply = a.get("supply_voltage", "none")  # [V] float64; text before cube format 2
         if supply != "none":
-            out.append(f"supply    {supply if isinstance(supply, str) else f'{supply:g} V'}")
+            d["supply_voltage"] = supply
         try:
-            out.extend(_validity_lines(f, h5, done_flags if not complete else
-                                       np.ones_like(done_flags)))
+            d["validity"] = _validity_counts(f, h5, done_flags if not complete else
+                                             np.ones_like(done_flags))
         except (OSError, ValueError, RuntimeError):
-            out.append("flagged   (the validity flags cannot be read)")
-        out.append("axes")
+            d["validity"] = "unreadable"
+        d["axes"] = {}
         for name in (*AXES, "stroke", "pressure"):
             v = VARIABLES[name]
-            vals = to_display(name, np.asarray(h5[name][...]))
-            unit = "" if v.display == "1" else f" {v.display}"
-            over = f.variables[name].dimensions[0]
-            where = f"; in the file over the dimension {over}" if over != name else ""
-            out.append(f"  {name:<15} {vals.min():g} .. {vals.max():g}{unit} "
-                       f"({len(vals)}{where})")
-        out.append("variables")
+            vals = np.asarray(h5[name][...], dtype=float)
+            d["axes"][name] = {"min": float(vals.min()), "max": float(vals.max()),
+                               "count": len(vals), "units": v.units, "display": v.display,
+                               "stored_over": f.variables[name].dimensions[0]}
+        d["variables"] = {}
         logical = {dim: name for name, dim in STORED_DIMS.items()}
         for name in _data_vars(f):
             if name == "slab_done":
                 continue
             var = f.variables[name]
-            dims = [logical.get(d, d) for d in var.dimensions]  # as open_cube gives them
-            out.append(f"  {name:<18} ({', '.join(dims)}) "
-                       f"[{_attr(var.attrs.get('units'))}] {_attr(var.attrs.get('long_name'))}")
+            d["variables"][name] = {
+                "dims": [logical.get(x, x) for x in var.dimensions],  # as open_cube has them
+                "units": _attr(var.attrs.get("units")),
+                "long_name": _attr(var.attrs.get("long_name"))}
+    d["provenance"] = {key: a[key] for key in (
+        "nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
+        "quadrature", "created", "run_seconds", "designs_per_second", "workers",
+        "scheduler") if key in a}
+    return d
+
+
+def cube_summary(path) -> list[str]:
+    """Lines that describe a cube (``nylonflex info``): :func:`cube_description` as text."""
+    return summary_lines(cube_description(path))
+
+
+def summary_lines(d: dict) -> list[str]:
+    """The text of a :func:`cube_description`, in display units."""
+    out = [f"cube      {d['cube']}",
+           f"name      {d['name']}   config sha256 {d['config_sha256'][:16]}",
+           f"status    {d['status']} ({d['radii_done']}/{d['radii']} radii)"]
+    out.extend(f"damaged   {line}" for line in d["damaged"])
+    out.append(f"designs   {d['designs']:,} = " + " x ".join(f"{n} {ax}"
+                                                           for ax, n in d["shape"].items()))
+    if "model" in d:
+        out.append("models    " + ", ".join(d["model"]))
+    if "model_spread" in d:
+        out.extend(_spread_lines(d["model_spread"]))
+    if "cooling" in d:
+        out.append("cooling   " + ", ".join(d["cooling"]))
+    if "supply_voltage" in d:
+        supply = d["supply_voltage"]
+        out.append(f"supply    {supply if isinstance(supply, str) else f'{supply:g} V'}")
+    if d["validity"] == "unreadable":
+        out.append("flagged   (the validity flags cannot be read)")
+    elif d["validity"] is not None:
+        out.append(_validity_line(d["validity"]))
+    out.append("axes")
+    for name, ax in d["axes"].items():
+        unit = "" if ax["display"] == "1" else f" {ax['display']}"
+        where = f"; in the file over the dimension {ax['stored_over']}" \
+            if ax["stored_over"] != name else ""
+        out.append(f"  {name:<15} {to_display(name, ax['min']):g} .. "
+                   f"{to_display(name, ax['max']):g}{unit} ({ax['count']}{where})")
+    out.append("variables")
+    for name, var in d["variables"].items():
+        out.append(f"  {name:<18} ({', '.join(var['dims'])}) [{var['units']}] "
+                   f"{var['long_name']}")
     out.append("provenance")
-    for key in ("nylonflex_version", "numba_version", "numpy_version", "silicone", "nylon",
-                "quadrature", "created", "run_seconds", "designs_per_second", "workers",
-                "scheduler"):
-        if key in a:
-            out.append(f"  {key:<18} {str(a[key])[:200]}")
+    out.extend(f"  {key:<18} {str(value)[:200]}" for key, value in d["provenance"].items())
     return out
 
 

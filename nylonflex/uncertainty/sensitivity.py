@@ -83,7 +83,7 @@ def _grid_designs(cfg, at, max_designs, seed):
 
 def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
                   base_samples: int = 512, max_designs: int = 16, seed: int | None = None,
-                  num_resamples: int = 100) -> SensitivityResult:
+                  num_resamples: int = 100, progress=None) -> SensitivityResult:
     """First-order and total Sobol' indices of ``outputs`` w.r.t. the uncertain parameters.
 
     Parameters
@@ -104,6 +104,9 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
         Seed of the samples and the bootstrap; the config's ``uncertainty.seed`` by default.
     num_resamples : int
         Bootstrap resamples of the confidence intervals.
+    progress : callable, optional
+        Called as ``progress(done, total)`` [steps: a design's closed loops, an output's
+        analysis of a design] as the work goes.
 
     Returns
     -------
@@ -176,14 +179,27 @@ def sobol_indices(cfg: ResolvedConfig, outputs=("tip_force_max",), *, at=None,
     out = {}
     if relative or any(o not in tracked for o in outputs):
         out = evaluate(**perturbed_inputs(designs, cfg, z))  # (designs, samples)
+    n = len(designs["radius"])
+    total, step = (n if loop else 0) + len(outputs) * n, 0
+
+    def tick():
+        nonlocal step
+        step += 1
+        if progress is not None:
+            progress(step, total)
+
     if loop:  # the closed loop of each sample of each design
-        rows = [sampled_tracking(cfg, {a: designs[a][i] for a in AXES}, z, loop,
-                                 bend_angle_max=out["bend_angle_max"][i] if relative
-                                 else None) for i in range(len(designs["radius"]))]
+        rows = []
+        for i in range(n):
+            rows.append(sampled_tracking(cfg, {a: designs[a][i] for a in AXES}, z, loop,
+                                         bend_angle_max=out["bend_angle_max"][i] if relative
+                                         else None))
+            tick()
         out = {**out, **{o: np.array([r[o] for r in rows]) for o in loop}}
     acc = {o: {k: {p: [] for p in names} for k in _KEYS} for o in outputs}
     for o in outputs:
         for row in np.asarray(out[o]):
+            tick()
             if not np.all(np.isfinite(row)) or np.ptp(row) <= 1e-12 * max(np.abs(row).max(), 1e-300):
                 continue  # a design whose output does not vary: no indices
             res = analyze.analyze(problem, row, calc_second_order=False, seed=seed,
