@@ -107,9 +107,23 @@ VARIANTS = {v.name: v for v in [
             "0.999 (0.88-1.18) of the FE over its training space, each design left out, 88 "
             f"of 96 within 10 %; {_FIG12} 0.99 (0.81-1.05) at half of p*, 19 of 22 within 10 "
             "%, 0.88 (0.67-1.07) at p* (past its training), 7 of 16",
-            "the designer's choice for bend angles up to about 60 deg inside the measured "
-            "space; outside it (another silicone, base != wall, L/a beyond 2-30), run "
-            "nylonflex verify on the cube", "s. 21"),
+            "the designer's choice for the bend at a known (measured) pressure, up to about "
+            "60 deg inside the measured space; outside it (another silicone, base != wall, "
+            "L/a beyond 2-30), run nylonflex verify on the cube. Its full-stroke answers "
+            "take eq. 8's pressure, 3-10x the sealed FE twin's (see sealed_chamber)",
+            "s. 21"),
+    Variant("sealed_chamber", "the sealed chamber as built (uncalibrated)",
+            "the chamber's real pressure when the wrap squeezes the sealed air: Boyle with a "
+            "compliant chamber that rounds out, (p0 + p)(v_free(s) + p/K) = p0, instead of "
+            "eq. 8's rigid section; lateral_pressure's balance at that pressure plus the "
+            "wall's squeeze bend c_sq s L / h",
+            "against the stroke-driven, sealed FE twin (docs/fidelity.md, \"Driven as "
+            "built\"), on 5 designs only: full-stroke bend within 15 % on 3 of 5 (paper 0 of "
+            "5, fe_calibrated 1 of 5), blocked force within 15 % on 0 of 3; its coefficients "
+            "are closed forms (Lame's stiffness, a rigid section), not yet fitted to the twin",
+            "not yet for design answers: it shows how far below eq. 8 the sealed chamber's "
+            "pressure may fall (a tenth, at the worked examples); settle it for your "
+            "actuator on the bench (docs/bench.md, nylonflex fit chamber)", "s. 22"),
 ]}
 
 
