@@ -12,9 +12,7 @@ runs in parallel over the designs; its body is the one the pure-Python reference
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Mapping
-from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
@@ -39,8 +37,6 @@ __all__ = ["MODELS", "design_limits", "evaluate"]
 
 #: Designs below which the kernel runs in the calling thread (threads cost more than they save).
 _PARALLEL_FROM = 64
-#: ``_SERIAL.on`` set in a thread (:func:`serial`): that thread's calls run in it.
-_SERIAL = threading.local()
 
 _MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistance_per_length",
                   "heat_capacity_per_length", "heat_loss_per_length",
@@ -310,7 +306,7 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     args = (PointDesigns(*design_arrays), CoilTable(*coil_arrays), Ogden(mu, alpha), nodes,
             Muscle(*muscle), Options(*options), P_ATM, out)
     run_chunks(lambda i0, i1: kernels.design_points(*args, node_scratch(nodes), i0, i1), n,
-               parallel=n >= _PARALLEL_FROM and not getattr(_SERIAL, "on", False))
+               parallel=n >= _PARALLEL_FROM)
     # the kernel's rows by name (kernels.rows, the one table both sides read)
     design = out.design.reshape(N_FLOAT_DESIGN, *shape)
     flags = out.flags.reshape(N_FLAGS, *shape)
@@ -332,18 +328,6 @@ def _kernels():
     from ..kernels import design as kernels
 
     return kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut)
-
-
-@contextmanager
-def serial():
-    """Within this block, this thread's :func:`evaluate` calls run in this thread (Dask
-    workers: one level of parallelism, no Numba thread pool)."""
-    before = getattr(_SERIAL, "on", False)
-    _SERIAL.on = True
-    try:
-        yield
-    finally:
-        _SERIAL.on = before
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,

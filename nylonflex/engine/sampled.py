@@ -319,7 +319,7 @@ def sample_statistics(out: dict, quantiles, requirements=()) -> dict:
     if reqs:
         ok = np.ones(out[FLOAT_NAMES[0]].shape, dtype=bool)
         for r in reqs:
-            ok &= r.holds(out[r.name])
+            ok &= r.mask(out[r.name])
         stats["feasibility"] = ok.mean(axis=-1)
     return stats
 
@@ -340,7 +340,7 @@ def slab_statistics(cfg: ResolvedConfig, i0: int, i1: int, nominal: dict, model:
     if cfg.uncertainty is None:
         ok = np.ones(nominal[FLOAT_NAMES[0]].shape, dtype=bool)
         for r in reqs:
-            ok &= r.holds(nominal[r.name])
+            ok &= r.mask(nominal[r.name])
         return {"feasibility": ok.astype(float)}
     spec = cfg.uncertainty
     z = standard_samples(spec)

@@ -35,12 +35,12 @@ __all__ = ["COMPILE_NOTICE", "KERNELS", "grid_families", "timed", "warm_up_aside
 COMPILE_NOTICE = "compiling "
 
 
-def timed(call, notice, after=None):
+def timed(call, notice):
     """Run ``call()`` with the compile notices going to ``notice`` (None: a
     :class:`~nylonflex.kernels.compiling.CompileWarning`).
 
     Returns the seconds ``call`` took when a kernel compiled in it, else 0.0 (a warm
-    cache). ``after`` is ignored (the notice once waited for a timer).
+    cache).
     """
     from ..kernels.compiling import compile_seconds, notices_to
 
@@ -52,8 +52,7 @@ def timed(call, notice, after=None):
     return seconds if sum(compile_seconds().values()) > before else 0.0
 
 
-def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
-                 after: float = 1.0) -> float:
+def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None) -> float:
     """Compile (or load from cache) the grid kernel ``cfg`` will run, on one design.
 
     Parameters
@@ -65,8 +64,6 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
-    after : float
-        Ignored (kept for callers of the timer it replaced).
 
     Returns
     -------
@@ -76,7 +73,7 @@ def warm_up_grid(cfg: ResolvedConfig, *, parallel: bool = True, notice=None,
     tiny = dataclasses.replace(
         cfg, axes={k: v[:1] for k, v in cfg.axes.items()},
         curves={k: v[:2] for k, v in cfg.curves.items()})
-    return timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice, after)
+    return timed(lambda: compute_slab(tiny, 0, 1, parallel=parallel), notice)
 
 
 def grid_families(cfg: ResolvedConfig) -> set:
@@ -176,7 +173,7 @@ def _child(warm):  # pragma: no cover - runs in the forked child only
         os._exit(status)
 
 
-def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
+def warm_up_points(settings=None, *, notice=None) -> float:
     """Compile (or load from cache) the pointwise kernel of :func:`nylonflex.evaluate` (one
     compiled loop for every batch size, threaded or not).
 
@@ -187,8 +184,6 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     notice : callable, optional
         Receives one line per kernel family that really compiles (Numba's signal), with
         an estimate; None: a :class:`~nylonflex.kernels.compiling.CompileWarning`.
-    after : float
-        Ignored (kept for callers of the timer it replaced).
 
     Returns
     -------
@@ -200,7 +195,7 @@ def warm_up_points(settings=None, *, notice=None, after: float = 1.0) -> float:
     def call():
         evaluate(np.full(2, 10e-3), 2e-3, 90e-3, 1.3, 0.14, **kw)
 
-    return timed(call, notice, after)
+    return timed(call, notice)
 
 
 def warm_up_codec(*, notice=None) -> float:

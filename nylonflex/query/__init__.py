@@ -28,18 +28,15 @@ output can say how many rows it held back.
 from __future__ import annotations
 
 from ..variables import AXES, DESIGN, VARIABLES  # noqa: F401  (names the tests use)
-from .format import (_describe_at, _records, _sig3, _unit, cell_text, flag_names,  # noqa: F401
-                     format_csv, format_json, format_table, held_back, rows_note,
-                     shown_columns)
-from .parse import (_FIELDS, _LIMIT_WORDS, _CATEGORY_WHERE, COLUMNS, EXACT, GRID,  # noqa: F401
-                    HEADLINE, INTERPOLATED, OPS, OPTIONAL, Condition, _parse_sort,
-                    _quantity, default_columns, parse_at, parse_columns, parse_condition,
+from .format import (cell_text, flag_names, format_csv, format_json, format_table, held_back,
+                     rows_note, shown_columns)
+from .parse import (COLUMNS, EXACT, GRID, HEADLINE, INTERPOLATED, OPS, OPTIONAL,
+                    Condition, default_columns, parse_at, parse_columns, parse_condition,
                     parse_constraint, parse_requirements, parse_where)
-from .scan import (_GRID_RTOL, _SLAB_VALUES, QueryResult, _exact_rows,  # noqa: F401
-                   _exact_settings, _select_model, _sorted, at_value, locate, slab_rows,
-                   query_cube)
+from .scan import QueryResult, at_value, locate, query_cube, slab_rows
 
-__all__ = ["EXACT", "GRID", "HEADLINE", "INTERPOLATED", "OPS", "Condition", "QueryResult",
+__all__ = ["COLUMNS", "EXACT", "GRID", "HEADLINE", "INTERPOLATED", "OPS", "OPTIONAL",
+           "Condition", "QueryResult", "at_value",
            "cell_text", "default_columns", "flag_names", "format_csv", "format_json",
            "format_table", "held_back", "locate", "parse_at", "parse_columns",
            "parse_condition", "parse_constraint", "parse_requirements", "parse_where",

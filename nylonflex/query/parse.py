@@ -123,7 +123,6 @@ class Condition:
             return near if self.op == "==" else ~near & ~np.isnan(x)
         return _COMPARE[self.op](x, self.value)
 
-    holds = mask
 
     def __repr__(self):
         return f"Condition({self.text or f'{self.name} {self.op} {self.value!r}'!r})"
