@@ -72,6 +72,7 @@ def _run(args, charts: bool) -> int:
         with _collect_after_start():
             from ..config import load_config
             from ..engine.slabs import deferred_signals
+            from ..storage.journal import file_locks
             from ..storage.sweep import default_output, prepare, sweep_file
 
             cfg = load_config(args.config, args.set)
@@ -79,6 +80,7 @@ def _run(args, charts: bool) -> int:
             refuse_special(out, "--out")
             if args.dry_run:
                 return _dry_run(cfg, out, args, log)
+            file_locks()  # a platform without POSIX locks is refused before any work
             signals.enter_context(deferred_signals(on_second=_stop_at_once, earlier=EARLY_SIGNALS))
             unchanged = _up_to_date(cfg, out, args)
             # the chart libraries load while the kernel compiles, when it has to
