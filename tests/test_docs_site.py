@@ -108,3 +108,29 @@ def test_the_block_runs(project, tmp_path, where, line, lang, code, reason):
     done = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
                           timeout=900)
     assert done.returncode == 0, f"{where}:{line}\n{done.stdout[-2000:]}\n{done.stderr[-3000:]}"
+
+
+@pytest.mark.parametrize("codec, reads", [("zstd", True), ("lz4", False)])
+def test_netcdf4_reads_the_codecs_docs_cube_md_says(tmp_path, codec, reads):
+    # docs/cube.md's codec table: netCDF4's wheel carries the zstd filter, not LZ4's
+    pytest.importorskip("netCDF4")
+    from helpers import write_cube
+
+    raw = {"name": "codec", "compression": codec, "charts": [],
+           "grid": {"radius": {"start": 5, "stop": 25, "num": 3, "units": "mm"},
+                    "wall_thickness": {"values": [2], "units": "mm"},
+                    "length": {"values": [70], "units": "mm"},
+                    "coil_index": {"values": [1.7]}, "wrap_angle": {"values": [8], "units": "deg"}},
+           "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+                      "pressure": {"start": 0, "stop": 25, "num": 3, "units": "kPa"}}}
+    cube = write_cube(tmp_path, raw)
+    env = {k: v for k, v in os.environ.items() if k != "HDF5_PLUGIN_PATH"}
+    code = f"import netCDF4; print(netCDF4.Dataset({str(cube)!r})['tip_force_max'][:].sum())"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=120)
+    assert (done.returncode == 0) is reads, done.stderr[-500:]
+    if not reads:
+        assert "filter" in done.stderr.lower()
+    row = next(line for line in (ROOT / "docs" / "cube.md").read_text().splitlines()
+               if line.startswith(f"| `{codec}` |"))
+    assert "netCDF4" in row
