@@ -43,6 +43,7 @@ COMMANDS = {
     "explore": "explore",
     "fe": "fe",
     "verify": "verify",
+    "completion": "completion",
 }
 
 
