@@ -3,6 +3,10 @@ from the same parser the console script builds (every command, flag and choice).
 
 from __future__ import annotations
 
+import shtab
+
+from . import build_parser
+
 HELP = "print a shell completion script (bash, zsh, tcsh)"
 DESCRIPTION = """\
 Print a shell completion script for nylonflex: commands, flags and their choices, made
@@ -20,9 +24,5 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    import shtab
-
-    from . import build_parser
-
     print(shtab.complete(build_parser(), shell=args.shell))
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import shlex
 import sys
 from contextlib import ExitStack
 from pathlib import Path
@@ -90,7 +91,7 @@ def _run(args, charts: bool) -> int:
         with _progress(cfg.n_designs, args.quiet) as bar:
             sweep_file(cfg, out, resume=args.resume, workers=args.workers,
                        scheduler=args.scheduler, progress=bar.update, log=log,
-                       overwrite=args.overwrite)
+                       overwrite=args.overwrite, command=_command_line(args))
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if not charts or not cfg.charts:
         return 0
@@ -110,6 +111,20 @@ def _run(args, charts: bool) -> int:
     for path in paths:
         print(path)
     return 0
+
+
+def _command_line(args) -> str:
+    """The sweep as a command line, for the cube's ``history``: the config, every option
+    given (--set, --out, --resume, ...), shell-quoted."""
+    words = ["nylonflex", "sweep", str(args.config)]
+    words += [w for value in args.set or () for w in ("--set", value)]
+    for flag, value in (("--out", args.out), ("--workers", args.workers),
+                        ("--scheduler", args.scheduler)):
+        if value is not None:
+            words += [flag, str(value)]
+    words += [flag for flag, on in (("--resume", args.resume), ("--overwrite", args.overwrite))
+              if on]
+    return shlex.join(words)
 
 
 def _chart_libraries():
