@@ -51,3 +51,20 @@ def test_file_locks_names_the_platform_gap(monkeypatch):
     monkeypatch.setitem(sys.modules, "fcntl", None)
     with pytest.raises(InputError, match=r"^sweep: writing a cube needs POSIX file locks"):
         file_locks()
+
+
+def test_the_fe_extra_without_pardiso_solves_with_scipy(monkeypatch):
+    # [fe] is FElupe with SciPy's solver; [fe-fast] adds pypardiso, used when importable
+    pytest.importorskip("felupe")
+    import numpy as np
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    from nylonflex.fe.solve import linear_solver
+
+    monkeypatch.setitem(sys.modules, "pypardiso", None)
+    solve = linear_solver()
+    assert solve is spsolve
+    A = sp.csr_matrix(np.array([[4.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 2.0]]))
+    b = np.array([1.0, 2.0, 3.0])
+    np.testing.assert_allclose(A @ solve(A, b), b, rtol=1e-12)
