@@ -45,8 +45,24 @@ def code_blocks():
     return out
 
 
-BLOCKS = code_blocks()
+#: The README's first block, its two commands (install and run the main job; install and
+#: run the tests), stays its first lines as they are: .ci/run makes that environment and
+#: runs its test command (test_ci_runs_the_readmes_test_command), and the main job runs in
+#: the blocks below (docs/getting_started.md).
+README_COMMANDS = ("README.md", 3)
+BLOCKS = [b for b in code_blocks() if b[:2] != README_COMMANDS]
 TO_RUN = [b for b in BLOCKS if b[4] is None]
+
+
+def test_ci_runs_the_readmes_test_command():
+    first = next(b for b in code_blocks() if b[:2] == README_COMMANDS)[3]
+    install, tests = [line for line in first.splitlines() if "pip install" in line]
+    assert install.endswith("nylonflex sweep configs/fig12.yaml")
+    command = tests.rsplit("&& ", 1)[1]          # python -m pytest -q
+    assert command == "python -m pytest -q"
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert f"coverage run -m pytest -q\n" in ci or f"\n{command}\n" in ci
+    assert 'pip install -q -e ".[test' in ci
 
 
 def test_every_block_runs_or_says_why_not():
