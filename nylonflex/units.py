@@ -59,15 +59,27 @@ UNITS: dict[str, tuple[str, float, float]] = {
     "%": ("dimensionless", 1e-2, 0.0),
 }
 
-_ALIASES = {"Nm": "N m", "N*m": "N m", "N.m": "N m", "Nmm": "N mm", "C": "degC",
+_ALIASES = {"N*m": "N m", "N.m": "N m",
             "celsius": "degC", "degrees": "deg", "degree": "deg", "": "1", "-": "1",
-            "mNm": "mN m", "Ohm": "ohm", "mL": "ml", "ul": "uL", "\u03a9": "ohm"}
+            "mL": "ml", "ul": "uL", "\u03a9": "ohm"}
+
+#: Spellings refused because the unit libraries a user's other tools use (pint, UDUNITS)
+#: read them otherwise or not at all: unit -> (the spelling to write, why). ``C`` is the
+#: coulomb there, ``Nm`` no unit (``nm`` is the nanometre), ``Ohm`` is case-sensitive.
+_PINT_SPELLING = {"C": ("degC", "C is the coulomb in pint and UDUNITS"),
+                  "Nm": ("N m", "pint reads no unit Nm"),
+                  "Nmm": ("N mm", "pint reads no unit Nmm"),
+                  "mNm": ("mN m", "pint reads no unit mNm"),
+                  "Ohm": ("ohm", "unit names are case-sensitive")}
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
 
 def _canonical(unit: str) -> str:
     unit = unit.strip()
+    if unit in _PINT_SPELLING:
+        spelling, why = _PINT_SPELLING[unit]
+        raise InputError(f"unit {unit!r}: write {spelling!r} ({why})")
     return _ALIASES.get(unit, unit)
 
 
@@ -117,7 +129,10 @@ def to_si(value, unit: str, field: str = "value", kind: str | None = None):
     InputError
         Unknown unit, or a unit of another kind than ``kind``; the message names ``field``.
     """
-    u = _canonical(unit)
+    try:
+        u = _canonical(unit)
+    except InputError as err:  # a spelling other tools read otherwise: name the field
+        raise InputError(f"{field}: {err}") from None
     if u not in UNITS:
         raise InputError(f"{field}: unknown unit {unit!r}; accepted: "
                          f"{', '.join(_units_of(kind) if kind else UNITS)}")

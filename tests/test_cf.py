@@ -66,7 +66,7 @@ def test_compliance_checker_finds_nothing(tmp_path, kind):
     # what the checker asked of the attributes: typed, a history, CF-1.8, no host name
     with h5py.File(path, "r") as f:
         a = f.attrs
-        assert a["Conventions"] == "CF-1.8" and "nylonflex sweep" in a["history"]
+        assert a["Conventions"] == "CF-1.8" and "nylonflex.run_sweep" in a["history"]
         assert a["complete"].dtype == np.int8 and int(a["complete"][0]) == 1
         assert a["run_seconds"].dtype == np.float64 and a["workers"].dtype.kind == "i"
         assert "hostname" not in a

@@ -47,6 +47,7 @@ COMMANDS = {
     "explore": "explore",
     "fe": "fe",
     "verify": "verify",
+    "completion": "completion",
 }
 
 

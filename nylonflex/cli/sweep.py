@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import shlex
 import sys
 from contextlib import ExitStack
 from pathlib import Path
@@ -54,6 +55,7 @@ def _run(args, charts: bool) -> int:
         with _collect_after_start():
             from ..config import load_config
             from ..engine.slabs import deferred_signals
+            from ..storage.journal import file_locks
             from ..storage.sweep import default_output, prepare, sweep_file
 
             cfg = load_config(args.config, args.set)
@@ -61,6 +63,7 @@ def _run(args, charts: bool) -> int:
             refuse_special(out, "--out")
             if args.dry_run:
                 return _dry_run(cfg, out, args, log)
+            file_locks()  # a platform without POSIX locks is refused before any work
             signals.enter_context(deferred_signals(on_second=_stop_at_once, earlier=EARLY_SIGNALS))
             unchanged = _up_to_date(cfg, out, args)
             # the chart libraries load while the kernel compiles, when it has to
@@ -72,7 +75,7 @@ def _run(args, charts: bool) -> int:
             bar(0, cfg.n_designs)
             sweep_file(cfg, out, resume=args.resume, workers=args.workers,
                        scheduler=args.scheduler, progress=bar.update, log=log,
-                       overwrite=args.overwrite)
+                       overwrite=args.overwrite, command=_command_line(args))
         bar = None
     print(f"{out}  {cfg.n_designs:,} designs  complete")
     if not charts or not cfg.charts:
@@ -93,6 +96,20 @@ def _run(args, charts: bool) -> int:
     for path in paths:
         print(path)
     return 0
+
+
+def _command_line(args) -> str:
+    """The sweep as a command line, for the cube's ``history``: the config, every option
+    given (--set, --out, --resume, ...), shell-quoted."""
+    words = ["nylonflex", "sweep", str(args.config)]
+    words += [w for value in args.set or () for w in ("--set", value)]
+    for flag, value in (("--out", args.out), ("--workers", args.workers),
+                        ("--scheduler", args.scheduler)):
+        if value is not None:
+            words += [flag, str(value)]
+    words += [flag for flag, on in (("--resume", args.resume), ("--overwrite", args.overwrite))
+              if on]
+    return shlex.join(words)
 
 
 def _chart_libraries():

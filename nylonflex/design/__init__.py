@@ -15,6 +15,7 @@ it and re-checked exactly, and designs equal in every objective merged into one 
 from __future__ import annotations
 
 import functools
+import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,10 +23,12 @@ import numpy as np
 
 from ..config import parse_config
 from ..engine.provenance import cube_settings
-from ..query import COLUMNS
+from ..query import COLUMNS, HEADLINE as _HEADLINE
+from ..query.frames import html_table, rows_frame
 from ..storage import open_cube
 from ..storage.sweep import run_sweep
 from ..units import InputError
+from ..variables import AXES, DESIGN
 from .refine import Model, _bounds, evaluate_rows, meets, refine
 from .resolution import check_fixed, lattice_search, merge_equal, same_intervals, snap
 from .search import CUBE_ONLY, GridScan, nondominated, scan_grid
@@ -87,6 +90,28 @@ class DesignResult:
     @property
     def feasible(self) -> bool:
         return bool(self.designs)
+
+    def _columns(self):
+        names = [n for n in (*AXES, *DESIGN) if self.designs and n in self.designs[0]]
+        columns = {n: np.array([d[n] for d in self.designs], dtype=float) for n in names}
+        return names, columns, {"source": [d.get("source", "") for d in self.designs]}
+
+    def to_dataframe(self):
+        """The reported designs as a pandas DataFrame, one row each: ``source`` (grid or
+        refined), every axis and design variable in SI (``df.attrs["units"]``)."""
+        names, columns, extra = self._columns()
+        return rows_frame(columns, names, extra)
+
+    def _repr_html_(self) -> str:
+        """The reported designs as an HTML table in display units, or why none is."""
+        if not self.designs:
+            items = "".join(f"<li>{html.escape(r)}</li>" for r in self.reasons)
+            return f"<p>no design meets the spec:</p><ul>{items}</ul>"
+        names, columns, extra = self._columns()
+        shown = [n for n in names if n in AXES or n in _HEADLINE]
+        caption = (f"{len(self.designs)} design(s) under model {self.model}; "
+                   f"{self.evaluations} exact evaluations")
+        return html_table(columns, shown, len(self.designs), caption, extra)
 
     @property
     def reasons(self) -> list:

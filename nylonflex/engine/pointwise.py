@@ -30,7 +30,8 @@ from ..physics.nylon import check_stroke_shape
 from ..physics.sealed import sealed_coefficients
 from ..physics.thermal import check_supply_rise, coil_resistance, convection_loss_per_length
 from ..units import short
-from ..variables import DESIGN
+from ..variables import AXES, DESIGN
+from .results import to_dataset
 from .threads import run_chunks
 
 __all__ = ["MODELS", "design_limits", "evaluate"]
@@ -46,7 +47,7 @@ _SILICONE_FIELDS = ("mu", "alpha")
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
              silicone="tc5005", nylon="silver_nylon66", model="paper", supply_voltage=None,
-             cooling=None, chamber=None):
+             cooling=None, chamber=None, as_dataset=False):
     """Every design variable of designs that broadcast together (compiled, parallel).
 
     Parameters
@@ -83,10 +84,16 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     chamber : dict or sequence, optional
         ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) [-]; None: the
         shipped ones (docs/model.md s. 22).
+    as_dataset : bool, default False
+        Return an ``xarray.Dataset`` instead of a dict: the same arrays over dimensions
+        ``design`` (1-D designs; ``design_0``, ``design_1``, ... for more axes; none for
+        one design), each with ``units``, ``long_name`` and ``description`` attributes
+        (CF flag attributes for ``limit`` and ``validity``), the five inputs and
+        ``base_thickness`` as coordinates [m, rad, -], and ``model`` in its attributes.
 
     Returns
     -------
-    dict of str to ndarray
+    dict of str to ndarray, or xarray.Dataset
         The design variables of :data:`nylonflex.variables.DESIGN` (the same names, units
         and values as :func:`nylonflex.design_limits`), each of the broadcast shape;
         ``limit`` and ``validity`` are int8; ``heating_time`` and the dynamics
@@ -137,6 +144,10 @@ def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thi
     out = _run(shape, n, designs, coil, ogden, muscle, options)
     check_supply_rise(voltage, out["muscle_length"], coil[3].reshape(shape),
                       coil[4].reshape(shape), "supply_voltage")
+    if as_dataset:
+        inputs = dict(zip((*AXES, "base_thickness"), (a, t, L, c, psi, b)))
+        extra = {} if supply_voltage is None else {"supply_voltage": voltage}
+        return to_dataset(out, inputs, {"model": model, **extra})
     return out
 
 

@@ -54,7 +54,7 @@ def typed_info(info: dict) -> dict:
 
 
 def run_attrs(info: dict, *, complete: bool, seconds: float, computed: int,
-              resumed: int) -> dict:
+              resumed: int, command: str | None = None) -> dict:
     """The global attributes a finished (or stopped) run adds, typed: ``complete`` int8
     1/0, ``run_seconds`` [s] and ``designs_per_second`` [1/s] as float64, counts as ints,
     ``created`` and ``history`` (CF's audit line); the host name only when
@@ -72,13 +72,17 @@ def run_attrs(info: dict, *, complete: bool, seconds: float, computed: int,
         Designs computed by this run (not restored from the journal) [-].
     resumed : int
         Slabs restored from the journal [-].
+    command : str, optional
+        The command line that ran the sweep, for the ``history`` line (CF: "a list of the
+        applications that have modified the original data", with their arguments); None:
+        ``nylonflex.run_sweep`` from Python.
     """
     created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
     out = typed_info(info)
     out.update({
         "complete": np.int8(1 if complete else 0),
         "created": created,
-        "history": f"{created} nylonflex {__version__}: nylonflex sweep"
+        "history": f"{created} nylonflex {__version__}: {command or 'nylonflex.run_sweep'}"
                    f"{'' if complete else ' (stopped; resume with --resume)'}"
                    f"{f' ({resumed} slabs resumed)' if resumed else ''}",
         "run_seconds": np.float64(round(seconds, 3)),

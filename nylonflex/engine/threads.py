@@ -5,7 +5,7 @@ slab of the grid or a batch of designs runs as contiguous chunks on :func:`worke
 threads, and a serial run (a Dask worker's slab, a thread that is already one of several)
 is the same compiled body called once. Numba's ``parallel=True`` would
 compile each kernel a second time for its threaded form, about as long again as the first
-on a cold cache (README, Performance), for no gain here: the chunks are independent and
+on a cold cache (benchmarks/README.md), for no gain here: the chunks are independent and
 write disjoint parts of the output, so the numbers do not depend on how they are split.
 """
 

@@ -44,10 +44,11 @@ EASY_STEP = 4
 
 def linear_solver():
     """The sparse direct solver of Newton's steps: MKL PARDISO through ``pypardiso`` where
-    it is installed (about 20 times faster than SuperLU on the default mesh's 6,000
-    unknowns, measured), reusing its fill-reducing analysis while the matrix's pattern
-    stays (:class:`PardisoSteps`); else scipy's SuperLU (``spsolve``). Newton's converged
-    state does not depend on it beyond its tolerance."""
+    it is installed (the ``fe-fast`` extra; about 20 times faster than SuperLU on the default
+    mesh's 6,000 unknowns, measured, and a whole default-mesh ``fe_bend`` 3.4x cheaper in
+    CPU, docs/fidelity.md), reusing its fill-reducing analysis while the matrix's pattern
+    stays (:class:`PardisoSteps`); else (the ``fe`` extra) scipy's SuperLU (``spsolve``).
+    Newton's converged state does not depend on it beyond its tolerance."""
     try:
         import pypardiso
     except ImportError:

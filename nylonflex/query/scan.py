@@ -13,6 +13,8 @@ import numpy as np
 from ..physics import design_limits
 from ..units import InputError, from_si
 from ..variables import CATEGORIES, AXES, DESIGN, SPREAD, VARIABLES
+from .format import rows_note, shown_columns
+from .frames import html_table, rows_frame
 from .parse import (_CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
                     _parse_sort, missing_hint, parse_at, parse_columns, parse_condition)
 from .spread import PER_LENGTH, TIMES_LENGTH, exact_spread, spread_variants
@@ -90,6 +92,17 @@ class QueryResult:
 
     def __len__(self):
         return len(self.data[COLUMNS[0]])
+
+    def to_dataframe(self):
+        """The rows as a pandas DataFrame, every column in SI (``df.attrs["units"]``),
+        ``limit`` and ``validity`` as numbers (NaN: unknown), as ``--format csv``."""
+        extra = {"point": [self.point] * len(self)} if self.point else None
+        return rows_frame(self.data, shown_columns(self, "csv"), extra)
+
+    def _repr_html_(self) -> str:
+        """The table ``nylonflex query`` prints, as HTML (display units, flags by name)."""
+        caption = rows_note(self) if self.matched is not None else (self.point or "")
+        return html_table(self.data, shown_columns(self), len(self), caption)
 
 
 def slab_rows(ds, at_loc, r0, r1):

@@ -9,15 +9,19 @@ Dataset. The cube itself stays SI; these give display-unit copies for plots and 
     ds.nf.sel(radius=0.0105)                             # a bare number is SI, as in Python
     ds["tip_force_max"].nf.display()                     # N -> N, torque N m -> N mm, ...
     ds.nf.display()["radius"]                            # every registered variable
+    ds.nf                                                # its name, models, materials,
+                                                         # grid and completeness
 """
 
 from __future__ import annotations
+
+import html
 
 import numpy as np
 import xarray as xr
 
 from ..units import InputError, from_si, parse_quantity
-from ..variables import VARIABLES, to_display
+from ..variables import AXES, VARIABLES, is_complete, to_display
 
 __all__ = ["CubeAccessor", "NotOnGrid", "VariableAccessor"]
 
@@ -106,3 +110,50 @@ class CubeAccessor:
         ds = self._ds
         out = ds.assign({n: _display(ds[n], n) for n in ds.data_vars if n in VARIABLES})
         return out.assign_coords({c: _display(ds[c], c) for c in ds.coords if c in VARIABLES})
+
+    def summary(self) -> list[str]:
+        """What the cube is, one line each: its name and version, whether it is complete
+        (and how far an incomplete one got), its grid in display units, its models and
+        material sets, its provenance."""
+        ds, a = self._ds, self._ds.attrs
+        lines = [f"nylonflex cube {a.get('name', '?')!r} (cube format "
+                 f"{a.get('nylonflex_cube', '?')}, nylonflex {a.get('nylonflex_version', '?')})"]
+        if is_complete(a):
+            lines.append("complete")
+        else:
+            done = ds["slab_done"].values if "slab_done" in ds else None
+            part = f": {int(np.sum(done == 1))} of {done.size} slabs done" \
+                if done is not None else ""
+            lines.append(f"INCOMPLETE{part} (nylonflex sweep --resume finishes it)")
+        axes = [n for n in AXES if n in ds.dims]
+        n = int(np.prod([ds.sizes[x] for x in axes])) if axes else 0
+        grid = ", ".join(_axis_text(ds, x) for x in axes)
+        lines.append(f"{n:,} designs: {grid}")
+        models = ds["model"].values.tolist() if "model" in ds.dims else [a.get("models", "?")]
+        lines.append(f"model: {', '.join(map(str, models))}")
+        for kind in ("silicone", "nylon"):
+            if kind in a:
+                note = a.get(f"{kind}_description", "")
+                lines.append(f"{kind}: {a[kind]}" + (f" ({note})" if note else ""))
+        if "created" in a:
+            lines.append(f"created {a['created']}, config sha256 "
+                         f"{str(a.get('config_sha256', '?'))[:12]}")
+        return lines
+
+    def __repr__(self) -> str:
+        return "\n".join(self.summary())
+
+    def _repr_html_(self) -> str:
+        head, *rest = self.summary()
+        items = "".join(f"<li>{html.escape(line)}</li>" for line in rest)
+        return f"<div class='nylonflex'><strong>{html.escape(head)}</strong><ul>{items}</ul></div>"
+
+
+def _axis_text(ds, name: str) -> str:
+    """``radius 5-25 mm (41)`` in the axis's display unit."""
+    v = VARIABLES[name]
+    values = to_display(name, ds[name].values)
+    unit = "" if v.display in ("1", "") else f" {v.display}"
+    lo, hi = float(np.min(values)), float(np.max(values))
+    span = f"{lo:g}" if lo == hi else f"{lo:g}-{hi:g}"
+    return f"{name} {span}{unit} ({values.size})"

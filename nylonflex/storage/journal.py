@@ -256,9 +256,23 @@ def _busy(cube_path, what) -> RuntimeError:
                         "for it or stop it first")
 
 
+def file_locks():
+    """The ``fcntl`` module, whose ``flock`` guards a cube being written (POSIX: Linux,
+    macOS, the BSDs). Without it (Windows) writing a cube is refused with one line
+    (InputError); a sweep in memory (``nylonflex.run_sweep(cfg)``) and reading cubes work
+    everywhere."""
+    try:
+        import fcntl
+    except ImportError:
+        raise InputError("sweep: writing a cube needs POSIX file locks (fcntl), which this "
+                         "platform lacks: run it on Linux or macOS (or WSL), or sweep in "
+                         "memory from Python with nylonflex.run_sweep(cfg)") from None
+    return fcntl
+
+
 def _lock_file(lock: Path):
     """An fd of ``lock`` holding its flock: the file at that path when the lock was won."""
-    import fcntl
+    fcntl = file_locks()
 
     refuse_special(lock, "--out")
     if _regular(lock):
@@ -307,7 +321,7 @@ def share_building(building):
     made it fail ("unable to lock file") until the journal was removed. A second writer's
     exclusive lock is still refused (and the lock file is still held).
     """
-    import fcntl
+    fcntl = file_locks()
 
     fd = _HELD.get(str(building))
     if fd is not None:
@@ -358,7 +372,7 @@ def exclusive(cube_path):
     even when the first run's lock file was deleted. Yields the path of the building file,
     which the holder may then open for writing (with HDF5 file locking off).
     """
-    import fcntl
+    fcntl = file_locks()
 
     cube_path = Path(cube_path)
     lock = Path(str(cube_path) + ".lock")

@@ -212,14 +212,15 @@ def _disk_full(exc) -> bool:
 
 
 def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, scheduler=None,
-                  progress=None, log=None, overwrite=False) -> Path:
+                  progress=None, log=None, overwrite=False, command=None) -> Path:
     """Sweep ``cfg`` into the cube file ``out`` (one writer: a second run is refused).
 
     Parameters are those of :func:`nylonflex.run_sweep`; ``progress`` receives the designs
     each stored slab adds, ``log`` one-line messages. A finished cube at ``out`` is
     replaced only with ``overwrite`` (atomically: an interrupted replacement leaves it in
     place); with the same config it is up to date and left alone. Anything at ``out`` that
-    is not a nylonflex cube is refused, never replaced.
+    is not a nylonflex cube is refused, never replaced. ``command`` (the command line that
+    ran it, a str) goes into the cube's ``history`` line.
 
     Raises
     ------
@@ -257,7 +258,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
                                "compression": codec, **_versions(),
                                "replaces": bool(replaces)})
             _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor,
-                   progress, log, replaces)
+                   progress, log, replaces, command)
         except OSError as exc:
             if not _disk_full(exc):
                 raise
@@ -271,21 +272,21 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
 
 
 def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log,
-           replaces=False):
+           replaces=False, command=None):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
                     cfg.models, cfg.cooling_names)
     try:
         check_building(building)  # HDF5 opened it by name: still the file this run locked
         _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
-              replaces)
+              replaces, command)
     except BaseException:
         cube.abandon()
         raise
 
 
 def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
-          replaces):
+          replaces, command=None):
     per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
     kept = set()
@@ -313,7 +314,7 @@ def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, lo
     complete = not stats.stopped and done == len(slabs)
     seconds = stats.seconds
     final = run_attrs(executor.info(), complete=complete, seconds=seconds,
-                      computed=stats.computed, resumed=len(keep))
+                      computed=stats.computed, resumed=len(keep), command=command)
     with deferred_signals():  # the publishing steps run to their end
         cube.close(final)
         if complete or not replaces:

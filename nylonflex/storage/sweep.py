@@ -81,11 +81,13 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
 
 
 def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
-               scheduler=None, progress=None, log=None, overwrite: bool = False) -> Path:
+               scheduler=None, progress=None, log=None, overwrite: bool = False,
+               command=None) -> Path:
     """:func:`run_sweep` into the cube file ``out``, without opening the cube afterwards.
 
     The parameters and exceptions are :func:`run_sweep`'s; returns ``out`` as a Path. The
-    command line uses it: a sweep without charts never imports xarray.
+    command line uses it: a sweep without charts never imports xarray. ``command``: the
+    command line, recorded in the cube's ``history``.
     """
     check_physics(cfg)  # before any file
     # from here on Ctrl-C and SIGTERM are recorded, never raised inside a finaliser (where
@@ -94,7 +96,7 @@ def sweep_file(cfg: ResolvedConfig, out, *, resume: bool = False, workers=None,
         _warm_up(cfg, workers, scheduler, log)
         return sweep_to_file(cfg, out, resume=resume, workers=workers,
                              scheduler=scheduler, progress=progress, log=log,
-                             overwrite=overwrite)
+                             overwrite=overwrite, command=command)
 
 
 def _interrupt():
