@@ -391,14 +391,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
     # every model (cooling set) at once: the model (cooling set) names each row
     columns = (*(c for c in CATEGORIES if c in ds.dims), *columns)
-    for name in [c.name for c in conditions] + [sort_name]:
-        if name in OPTIONAL and name not in ds:
-            raise InputError(f"{name}: the cube has no {name}; {missing_hint(name)}")
-    if limit is not None and limit < 0:
-        raise InputError(f"--limit: must be 0 or more, got {limit}")
-    for name in chosen or ():
-        if name in OPTIONAL and name not in ds:
-            raise InputError(f"--columns: the cube has no {name}; {missing_hint(name)}")
+    _check_asked(ds, [c.name for c in conditions] + [sort_name], chosen, limit)
     at_loc = {name: locate(ds, name, value) for name, value in at.items()}
     off_grid = [name for name, loc in at_loc.items() if not loc[3]]
     exact = bool(off_grid) and not interpolate
@@ -406,14 +399,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     # a model spread off the grid: every variant through the exact model (query/spread.py)
     variants = spread_variants(ds) if exact else ()
     if exact:  # the exact model gives the design variables, not the sampled or tracked ones
-        for name in [c.name for c in conditions] + [sort_name] + list(chosen or ()):
-            if name in OPTIONAL and not (variants and name in SPREAD):
-                raise InputError(f"{name}: not computed off the grid (the exact model gives "
-                                 "the design variables; the sweep sampled or simulated "
-                                 f"{name} on the grid): use --interpolate, or grid values "
-                                 f"for {', '.join(off_grid)}")
-        columns = tuple(c for c in columns
-                        if c not in OPTIONAL or (variants and c in SPREAD))
+        columns = _exact_columns(columns, [c.name for c in conditions] + [sort_name] +
+                                 list(chosen or ()), variants, off_grid)
     flags = None
     if off_grid and interpolate:  # the flags from the exact model, when it can be had
         try:
@@ -439,19 +426,9 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
             continue  # an incomplete cube: nothing computed here
         room = None if limit is None or sort_name is not None else \
             limit - len(kept[COLUMNS[0]])
-        n_where = None
-        if exact:
-            rows = _exact_rows(ds, at, at_loc, r0, r1, settings, evaluate)
-            if variants:
-                rows.update(exact_spread(rows, settings, evaluate, variants))
-        elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
-            # variable by variable (a cube of several models or cooling sets is read
-            # whole, per slab)
-            rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
-        else:
-            rows = slab_rows(ds, at_loc, r0, r1)
-        if flags == EXACT:
-            rows = _exact_flags(rows, settings, evaluate)
+        rows, n_where = _rows_of_slab(ds, at, at_loc, (r0, r1), conditions, room,
+                                      model=(settings, evaluate, variants), exact=exact,
+                                      flags=flags, off_grid=off_grid)
         mask = np.ones(len(rows[COLUMNS[0]]), dtype=bool)
         for c in conditions:
             mask &= c.mask(rows[c.name])
@@ -477,6 +454,55 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     return QueryResult(kept, point, off_grid, matched, single=len(at_loc) == len(AXES),
                        at=at, columns=columns, chosen=chosen, asked=asked, flags=flags,
                        every=every)
+
+
+def _check_asked(ds, names, chosen, limit):
+    """Refuse a condition, sort or column the cube does not hold, and a negative limit."""
+    for name in names:
+        if name in OPTIONAL and name not in ds:
+            raise InputError(f"{name}: the cube has no {name}; {missing_hint(name)}")
+    if limit is not None and limit < 0:
+        raise InputError(f"--limit: must be 0 or more, got {limit}")
+    for name in chosen or ():
+        if name in OPTIONAL and name not in ds:
+            raise InputError(f"--columns: the cube has no {name}; {missing_hint(name)}")
+
+
+def _exact_columns(columns, asked, variants, off_grid):
+    """The columns an off-grid (exact) query can give: the design variables, and a model
+    spread's range where the cube has one; an asked-for sampled or tracked variable is
+    refused in one line."""
+    for name in asked:
+        if name in OPTIONAL and not (variants and name in SPREAD):
+            raise InputError(f"{name}: not computed off the grid (the exact model gives "
+                             "the design variables; the sweep sampled or simulated "
+                             f"{name} on the grid): use --interpolate, or grid values "
+                             f"for {', '.join(off_grid)}")
+    return tuple(c for c in columns if c not in OPTIONAL or (variants and c in SPREAD))
+
+
+def _rows_of_slab(ds, at, at_loc, bounds, conditions, room, *, model, exact, flags,
+                  off_grid):
+    """One slab's candidate rows and, where the conditions were applied variable by
+    variable, how many matched (else None). ``model``: (settings, evaluate, variants) of
+    the exact model (None, None, () where it is not used); ``exact``: the rows come from
+    it (an off-grid query without --interpolate)."""
+    r0, r1 = bounds
+    n_where = None
+    settings, evaluate, variants = model
+    if exact:
+        rows = _exact_rows(ds, at, at_loc, r0, r1, settings, evaluate)
+        if variants:
+            rows.update(exact_spread(rows, settings, evaluate, variants))
+    elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
+        # variable by variable (a cube of several models or cooling sets is read whole,
+        # per slab)
+        rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
+    else:
+        rows = slab_rows(ds, at_loc, r0, r1)
+    if flags == EXACT:
+        rows = _exact_flags(rows, settings, evaluate)
+    return rows, n_where
 
 
 def _exact_flags(rows, settings, evaluate):
