@@ -30,7 +30,7 @@ from nylonflex.engine.grid import compute_slab
 from nylonflex.physics import design_limits as python_loop
 from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.storage import open_cube
-from nylonflex.storage.sweep import run_sweep, sweep_file
+from nylonflex.sweep.conductor import run_sweep, sweep_file
 
 from .first_use import cold_compiles, command_costs
 from .flops import kernel_flops_per_design

@@ -34,7 +34,7 @@ _LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
          "nylon_parameters": "materials", "silicone_parameters": "materials",
          "design_limits": "engine", "evaluate": "engine", "load_config": "config",
          "bend_angle": "engine", "fe_bend": "fe",
-         "run_sweep": "storage.sweep", "open_cube": "storage", "run_design": "design",
+         "run_sweep": "sweep.conductor", "open_cube": "storage", "run_design": "design",
          "CompileWarning": "kernels.compiling"}
 
 

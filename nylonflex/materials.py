@@ -528,7 +528,7 @@ def _resolve(kind, table, value, overrides):
     if isinstance(value, Mapping):
         value = dict(value)
         if "file" in value:  # a fitted material file (nylonflex.calibration), as a set
-            from .config.material_files import read_material_set
+            from .files.material_files import read_material_set
 
             if "set" in value:
                 raise ValueError(f"{kind}: give 'file' or 'set', not both")

@@ -16,7 +16,7 @@ def write_config(folder, raw, name="cfg.yaml"):
 def write_cube(folder, raw):
     """Sweep a config mapping into ``folder/cube.h5``; return the path."""
     from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     path = Path(folder) / "cube.h5"
     run_sweep(parse_config(raw), out=path).close()
@@ -39,7 +39,7 @@ def fitted_thermal_file(folder, lam=0.05, cap=0.45, lm=0.3, v=5.0, r_meas=40.0):
     import numpy as np
 
     from nylonflex.calibration import fit_thermal
-    from nylonflex.config.material_files import write_material_file
+    from nylonflex.files.material_files import write_material_file
     from nylonflex.materials import nylon_parameters
 
     t_amb = nylon_parameters().t_amb

@@ -15,7 +15,7 @@ import sys
 _KILL_AFTER = """
 import os, signal, sys
 import nylonflex.engine.slabs as slabs
-import nylonflex.storage.run as run
+import nylonflex.sweep.run as run
 
 K, SIG = int(sys.argv[1]), int(sys.argv[2])
 original = slabs.run_slabs

@@ -20,8 +20,8 @@ from nylonflex.config.sweep import parse_config
 from nylonflex.physics import thermal
 from nylonflex.physics.limits import _validity
 from nylonflex.physics.records import Section
-from nylonflex.query.parse import parse_condition
-from nylonflex.storage import files
+from nylonflex.conditions import parse_condition
+from nylonflex.files import atomic as files
 from nylonflex.units import InputError
 
 SECTION = Section(radius=7.5e-3, wall=2e-3, base=2e-3)  # the paper's example 2 [m]

@@ -12,7 +12,7 @@ from nylonflex import charts
 from nylonflex.cli import main
 from nylonflex.config import CHARTS, parse_config
 from nylonflex.storage import open_cube
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 
 DEG = math.pi / 180.0
 SMALL = {

@@ -53,7 +53,7 @@ def test_a_folder_that_refuses_the_write_is_the_environment(code, words):
 def test_a_sweep_into_a_read_only_folder_exits_2_with_one_line(tmp_path, capsys,
                                                                 monkeypatch):
     # root ignores the mode bits, so the folder's refusal is the write's own exception
-    import nylonflex.storage.sweep as sweep
+    import nylonflex.sweep.conductor as sweep
 
     def refuse(*a, **k):
         raise PermissionError(errno.EACCES, "Permission denied", str(tmp_path / "ro" / "c.h5"))

@@ -1,5 +1,5 @@
 """One condition grammar: the same table of conditions through ``--where``, a sweep's
-``requirements:`` and a design's ``constraints:`` (query/parse.py).
+``requirements:`` and a design's ``constraints:`` (conditions.py).
 
 Each row: the text, then what each of the three makes of it, a ``(name, op, SI value)`` or
 the pattern of the one-line refusal. The SI values are the typed numbers converted by hand
@@ -15,7 +15,7 @@ import pytest
 from nylonflex.config import parse_config
 from nylonflex.design.spec import parse_spec
 from nylonflex.query import Condition, parse_condition, parse_where
-from nylonflex.query.parse import parse_requirements
+from nylonflex.conditions import parse_requirements
 from nylonflex.units import InputError
 
 SWEEP = {

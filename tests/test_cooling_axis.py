@@ -170,7 +170,7 @@ def test_a_speed_typed_with_its_unit_is_read_as_m_per_s():
     with pytest.raises(InputError, match=r"^cooling\[1\]\.speed: unknown unit 'km'"):
         parse_config(_with(cooling=["still_air", {"set": "forced_air", "speed": "5 km"}]))
     from nylonflex.sim import parse_sim_config
-    from nylonflex.config.safe_yaml import read_yaml
+    from nylonflex.files.safe_yaml import read_yaml
 
     sim = parse_sim_config({**read_yaml("configs/control.yaml"),
                             "cooling": {"set": "forced_air", "speed": "5 m/s"}})

@@ -19,7 +19,7 @@ from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.design import nondominated, parse_spec, run_design
 from nylonflex.query import parse_condition
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.units import InputError
 from nylonflex.variables import AXES, DESIGN, SUPPLY_ONLY, VARIABLES, to_display
 

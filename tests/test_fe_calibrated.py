@@ -55,7 +55,7 @@ def test_angle_grows_with_pressure_beyond_the_training_range(a, t, L):
 
 def test_cube_and_evaluate_agree_with_the_correction():
     from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     cfg = parse_config({
         "name": "calibrated", "model": ["lateral_pressure", "fe_calibrated"],

@@ -9,7 +9,7 @@ import yaml
 
 from nylonflex.calibration.chamber_bench import fit_chamber
 from nylonflex.cli import main
-from nylonflex.config.material_files import read_chamber_file
+from nylonflex.files.material_files import read_chamber_file
 from nylonflex.physics import P_ATM
 from nylonflex.physics.sealed_model import boyle_pressure
 
@@ -158,7 +158,7 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
     from nylonflex.engine.provenance import cube_settings
     from nylonflex.materials import silicone_parameters
     from nylonflex.physics.sealed import anchored_coefficients
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     out = tmp_path / "chamber.yaml"
     assert main(["fit", "chamber", str(bench_csv(tmp_path / "b.csv", seed=5)), "--radius",

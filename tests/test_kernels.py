@@ -15,7 +15,7 @@ from nylonflex.materials import SILICONE_PARAMETERS, silicone_parameters
 from nylonflex.physics import bending, chamber, elementary, nylon, wrap
 from nylonflex.physics.elementary import _exp, _log
 from nylonflex.engine.grid import compute_slab
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.variables import SUPPLY_ONLY
 
 IRREGULAR = {

@@ -85,7 +85,7 @@ def test_bend_angle_broadcasts_and_checks_its_input():
 
 def test_cube_curve_of_the_lateral_model_is_nf_bend_angle():
     from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     cfg = parse_config({
         "name": "lateral", "model": ["paper", "lateral_pressure"],

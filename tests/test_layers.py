@@ -1,13 +1,13 @@
 """The import-layering contract: imports point down, never back, and never in a circle.
 
-Each module of the package sits in one of the named layers of :data:`NAMED_LAYERS`, lowest
-first: foundation (units) <- files <- registry (variables) <- material files <- materials
-<- condition grammar <- config <- physics <- simulate config <- kernels <- engine <-
-simulation <- outputs (storage, charts, query) <- finite elements <- applications
-(calibration, design, explore, uncertainty, the JSON Schema) <- cli. An import of another
-nylonflex module must reach a lower layer (or its own package). The physics imports
-neither numba, xarray nor matplotlib. Imports sit at module top unless they are heavy
-(:data:`HEAVY_IMPORTS`, docs/architecture.md); no private name crosses a package.
+Each top-level module and folder of the package is one layer of :data:`NAMED_LAYERS`,
+lowest first: foundation (units) <- files <- examples <- registry (variables) <- variant
+notes <- materials <- condition grammar <- physics <- config <- kernels <- engine <-
+simulation <- outputs (storage, charts, query) <- sweep <- finite elements <- applications
+(calibration, design, explore, uncertainty) <- cli. An import of another nylonflex module
+must reach a lower layer (or its own folder). The physics imports neither numba, xarray
+nor matplotlib. Imports sit at module top unless they are heavy (:data:`HEAVY_IMPORTS`,
+docs/architecture.md); no private name crosses a package.
 """
 
 import ast
@@ -19,30 +19,26 @@ import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 
-#: The layers, lowest first: a name, and the top-level modules and subpackages in it.
-#: Same-layer imports are allowed only inside one subpackage. A module of a subpackage may
-#: have a layer of its own: lower than its package (``query.parse``, the condition grammar
-#: the config reads, needs only units and variables; ``config.safe_yaml``,
-#: ``config.material_files`` and ``storage.files``, which the materials and the config read
-#: and write through; the simulate config ``config.simulate``, which checks a supply
-#: against the physics) or higher (``config.schema``, the JSON Schema of every config).
+#: The layers, lowest first: a name, and the top-level modules and folders in it (one line
+#: a layer, folders only: no module of a folder has a layer of its own). Same-layer imports
+#: are allowed only inside one folder.
 NAMED_LAYERS = (
     ("foundation", ("_version", "units")),
-    ("files", ("config.safe_yaml", "storage.files", "examples")),
+    ("files", ("files",)),
+    ("examples", ("examples",)),
     ("registry", ("variables",)),
     ("variant notes", ("variants",)),
-    ("material files", ("config.material_files",)),
     ("materials", ("materials",)),
-    ("condition grammar", ("query.parse",)),
-    ("config", ("config",)),
+    ("condition grammar", ("conditions",)),
     ("physics", ("physics",)),
-    ("simulate config", ("config.simulate",)),
+    ("config", ("config",)),
     ("kernels", ("kernels",)),
     ("engine", ("engine",)),
     ("simulation", ("sim",)),
     ("outputs", ("storage", "charts", "query")),
+    ("sweep", ("sweep",)),
     ("finite elements", ("fe",)),
-    ("applications", ("calibration", "design", "explore", "uncertainty", "config.schema")),
+    ("applications", ("calibration", "design", "explore", "uncertainty")),
     ("cli", ("cli",)),
 )
 
@@ -78,11 +74,8 @@ def _imports(path: Path, module: str) -> set[str]:
 
 
 def _unit(name: str) -> str | None:
-    """The top-level module or subpackage of a dotted nylonflex name (None: the root), or
-    the module of a subpackage that has a layer of its own (``query.parse``)."""
+    """The top-level module or folder of a dotted nylonflex name (None: the root)."""
     parts = name.split(".")
-    if len(parts) > 2 and ".".join(parts[1:3]) in LAYERS:
-        return ".".join(parts[1:3])
     return parts[1] if len(parts) > 1 else None
 
 
@@ -392,13 +385,13 @@ def test_no_private_name_is_imported_across_packages():
 
 #: The modules the package root holds (issue 28); everything else lives in a subpackage.
 ROOT = {"__init__", "__main__", "_version", "errors", "materials", "units", "variables",
-        "variants"}  # variants: the model variants' records beside MODELS (issue 46)
+        "variants", "conditions"}  # variants: the model variants' records beside MODELS (issue 46)
 
 #: The subpackages the package root holds (issue 28). The benchmarks and the slow reference
 #: are not among them: they live in the repository's benchmarks/ and tests/naive.py.
 SUBPACKAGES = {"physics", "kernels", "engine", "storage", "config", "query", "sim",
                "calibration", "uncertainty", "design", "charts", "explore", "fe", "cli",
-               "examples"}
+               "examples", "files", "sweep"}
 
 
 def _root_contents(pkg: Path):

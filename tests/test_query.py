@@ -20,7 +20,7 @@ from nylonflex import query
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import open_cube
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.units import InputError
 
 AT_2 = "radius=7.5mm,wall_thickness=2mm,length=70mm,coil_index=1.7,wrap_angle=8deg"

@@ -29,11 +29,11 @@ import yaml
 from helpers import stable, write_config
 
 import nylonflex.storage.journal as journal_mod
-import nylonflex.storage.run as run_mod
+import nylonflex.sweep.run as run_mod
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import Journal, exclusive, open_cube
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.units import InputError
 from nylonflex.variables import is_complete
 
@@ -639,7 +639,7 @@ def test_a_signal_while_a_slab_computes_stops_after_it(tmp_path):
 _FINALISER_SIGNAL = """
 import os, signal, sys
 import nylonflex.engine.slabs as slabs
-import nylonflex.storage.run as run_mod
+import nylonflex.sweep.run as run_mod
 
 WHERE, SIG = sys.argv[1], int(sys.argv[2])
 

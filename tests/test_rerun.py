@@ -90,7 +90,7 @@ LAST_BITS = {"bend_angle_max": 1e-10, "range_fraction": 1e-10}
 
 def _swept(tmp_path, case):
     from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     cfg = parse_config({**SMALL, **CASES[case]})
     return cfg, run_sweep(cfg, tmp_path / f"{case}.h5")

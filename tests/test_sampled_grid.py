@@ -21,7 +21,7 @@ from nylonflex.config import parse_config
 from nylonflex.engine.pointwise import evaluate
 from nylonflex.engine.sampled import (perturbed_inputs, sample_configs, sample_statistics,
                                       standard_samples)
-from nylonflex.query.parse import parse_requirements
+from nylonflex.conditions import parse_requirements
 from nylonflex.variables import AXES
 
 from helpers import tight_fit_file

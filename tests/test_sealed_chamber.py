@@ -156,7 +156,7 @@ def test_the_shipped_file_says_what_it_is():
 
 def test_cube_curves_and_designs_agree_with_the_physics():
     from nylonflex.config import parse_config
-    from nylonflex.storage.sweep import run_sweep
+    from nylonflex.sweep.conductor import run_sweep
 
     cfg = parse_config({
         "name": "sealed", "model": ["paper", "sealed_chamber"],

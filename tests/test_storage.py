@@ -57,7 +57,7 @@ def _h5netcdf_cube(path, cfg, codec):
     import h5netcdf
 
     from nylonflex.engine.grid import coords, cube_variables, plan_slabs
-    from nylonflex.storage.cube import CODECS, _chunks
+    from nylonflex.storage.cube import CODECS, chunk_shape
     from nylonflex.variables import COORDS, MODEL, slab_done_attrs
 
     _, chunk = plan_slabs(cfg)
@@ -81,7 +81,7 @@ def _h5netcdf_cube(path, cfg, codec):
             dims = tuple(disk.get(d, d) for d in dims)
             aux = {"coordinates": "pressure"} if "pressure_point" in dims else {}
             f.create_variable(var.name, dims, var.dtype, fillvalue=fill,
-                              chunks=_chunks(dims, sizes, chunk),
+                              chunks=chunk_shape(dims, sizes, chunk),
                               **CODECS[codec].filters).attrs.update({**var.attrs(), **aux})
         f.create_variable("slab_done", ("radius",), "i1", fillvalue=None).attrs.update(
             slab_done_attrs())
@@ -186,15 +186,15 @@ def test_shuffle_is_hdf5s_byte_transpose(itemsize, n):
 def test_numpy_and_compiled_shuffles_store_the_same_bytes(codec, dtype):
     # a small cube's chunks are shuffled by NumPy (nothing to compile), a large one's by the
     # compiled loops: the stored chunk must be the same either way, padded chunks included
-    from nylonflex.storage.cube import CODECS, _encode_chunk
+    from nylonflex.storage.cube import CODECS, encode_chunk
 
     if CODECS[codec].plugin:
         pytest.importorskip("zstandard")
     rng = np.random.default_rng(3)
     block = (rng.random((3, 5, 7)) * 100).astype(dtype)
     for chunks in ((3, 5, 7), (4, 5, 8)):
-        assert _encode_chunk(block, chunks, CODECS[codec], True) == \
-            _encode_chunk(block, chunks, CODECS[codec], False)
+        assert encode_chunk(block, chunks, CODECS[codec], True) == \
+            encode_chunk(block, chunks, CODECS[codec], False)
 
 
 def test_a_small_cube_compiles_no_shuffle(tmp_path):

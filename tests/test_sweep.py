@@ -14,7 +14,7 @@ from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.storage import Journal, exclusive, open_cube
 from nylonflex.engine.grid import bytes_per_radius, plan_slabs
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.variables import VARIABLES
 
 SMALL = {

@@ -16,7 +16,7 @@ import nylonflex as nf
 from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.engine.grid import cube_variables, plan_slabs
-from nylonflex.config.safe_yaml import read_yaml
+from nylonflex.files.safe_yaml import read_yaml
 from nylonflex.physics.thermal import coil_heat_loss_per_length
 from nylonflex.sim import parse_sim_config, run_simulation
 from nylonflex.units import InputError

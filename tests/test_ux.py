@@ -41,7 +41,7 @@ def test_dry_run_prints_size_memory_time_and_writes_nothing(tmp_path, capsys):
 
 
 def test_estimate_sizes_match_the_written_cube(tmp_path):
-    from nylonflex.storage.sweep import estimate
+    from nylonflex.sweep.conductor import estimate
 
     cfg = parse_config(TINY)
     e = estimate(cfg)
@@ -56,7 +56,7 @@ def test_estimate_sizes_match_the_written_cube(tmp_path):
 def test_a_dry_run_of_a_sampled_sweep_estimates_its_quantile_variables(tmp_path, capsys):
     # the estimate sizes each variable's chunks from the cube's coordinates: a sampled
     # sweep's <variable>_quantile lie over quantile (a KeyError before, exit 1)
-    from nylonflex.storage.sweep import estimate
+    from nylonflex.sweep.conductor import estimate
 
     raw = {**TINY, "uncertainty": {"samples": 8, "seed": 1,
                                    "parameters": {"silicone.mu": {"rel_sd": 0.1}}}}

@@ -20,7 +20,7 @@ from nylonflex.variables import SUPPLY_ONLY
 from nylonflex.physics.nylon import _temperature_for_stroke
 from nylonflex.physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from nylonflex.materials import nylon_parameters, silicone_parameters
-from nylonflex.storage.sweep import run_sweep
+from nylonflex.sweep.conductor import run_sweep
 from nylonflex.units import InputError
 
 NY = nylon_parameters("silver_nylon66")

@@ -8,7 +8,7 @@ compares one design's model with its measurements. docs/calibration.md has the f
 """
 
 from .data import Table, read_table
-from ..config.material_files import read_material_set, write_material_file
+from ..files.material_files import read_material_set, write_material_file
 from .hyperelastic import MODELS, TESTS, fit_silicone, nominal_stress
 from .muscle import fit_muscle, fit_stroke, fit_thermal
 from .result import FitResult

@@ -29,7 +29,7 @@ from ..materials import nylon_parameters, silicone_parameters
 from ..physics import bend_angle, chamber_pressure, tip_force
 from ..units import InputError, parse_quantity
 from .data import Table, column, read_table
-from ..config.material_files import anchor_material_files
+from ..files.material_files import anchor_material_files
 from ..variables import VARIABLES
 
 __all__ = ["Comparison", "validate_design", "design_from_config"]

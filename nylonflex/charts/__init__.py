@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config.charts import CHART_REGISTRY
-from ..storage.files import OwnedFiles, save_figure
+from ..files.atomic import OwnedFiles, save_figure
 from ..units import InputError
 from ..variables import VARIABLES, to_display
 from ._common import FORMATS, RC, _grid_value, new_figure, rc_context
@@ -194,7 +194,7 @@ def draw_charts(ds, names, out_dir, fmt="png", on_skip=None, *, at=None, coil_in
         The variable ``compare`` draws (default ``tip_force_max``).
     overwrite : bool
         Replace files nylonflex did not write for this cube [-] (a manifest in the folder,
-        :class:`nylonflex.storage.files.OwnedFiles`, records the charts each cube drew).
+        :class:`nylonflex.files.atomic.OwnedFiles`, records the charts each cube drew).
     refuse_foreign : bool
         With such a file in the way and no ``overwrite``: raise before drawing anything
         (True) or leave that chart undrawn with a line to ``on_skip`` (False) [-].

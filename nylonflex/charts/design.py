@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..storage.files import save_figure
+from ..files.atomic import save_figure
 from ._common import new_figure, rc_context
 from ..variables import AXES, name_label, to_display
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..storage.files import save_figure
+from ..files.atomic import save_figure
 
 __all__ = ["fit_chart", "fit_figure", "validate_chart", "validate_figure"]
 

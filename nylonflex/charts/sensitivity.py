@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..storage.files import save_figure
+from ..files.atomic import save_figure
 from ._common import RC, new_figure, rc_context
 from ..variables import name_label
 

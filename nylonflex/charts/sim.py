@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..storage.files import save_figure
+from ..files.atomic import save_figure
 
 __all__ = ["draw_simulation_charts", "figure9", "figure10a"]
 

@@ -65,7 +65,7 @@ def port_free(port: int, host: str = "127.0.0.1") -> bool:
 
 def run(args) -> int:
     if args.html:
-        from ..storage.files import refuse_special
+        from ..files.atomic import refuse_special
 
         out = Path(args.html)
         refuse_special(out, "--html", inputs=[args.cube])
@@ -91,7 +91,7 @@ def run(args) -> int:
 
     fidelity = _fidelity(args.cube)
     if args.html:
-        from ..storage.files import write_atomic
+        from ..files.atomic import write_atomic
 
         with progress_bar("explore --html", unit="s", quiet=args.quiet, command="explore"):
             text = build_html(ds, source=source, where=where, fidelity=fidelity)

@@ -178,7 +178,7 @@ def run_fe(args) -> int:
     from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
     from ..physics.calibrated import CORRECTION, TERMS
     from ..fe.verify import MAX_DESIGNS
-    from ..storage.files import refuse_special, write_atomic
+    from ..files.atomic import refuse_special, write_atomic
 
     if args.data is not None:
         raise InputError(f"fit fe: takes no data file (got {args.data!r}); the FE twin "
@@ -254,7 +254,7 @@ def run_sealed(args) -> int:
     import numpy as np
 
     from ..calibration.chamber import calibration_document, fe_records, fit_sealed_chamber
-    from ..storage.files import refuse_special, write_atomic
+    from ..files.atomic import refuse_special, write_atomic
 
     if args.data is None or not Path(args.data).is_dir():
         raise InputError(f"DIR: 'fit sealed' needs the folder of FE records, got {args.data!r}")
@@ -308,7 +308,7 @@ def run(args) -> int:
     if args.data is None:
         raise InputError(f"DATA: required for 'fit {args.kind}' (a CSV or database file)")
     from ..calibration import write_material_file
-    from ..storage.files import refuse_special
+    from ..files.atomic import refuse_special
 
     # refused before the work: a link, a special file, the data file itself, or (without
     # --overwrite) any file

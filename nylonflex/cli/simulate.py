@@ -22,7 +22,7 @@ def run(args) -> int:
 
     cfg = load_sim_config(args.config)
     out = Path(args.out) if args.out else Path("sweeps") / cfg.name / "sim.h5"
-    from ..storage.files import refuse_special
+    from ..files.atomic import refuse_special
 
     refuse_special(out, "--out", inputs=[args.config])  # before the work
     with progress_bar("simulate", unit="s", quiet=args.quiet):  # the time elapsed

@@ -40,7 +40,7 @@ def run(args) -> int:
 
 
 def _run(args, charts: bool) -> int:
-    from ..storage.files import refuse_special
+    from ..files.atomic import refuse_special
 
     bar = None  # while the sweep's bar shows, a message goes above it, never into it
 
@@ -56,7 +56,7 @@ def _run(args, charts: bool) -> int:
             from ..config import load_config
             from ..engine.slabs import deferred_signals
             from ..storage.journal import file_locks
-            from ..storage.sweep import default_output, prepare, sweep_file
+            from ..sweep.conductor import default_output, prepare, sweep_file
 
             cfg = load_config(args.config, args.set)
             out = Path(args.out) if args.out else default_output(cfg)
@@ -200,7 +200,7 @@ def _duration(seconds) -> str:
 
 
 def _dry_run(cfg, out, args, log) -> int:
-    from ..storage.sweep import estimate
+    from ..sweep.conductor import estimate
 
     if args.scheduler:
         log("dry run: the time is estimated for this machine's threads, not the cluster")

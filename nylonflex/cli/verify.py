@@ -46,7 +46,7 @@ def run(args) -> int:
     from ..charts.fidelity import fidelity_map
     from ..fe import require_felupe
     from ..fe.verify import fidelity_summary, run_verify
-    from ..storage.files import save_figure
+    from ..files.atomic import save_figure
 
     require_felupe()
     start = time.monotonic()

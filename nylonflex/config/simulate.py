@@ -41,8 +41,8 @@ from ..physics.wrap import muscle_length
 from ..units import InputError, bare_number, from_si, plainly_degrees
 from .base import _no_bool, _pydantic_message, _Strict, check_range, check_run_name, \
     range_error, resolve_cooling
-from .material_files import anchor_material_files
-from .safe_yaml import read_yaml
+from ..files.material_files import anchor_material_files
+from ..files.safe_yaml import read_yaml
 from .sweep import DESIGN_RANGES
 
 __all__ = [

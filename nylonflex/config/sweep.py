@@ -25,9 +25,9 @@ import yaml
 from pydantic import BeforeValidator, Field, ValidationError, field_validator, model_validator
 
 from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_parameters
-from ..query.parse import parse_requirements
-from .material_files import anchor_material_files, read_chamber_file
-from .safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
+from ..conditions import parse_requirements
+from ..files.material_files import anchor_material_files, read_chamber_file
+from ..files.safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
 from ..units import (InputError, bare_number, decimal_to_si, parse_decimal, plainly_degrees,
                      short, to_si)
 from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES

@@ -124,7 +124,7 @@ def _fitted_field(p, numeric):
 
 
 def _fit_parameter(name, dist, path, raw_material, material):
-    from .material_files import read_material_file
+    from ..files.material_files import read_material_file
 
     if not (isinstance(raw_material, dict) and isinstance(raw_material.get("file"), str)):
         raise InputError(f"{path}.from_fit: {name} must come from a fitted material file "

@@ -26,7 +26,7 @@ from ..engine.provenance import cube_settings
 from ..query import COLUMNS, HEADLINE as _HEADLINE
 from ..query.frames import html_table, rows_frame
 from ..storage import open_cube
-from ..storage.sweep import run_sweep
+from ..sweep.conductor import run_sweep
 from ..units import InputError
 from ..variables import AXES, DESIGN
 from .refine import Model, _bounds, evaluate_rows, meets, refine

@@ -13,7 +13,7 @@ import yaml
 
 from .. import __version__
 from ..config import ResolvedConfig, parse_config
-from ..config.material_files import read_chamber_file
+from ..files.material_files import read_chamber_file
 from ..config.tracking import tracking_section
 from ..kernels import source_digest
 from ..materials import (COOLING_PARAMETERS, Cooling, Nylon, Silicone, cooling_parameters,

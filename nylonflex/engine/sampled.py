@@ -28,7 +28,7 @@ from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS
 from ..materials import SILICONE_PARAMETERS
 from ..physics.chamber import chamber_pressure
 from ..physics.nylon import stroke_max
-from ..query.parse import parse_requirements
+from ..conditions import parse_requirements
 from ..variables import AXES, COORDS, DESIGN, UNCERTAIN, quantile_name
 from .model_slab import (chamber_coefficients, grid_axes, grid_out, kernel_inputs, paper_kernel,
                          run_grid)

@@ -6,7 +6,7 @@
   :class:`LocalExecutor` (the engine's threads, the next slab computed while the last is stored)
   or :class:`nylonflex.engine.cluster.DaskExecutor`;
 - a *sink* stores them: ``sink.put(k, i0, i1, arrays)``. :class:`MemorySink` fills an
-  in-memory :class:`xarray.Dataset`; :class:`nylonflex.storage.CubeSink` journals each slab
+  in-memory :class:`xarray.Dataset`; :class:`nylonflex.sweep.run.CubeSink` journals each slab
   and writes the HDF5 cube.
 
 Ctrl-C or SIGTERM stops the loop after the slab being stored; what was stored stays, so an

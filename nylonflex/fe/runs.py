@@ -79,7 +79,7 @@ def journaled_runs(parts, plan, tasks, solve, *, workers=1, scheduler=None, prog
     ``plan`` (JSON-able) identifies the runs: a folder holding another plan is refused.
     ``solve`` must be importable (it runs in other processes); its result JSON-able.
     """
-    from ..storage.files import write_atomic
+    from ..files.atomic import write_atomic
 
     parts = Path(parts)
     if parts.is_symlink():

@@ -148,7 +148,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     """
     import xarray as xr
 
-    from ..storage.files import replacing
+    from ..files.atomic import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
 

@@ -1,4 +1,4 @@
-"""Numba kernels over design grids. Only :mod:`nylonflex.storage.sweep` (and the simulator)
+"""Numba kernels over design grids. Only :mod:`nylonflex.sweep.conductor` (and the simulator)
 call them.
 
 :func:`source_digest` (of the physics and kernel sources) names the compiled model in a

@@ -13,7 +13,7 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-from ..storage.files import create_new
+from ..files.atomic import create_new
 
 __all__ = ["cache_dir", "caching", "mark_compiled", "source_digest", "was_compiled",
            "writable"]

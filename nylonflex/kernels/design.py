@@ -1,8 +1,8 @@
 """The design-grid kernel: every design variable and curve of a slab of radii.
 
 Private compiled loops that write into ``out`` arrays and check nothing (numbagg's habit);
-:mod:`nylonflex.storage.sweep` validates and shapes. The loops follow the model's structure so that
-nothing is computed twice that a design axis does not change:
+:mod:`nylonflex.sweep.conductor` validates and shapes. The loops follow the model's
+structure so that nothing is computed twice that a design axis does not change:
 
 - per (a, t): the section's quadrature node table (heights and weights, no trigonometry),
   then the bend-angle curve over pressure, each solve started from the quintic Hermite

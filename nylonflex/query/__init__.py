@@ -30,7 +30,7 @@ from __future__ import annotations
 from ..variables import AXES, DESIGN, VARIABLES  # noqa: F401  (names the tests use)
 from .format import (cell_text, flag_names, format_csv, format_json, format_table, held_back,
                      rows_note, shown_columns)
-from .parse import (COLUMNS, EXACT, GRID, HEADLINE, INTERPOLATED, OPS, OPTIONAL,
+from ..conditions import (COLUMNS, EXACT, GRID, HEADLINE, INTERPOLATED, OPS, OPTIONAL,
                     Condition, default_columns, parse_at, parse_columns, parse_condition,
                     parse_constraint, parse_requirements, parse_where)
 from .scan import QueryResult, at_value, locate, query_cube, slab_rows

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..variables import AXES, CATEGORIES, COOLING, DESIGN, MODEL, SPREAD, VARIABLES, to_display
-from .parse import EXACT, OPTIONAL, default_columns
+from ..conditions import EXACT, OPTIONAL, default_columns
 
 
 def _var(name):

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..units import bare_number, from_si
 from ..variables import AXES, VARIABLES
-from .parse import _PATTERN, Condition
+from ..conditions import CONDITION_PATTERN, Condition
 
 __all__ = ["unit_notes", "variable_range"]
 
@@ -62,7 +62,7 @@ def unit_notes(ds, conditions, matched) -> list[str]:
     for c in conditions:
         if not isinstance(c, Condition) or c.name not in VARIABLES:
             continue
-        m = _PATTERN.match(c.text)
+        m = CONDITION_PATTERN.match(c.text)
         typed = bare_number(m.group(3)) if m else None
         v = VARIABLES[c.name]
         if typed is None or v.display == v.units or c.name not in ds:

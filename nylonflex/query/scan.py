@@ -15,8 +15,8 @@ from ..units import InputError, from_si
 from ..variables import CATEGORIES, AXES, DESIGN, SPREAD, VARIABLES
 from .format import rows_note, shown_columns
 from .frames import html_table, rows_frame
-from .parse import (_CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
-                    _parse_sort, missing_hint, parse_at, parse_columns, parse_condition)
+from ..conditions import (CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
+                    parse_sort, missing_hint, parse_at, parse_columns, parse_condition)
 from .spread import PER_LENGTH, TIMES_LENGTH, exact_spread, spread_variants
 
 # Values this close (relative to the axis span) to a grid value are that grid value.
@@ -387,7 +387,7 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     chosen = None if every else chosen
     ds, where = _select_model(ds, where)
     conditions = [c if isinstance(c, Condition) else parse_condition(c) for c in where]
-    sort_name, descending = _parse_sort(sort)
+    sort_name, descending = parse_sort(sort)
     columns = COLUMNS + tuple(n for n in OPTIONAL if n in ds)
     # every model (cooling set) at once: the model (cooling set) names each row
     columns = (*(c for c in CATEGORIES if c in ds.dims), *columns)
@@ -527,8 +527,8 @@ def _select_model(ds, where):
     name each row's).
     """
     where = list(where or ())
-    picks = [m for m in (_CATEGORY_WHERE.match(str(w)) for w in where) if m]
-    rest = [w for w in where if not _CATEGORY_WHERE.match(str(w))]
+    picks = [m for m in (CATEGORY_WHERE.match(str(w)) for w in where) if m]
+    rest = [w for w in where if not CATEGORY_WHERE.match(str(w))]
     for cat in CATEGORIES:
         names = [m.group(3) for m in picks if m.group(1) == cat]
         if cat in ds.dims:

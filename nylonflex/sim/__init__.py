@@ -46,7 +46,7 @@ from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length
 from ..physics.wrap import nylon_force
-from ..storage.files import refuse_special, replacing
+from ..files.atomic import refuse_special, replacing
 from ..units import InputError
 
 __all__ = [
@@ -331,7 +331,7 @@ def write_simulation(ds, path, inputs=()) -> Path:
     """Write a simulation Dataset to NetCDF4/HDF5 (h5netcdf engine) at ``path``.
 
     Atomic: written to a new temporary file beside it, fsynced, then renamed
-    (:func:`nylonflex.storage.files.replacing`). Only an earlier simulation is replaced; anything
+    (:func:`nylonflex.files.atomic.replacing`). Only an earlier simulation is replaced; anything
     else at ``path`` (a cube, a config, a link, a special file, one of ``inputs``) is
     refused with an InputError.
     """

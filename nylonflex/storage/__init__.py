@@ -3,7 +3,6 @@
 - :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once;
 - :mod:`.netcdf4`: the netCDF-4 layout (dimensions, coordinates, attributes) in h5py;
 - :mod:`.journal`: the journal of finished slabs and the one-writer lock;
-- :mod:`.run`: a sweep into a file (the journaled sink of the engine's slab loop, resume);
 - :mod:`.reader`: :func:`open_cube` and friends.
 
 The names below are imported from their modules on first use (PEP 562), so that reading a
@@ -22,7 +21,6 @@ _WHERE = {
     "check_cube": ".reader", "cube_attrs": ".reader", "cube_summary": ".reader",
     "cube_description": ".reader",
     "open_cube": ".reader",
-    "CubeSink": ".run", "DiskFull": ".run", "Interrupted": ".run", "sweep_to_file": ".run",
 }
 
 __all__ = sorted(_WHERE)

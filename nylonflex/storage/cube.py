@@ -23,7 +23,8 @@ from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .netcdf4 import NetCDF4File
 
 __all__ = ["CODECS", "DEFAULT_CODEC", "STORED_DIMS", "Codec", "CubeFile", "MissingPlugin",
-           "compiled_shuffle", "require_filters", "stored_dims"]
+           "chunk_shape", "compiled_shuffle", "encode_chunk", "require_filters",
+           "stored_dims"]
 
 #: Axes a cube stores as an auxiliary coordinate over a dimension of another name (cube
 #: format 3): {axis: its dimension in the file}. compliance-checker (cf:1.8, s. 5.1) asks a
@@ -172,7 +173,7 @@ def require_filters(codec_name) -> None:
         raise MissingPlugin(ZSTD_EXTRA)
 
 
-def _chunks(dims, sizes, radius_chunk):
+def chunk_shape(dims, sizes, radius_chunk):
     shape = [sizes[d] for d in dims]
     if dims and dims[0] == "radius":
         shape[0] = min(radius_chunk, shape[0])
@@ -243,7 +244,8 @@ class CubeFile:
             if aux:
                 var_attrs["coordinates"] = " ".join(aux)
             self.f.variable(var.name, dims, var.dtype, var_attrs, fillvalue=fill,
-                            chunks=_chunks(dims, sizes, radius_chunk), **self.codec.filters)
+                            chunks=chunk_shape(dims, sizes, radius_chunk),
+                            **self.codec.filters)
         self.f.variable("slab_done", ("radius",), "i1", slab_done_attrs())
         self.f.set_attrs({**attrs, "compression": self.codec.name})
         # each variable's dataset and layout, looked up once (an h5py lookup costs about
@@ -338,7 +340,7 @@ class CubeFile:
         for corner in itertools.product(*starts):
             block = data[tuple(slice(c, c + n) for c, n in zip(corner, chunks))]
             offset = (i0 + corner[0], *corner[1:])
-            yield offset, self._pool.submit(_encode_chunk, block, chunks, self.codec,
+            yield offset, self._pool.submit(encode_chunk, block, chunks, self.codec,
                                             self._compiled_shuffle)
 
     def abandon(self):
@@ -363,7 +365,7 @@ class CubeFile:
         self.f.close()
 
 
-def _encode_chunk(block, chunks, codec: Codec, compiled: bool = False):
+def encode_chunk(block, chunks, codec: Codec, compiled: bool = False):
     """One chunk as the codec's HDF5 filter pipeline stores it (padded to the chunk shape),
     shuffled by the compiled loop (``compiled``, a large cube) or by NumPy (the same bytes,
     nothing to compile; :data:`COMPILED_SHUFFLE_BYTES`)."""
@@ -397,4 +399,4 @@ def _shuffle_buffer(nbytes: int) -> np.ndarray:
 
 def _shuffle_deflate(block, chunks):
     """HDF5's shuffle then deflate filters on one chunk (padded to the full chunk shape)."""
-    return _encode_chunk(block, chunks, CODECS["gzip"])
+    return encode_chunk(block, chunks, CODECS["gzip"])

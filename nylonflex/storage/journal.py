@@ -40,7 +40,7 @@ import numpy as np
 import stat
 
 from ..units import InputError
-from .files import create_new, fsync_dir, publish, refuse_link, refuse_special
+from ..files.atomic import create_new, fsync_dir, publish, refuse_link, refuse_special
 
 __all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "exclusive", "fsync_dir",
            "publish", "refuse_special", "share_building"]

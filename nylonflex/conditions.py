@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..units import InputError, parse_quantity
-from ..variables import AXES, DESIGN, SPREAD, TRACKING, VARIABLES
+from .units import InputError, parse_quantity
+from .variables import AXES, DESIGN, SPREAD, TRACKING, VARIABLES
 
 #: Columns of every row: the five axes, then the design variables (registry order).
 COLUMNS = (*AXES, *DESIGN)
@@ -28,7 +28,7 @@ _LIMIT_WORDS = {"stroke": 0, "stroke_limited": 0, "strength": 1, "strength_limit
 #: ``--where "model == NAME"`` or ``"cooling == NAME"``: picks a model's (a cooling set's)
 #: slice of a cube (not a Condition); a cooling set's name may carry its speed
 #: (``forced_air 5 m/s``).
-_CATEGORY_WHERE = re.compile(r"^\s*(model|cooling)\s*(==|=)\s*([A-Za-z0-9_][A-Za-z0-9_ ./]*?)\s*$")
+CATEGORY_WHERE = re.compile(r"^\s*(model|cooling)\s*(==|=)\s*([A-Za-z0-9_][A-Za-z0-9_ ./]*?)\s*$")
 
 
 def missing_hint(name: str) -> str:
@@ -85,7 +85,8 @@ def parse_at(text) -> dict:
 OPS = ("<", "<=", "==", "!=", ">=", ">")
 INEQUALITIES = ("<", "<=", ">=", ">")
 _COMPARE = {"<=": np.less_equal, ">=": np.greater_equal, "<": np.less, ">": np.greater}
-_PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
+CONDITION_PATTERN = re.compile(
+    r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|==|!=|<|>|=)\s*(.+?)\s*$")
 #: Names a ``requirements:`` entry may constrain: the float design variables.
 REQUIREMENT_NAMES = tuple(n for n, v in DESIGN.items() if v.dtype != "int8")
 
@@ -158,7 +159,7 @@ def parse_condition(text, field: str = "--where", names=None, ops=OPS,
     names = tuple(COLUMNS + OPTIONAL if names is None else names)
     if str(text).strip() == "valid" and "validity" in names:  # issue 10: validity == 0
         text = "validity == 0"
-    m = _PATTERN.match(str(text))
+    m = CONDITION_PATTERN.match(str(text))
     op = None if not m else "==" if m.group(2) == "=" else m.group(2)
     if op not in ops:
         raise InputError(f"{field}: expected 'NAME OP VALUE [UNIT]' with OP one of "
@@ -179,7 +180,7 @@ def parse_where(texts) -> list[Condition]:
     ``model == NAME`` and ``cooling == NAME`` stay strings: :func:`query_cube` selects that
     model's (cooling set's) slice.
     """
-    return [t if _CATEGORY_WHERE.match(str(t)) else parse_condition(t) for t in texts or ()]
+    return [t if CATEGORY_WHERE.match(str(t)) else parse_condition(t) for t in texts or ()]
 
 
 def parse_requirements(texts, field: str = "requirements") -> tuple[Condition, ...]:
@@ -213,7 +214,7 @@ def parse_constraint(text, i: int) -> Condition:
     return parse_condition(text, f"constraints[{i}]")
 
 
-def _parse_sort(text):
+def parse_sort(text):
     if not text:
         return None, False
     name = text.strip()

@@ -89,7 +89,7 @@ def write_material_file(result, path, name=None, overwrite=False, fields=None,
                         inputs=()) -> Path:
     """Write a fit's material file (YAML); refuses to replace a file unless ``overwrite``.
 
-    Written through a new temporary and a rename (:func:`nylonflex.storage.files.replacing`):
+    Written through a new temporary and a rename (:func:`nylonflex.files.atomic.replacing`):
     never through a link, onto a special file, or onto the fit's data file or one of
     ``inputs``.
 
@@ -98,7 +98,7 @@ def write_material_file(result, path, name=None, overwrite=False, fields=None,
     InputError
         The file exists and ``overwrite`` is false, or it may not be written (see above).
     """
-    from ..storage.files import refuse_special, write_atomic
+    from .atomic import refuse_special, write_atomic
 
     path = Path(path)
     inputs = (result.data.get("path", ""), *inputs)

@@ -2,7 +2,7 @@
 
 Both go through the engine's one slab loop (:func:`nylonflex.engine.slabs.run_slabs`): in
 memory with :class:`~nylonflex.engine.slabs.MemorySink`, to a file with the journaled
-:class:`~nylonflex.storage.CubeSink`; locally or on a Dask cluster.
+:class:`~nylonflex.sweep.run.CubeSink`; locally or on a Dask cluster.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
 from ..engine.warmup import grid_families, warm_up_aside, warm_up_codec, warm_up_grid
 from ..variables import VARIABLES
-from .cube import CODECS, _chunks, _encode_chunk, compiled_shuffle
-from .reader import open_cube
+from ..storage.cube import CODECS, chunk_shape, encode_chunk, compiled_shuffle
+from ..storage.reader import open_cube
 from .run import sweep_to_file
 
 __all__ = ["default_output", "estimate", "prepare", "run_sweep", "sweep_file"]
@@ -64,12 +64,12 @@ def run_sweep(cfg: ResolvedConfig, out=None, *, resume: bool = False, workers=No
 
     Raises
     ------
-    nylonflex.storage.Interrupted
+    nylonflex.sweep.run.Interrupted
         Ctrl-C or SIGTERM stopped a run to a file; finish it with ``resume=True``.
     """
     check_physics(cfg)
     if out is None:
-        from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
+        from ..storage.accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
         with deferred_signals(on_second=_interrupt):
             _warm_up(cfg, workers, scheduler, log)
@@ -182,7 +182,7 @@ def _packed_bytes(value, chunks, codec, compiled: bool) -> int:
     total = 0
     for corner in itertools.product(*starts):
         block = value[tuple(slice(i, i + c) for i, c in zip(corner, chunks))]
-        total += len(_encode_chunk(block, chunks, codec, compiled))
+        total += len(encode_chunk(block, chunks, codec, compiled))
     return total
 
 
@@ -248,7 +248,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         t0 = time.perf_counter()
         for name, value in arrays.items():
             raw += value.nbytes
-            packed += _packed_bytes(value, _chunks(VARIABLES[name].dims, sizes,
+            packed += _packed_bytes(value, chunk_shape(VARIABLES[name].dims, sizes,
                                                    min(radius_chunk, size)), cfg.compression,
                                   shuffle_compiled)
         compress += time.perf_counter() - t0

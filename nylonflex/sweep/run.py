@@ -26,10 +26,10 @@ from ..engine.provenance import is_complete, provenance, run_attrs
 from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
 from ..kernels import source_digest
 from ..units import InputError
-from .cube import CODECS, CubeFile
-from .journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
+from ..storage.cube import CODECS, CubeFile
+from ..storage.journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
     manifest_digest, publish, refuse_special, share_building
-from .reader import cube_attrs
+from ..storage.reader import cube_attrs
 
 __all__ = ["CubeSink", "DiskFull", "Interrupted", "sweep_to_file"]
 
