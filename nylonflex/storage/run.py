@@ -258,7 +258,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
                                "compression": codec, **_versions(),
                                "replaces": bool(replaces)})
             _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor,
-                   progress, log, replaces, command)
+                   progress, log, replaces=replaces, command=command)
         except OSError as exc:
             if not _disk_full(exc):
                 raise
@@ -271,7 +271,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
     return out
 
 
-def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log,
+def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log, *,
            replaces=False, command=None):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
