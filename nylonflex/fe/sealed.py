@@ -136,7 +136,7 @@ def tip_moment(path):
 
 
 def solve_stroke(body: BodyMesh, mu, alpha, strokes, *, p_atm, heating=1.0, blocked=False,
-                 progress=None, partial=False):
+                 progress=None, partial=False, inspect=None):
     """States of the sealed body at each of ``strokes`` (any order, each in [0, 1)).
 
     ``mu``, ``alpha``: the Ogden set (nylonflex's convention) [Pa], [-]; ``p_atm`` the
@@ -144,7 +144,9 @@ def solve_stroke(body: BodyMesh, mu, alpha, strokes, *, p_atm, heating=1.0, bloc
     zero stroke first (the air warmed, sealed, before the wrap contracts). Returns arrays
     in the order of ``strokes``: ``pressure`` [Pa], ``volume_ratio`` V/V0 [-],
     ``bend_angle`` [rad] and, with ``blocked``, ``tip_moment`` [N m]; NaN where not
-    reached (``partial``; else :class:`.solve.FESolveError`).
+    reached (``partial``; else :class:`.solve.FESolveError`). ``inspect(index,
+    displacement)`` is called at each stroke reached with the nodes' displacement (n, 3)
+    [m] (for checks against the deformed mesh).
     """
     targets = np.asarray(strokes, dtype=float)
     model = build_model(body, mu, alpha, blocked=blocked)
@@ -168,6 +170,8 @@ def solve_stroke(body: BodyMesh, mu, alpha, strokes, *, p_atm, heating=1.0, bloc
         out["bend_angle"][idx] = path.angle()
         if blocked:
             out["tip_moment"][idx] = tip_moment(path)
+        if inspect is not None:
+            inspect(idx, path.u.values.copy())
 
     try:
         path = Path(body, model, solver, load_item=air, newton_solve=air.newton_solve(dofs))

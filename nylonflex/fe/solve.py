@@ -273,18 +273,20 @@ def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=F
 def solve_pressures(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=False,
                     blocked=False, stroke=0.0):
     """:func:`solve_bend`'s states as a dict of arrays in the order of ``pressures``:
-    ``bend_angle`` [rad] and, with ``blocked`` (the tip held straight), ``tip_moment``
+    ``bend_angle`` [rad], ``volume_ratio`` V/V0 of the chamber [-] and, with ``blocked`` (the tip held straight), ``tip_moment``
     [N m] (:func:`.sealed.tip_moment`, the whole body's). With ``stroke`` s > 0 the wrap
     is first shortened to its rest length 1 - s with the chamber vented (p = 0), then the
     pressures are imposed at that wrap length. NaN where not reached (``partial``)."""
     from .model import WRAP_ITEMS
-    from .sealed import tip_moment
+    from .sealed import chamber_volume, tip_moment
 
     targets = np.asarray(pressures, dtype=float)
     model = build_model(body, mu, alpha, blocked=blocked)
     mu0 = float(sum(felupe_ogden(mu, alpha)[0]))
     solver = linear_solver()
-    out = {"bend_angle": np.full(len(targets), np.nan)}
+    out = {"bend_angle": np.full(len(targets), np.nan),
+           "volume_ratio": np.full(len(targets), np.nan)}
+    volume0 = chamber_volume(model[2], body.points)
     if blocked:
         out["tip_moment"] = np.full(len(targets), np.nan)
     try:
@@ -302,6 +304,8 @@ def solve_pressures(body: BodyMesh, mu, alpha, pressures, *, progress=None, part
 
         def record(idx, target):
             out["bend_angle"][idx] = path.angle() if target > 0 or stroke > 0 else 0.0
+            path.load_item.field.link(path.field)
+            out["volume_ratio"][idx] = chamber_volume(path.load_item, body.points) / volume0
             if blocked:
                 out["tip_moment"][idx] = tip_moment(path)
 
