@@ -85,23 +85,26 @@ def test_sealed_chamber_obeys_boyle_with_the_deformed_cavity():
 
 
 def test_heated_air_obeys_boyle_and_the_isochoric_limit():
-    """Air warmed by dT at zero stroke in a body a thousand times stiffer than TC5005:
-    the cavity hardly moves, so p -> p0 dT / T0 (Gay-Lussac); the real silicone gives
-    way and holds less. Both obey (p0 + p) V/V0 = p0 (T0 + dT)/T0 on the deformed mesh."""
+    """Air warmed by dT at zero stroke: (p0 + p) V/V0 = p0 (T0 + dT)/T0 on the deformed
+    mesh. In a body 1e3 and 1e4 times stiffer than TC5005 (silicone, skin and wrap alike)
+    the cavity hardly moves, so p -> p0 dT / T0 (Gay-Lussac, isochoric), the gap falling as
+    the stiffness rises (about tenfold: measured 159 and 16 Pa); TC5005 itself gives way
+    (V/V0 1.064, p 335 Pa measured: the chamber's volumetric stiffness of about 5 kPa)."""
     t0 = nylon_parameters().t_amb
     dT = 20.0
     theta = (t0 + dT) / t0
     body = body_mesh(7.5e-3, 2e-3, 70e-3, mesh="rough")
     v0 = _cavity_volume(body, 0 * body.points)
     p = {}
-    for scale in (1.0, 1000.0):
+    for scale in (1.0, 1e3, 1e4):
         out, states = _solve(body, [0.0], mu_scale=scale, heating=theta)
         ratio = _cavity_volume(body, states[0]) / v0
         assert (P_ATM + out["pressure"][0]) * ratio == pytest.approx(P_ATM * theta, rel=1e-10)
         p[scale] = out["pressure"][0]
     isochoric = P_ATM * dT / t0  # 6797 Pa
-    assert p[1000.0] == pytest.approx(isochoric, rel=2e-3)
-    assert p[1.0] < 0.9 * isochoric
+    assert p[1e4] == pytest.approx(isochoric, rel=3e-3)
+    assert (isochoric - p[1e3]) / (isochoric - p[1e4]) == pytest.approx(10, rel=0.05)
+    assert 0 < p[1.0] < 0.1 * isochoric
 
 
 def test_sealed_state_is_the_imposed_pressure_state_at_that_wrap_length():

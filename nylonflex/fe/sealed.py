@@ -129,6 +129,8 @@ def tip_moment(path):
     the x-axis through y = 0 on the tip face, from the reactions of the last converged
     state: M = 2 sum_i y_i F_z,i (half model; positive when the pressure on the caps
     pushes the tip face's upper part out, the sense of eq. 16)."""
+    if path.residual is None:  # nothing solved yet: the unloaded body
+        return 0.0
     mask = path.boundaries["tip"].points  # point indices
     f = np.asarray(path.residual).reshape(-1, 3)  # reactions of the supports on the body
     y = path.body.points[:, 1]
