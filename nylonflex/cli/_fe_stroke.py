@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 
 from ..units import json_text
@@ -9,8 +10,6 @@ from ._common import progress_bar
 
 
 def _cell(value, fmt, width):
-    import math
-
     return f"{value:{width}{fmt}}" if math.isfinite(value) else f"{'-':>{width}}"
 
 
@@ -69,8 +68,6 @@ def run_stroke(args, design, silicone, strokes, air_heating) -> int:
 def run_blocked(args, design, kw, pressures) -> int:
     """The tip held straight at imposed ``pressures`` [Pa]: its moment and force beside
     the paper's eq. (16)."""
-    import math
-
     import numpy as np
 
     from ..fe import fe_bend

@@ -7,6 +7,7 @@ import sys
 
 from ..units import InputError, json_text, parse_quantity
 from ._common import progress_bar
+from ._fe_stroke import run_blocked, run_stroke
 
 HELP = "bend angle of one design by the finite-element twin (needs the [fe] extra)"
 DESCRIPTION = """\
@@ -166,8 +167,6 @@ def run(args) -> int:
             raise InputError("--blocked: needs --pressure or --stroke")
         raise InputError("--pressure: needed (or --stroke), e.g. --pressure 0:12:4kPa")
     if args.stroke is not None:
-        from ._fe_stroke import run_stroke
-
         return run_stroke(args, design, silicone, parse_strokes(args.stroke),
                           None if args.air_heating is None
                           else parse_air_heating(args.air_heating))
@@ -186,8 +185,6 @@ def _run_pressure(args, design, silicone) -> int:
     require_felupe()
     kw = {"base_thickness": design.get("base_thickness"), "silicone": silicone or "tc5005"}
     if args.blocked:
-        from ._fe_stroke import run_blocked
-
         return run_blocked(args, design, kw, pressures)
     with progress_bar("fe", unit="solve", quiet=args.quiet) as bar:
         res = fe_bend(design["radius"], design["wall_thickness"], design["length"],

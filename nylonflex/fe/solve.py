@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .measures import chamber_volume, tip_moment
 from .mesh import BodyMesh
-from .model import build_model, felupe_ogden
+from .model import WRAP_ITEMS, build_model, felupe_ogden
 
 __all__ = ["MAX_STEP", "FESolveError", "Path", "march", "solve_bend", "solve_pressures"]
 
@@ -277,9 +278,6 @@ def solve_pressures(body: BodyMesh, mu, alpha, pressures, *, progress=None, part
     [N m] (:func:`.sealed.tip_moment`, the whole body's). With ``stroke`` s > 0 the wrap
     is first shortened to its rest length 1 - s with the chamber vented (p = 0), then the
     pressures are imposed at that wrap length. NaN where not reached (``partial``)."""
-    from .model import WRAP_ITEMS
-    from .sealed import chamber_volume, tip_moment
-
     targets = np.asarray(pressures, dtype=float)
     model = build_model(body, mu, alpha, blocked=blocked)
     mu0 = float(sum(felupe_ogden(mu, alpha)[0]))
