@@ -44,18 +44,22 @@ def run_stroke(args, design, silicone, strokes, air_heating) -> int:
     heat = f", air +{res['air_heating']:g} K" if res["air_heating"] else ""
     held = ", tip held straight" if args.blocked else ""
     print(f"FE twin driven as built (sealed chamber{heat}{held}), mesh {args.mesh}")
-    head = f"{'stroke':>7} {'p':>8} {'p eq.8':>8} {'V/V0':>7} {'bend':>7}"
-    unit = f"{'[-]':>7} {'[kPa]':>8} {'[kPa]':>8} {'[-]':>7} {'[deg]':>7}"
-    if args.blocked:
+    head = f"{'stroke':>7} {'p':>8} {'p eq.8':>8} {'V/V0':>7}"
+    unit = f"{'[-]':>7} {'[kPa]':>8} {'[kPa]':>8} {'[-]':>7}"
+    if args.blocked:  # the bend of a body held at both ends is no result: not shown
         head += f" {'moment':>9} {'force':>7}"
         unit += f" {'[N mm]':>9} {'[N]':>7}"
+    else:
+        head += f" {'bend':>7}"
+        unit += f" {'[deg]':>7}"
     print(head + f" {'error':>6}")
     print(unit + f" {'[%]':>6}")
     for i, s in enumerate(res["stroke"]):
         row = (f"{s:7.4f} {_cell(res['pressure'][i] / 1e3, '.3f', 8)} {eq8[i] / 1e3:8.3f} "
-               f"{_cell(res['volume_ratio'][i], '.4f', 7)} "
-               f"{_cell(np.degrees(res['bend_angle'][i]), '.2f', 7)}")
-        if args.blocked:
+               f"{_cell(res['volume_ratio'][i], '.4f', 7)}")
+        if not args.blocked:
+            row += f" {_cell(np.degrees(res['bend_angle'][i]), '.2f', 7)}"
+        else:
             row += (f" {_cell(res['tip_moment'][i] * 1e3, '.2f', 9)}"
                     f" {_cell(res['tip_force'][i], '.4f', 7)}")
         print(row + f" {_cell(100 * res['discretisation_error'][i], '.2f', 6)}")
