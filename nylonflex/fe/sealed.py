@@ -24,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import BodyMesh
-from .model import WRAP_ITEMS, build_model
 from .measures import chamber_volume, tip_moment
+from .model import WRAP_ITEMS, build_model
 from .solve import STROKE_UNIT, Path, linear_solver, march
 
 __all__ = ["HEATING_UNIT", "SealedChamber", "solve_stroke"]
@@ -52,16 +52,19 @@ class SealedChamber:
         self.volume0 = chamber_volume(pressure_item, points)
         self.pressure, self.volume, self.load, self.stiffness = 0.0, self.volume0, None, 0.0
 
-    def settle(self, field):
-        """Volume and pressure of the state ``field`` (the body's field container)."""
-        self.item.field.link(field)
+    def _boyle(self):
+        """The volume of the item's current state, and its pressure by Boyle's law."""
         self.volume = chamber_volume(self.item, self.points)
         self.pressure = self.p_atm * (self.heating * self.volume0 / self.volume - 1.0)
 
+    def settle(self, field):
+        """Volume and pressure of the state ``field`` (the body's field container)."""
+        self.item.field.link(field)
+        self._boyle()
+
     def _vector(self, field=None, **kwargs):
         g = self.item.assemble.vector(field=field, pressure=1.0, **kwargs)
-        self.volume = chamber_volume(self.item, self.points)
-        self.pressure = self.p_atm * (self.heating * self.volume0 / self.volume - 1.0)
+        self._boyle()
         self.stiffness = (self.p_atm + self.pressure) / self.volume
         self.load = np.asarray(g.toarray()).ravel()
         self.item.update(self.pressure)
