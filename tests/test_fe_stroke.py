@@ -193,3 +193,15 @@ def test_cli_stroke_bad_input_exits_2_with_one_line(args, match, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1, err
     assert err[0].startswith("nylonflex fe: error: ") and __import__("re").search(match, err[0])
+
+
+def test_fe_bend_blocked_returns_the_moment_and_eq_16s_force():
+    """``fe_bend(blocked=True)``: the moment on the held tip, F = M/L (eq. 16), its
+    Richardson estimate against the coarser mesh; the free call is as before."""
+    from nylonflex.fe import fe_bend
+
+    out = fe_bend(7.5e-3, 2e-3, 70e-3, [1e3], mesh="coarse", blocked=True)
+    assert out["tip_force"][0] == pytest.approx(out["tip_moment"][0] / 70e-3, rel=1e-14)
+    eq16 = (4 * 7.5e-3 ** 3 + 3 * math.pi * 7.5e-3 ** 2 * 2e-3) / 6 * 1e3
+    assert 1.5 < out["tip_moment"][0] / eq16 < 2.5  # measured 1.99 (coarse)
+    assert out["coarser_tip_moment"][0] > 0 and 0 < out["discretisation_error"][0] < 0.1
