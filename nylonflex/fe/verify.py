@@ -23,7 +23,8 @@ from .calibrate import extrapolated
 from .runs import journaled_runs, plan_material, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
-           "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
+           "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs",
+           "write_fidelity"]
 
 #: The variants whose bend angle at a given pressure differs (the others change the
 #: muscle's side only): the ones the fidelity dataset compares.
@@ -39,6 +40,8 @@ MAX_DESIGNS = 500
 FRACTIONS = (0.5, 1.0)
 
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
+#: What a verify run file holds: one number a pressure each.
+RUN_KEYS = ("bend_angle", "coarser_bend_angle", "discretisation_error")
 
 
 def fidelity_path(cube) -> Path:
@@ -148,7 +151,6 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     """
     import xarray as xr
 
-    from ..storage.files import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
 
@@ -168,8 +170,8 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
         ds.close()
     parts = _parts(cube)
     tasks = [(d, plan["silicone"], mesh) for d in plan["designs"]]
-    done = journaled_runs(parts, plan, tasks, _solve, workers=workers, scheduler=scheduler,
-                          progress=progress, log=log, what="verify")
+    done = journaled_runs(parts, plan, tasks, _solve, keys=RUN_KEYS, workers=workers,
+                          scheduler=scheduler, progress=progress, log=log, what="verify")
     sil = plan["silicone"]
     total = len(plan["designs"])
     # the dataset: design x level (the fractions of p*)
@@ -218,9 +220,23 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
                       "fe_model": json.dumps(plan["fe_model"], sort_keys=True),
                       "Conventions": "CF-1.8"})
     path = fidelity_path(cube)
-    with replacing(path, what="verify", inputs=(cube,)) as tmp:
-        out.to_netcdf(tmp, engine="h5netcdf")
+    write_fidelity(out, path, inputs=(cube,))
     return path
+
+
+def write_fidelity(fid, path, inputs=()) -> Path:
+    """Write the fidelity dataset ``fid`` to ``path`` (netCDF-4): made whole in memory
+    (at most :data:`MAX_DESIGNS` designs, under a megabyte), then written through
+    :func:`~nylonflex.storage.files.write_atomic`.
+
+    HDF5 never writes to the disk here: on a full disk h5netcdf's close failed partway and
+    HDF5 freed its ids a second time (a segfault, exit -11); a plain write fails with an
+    ``OSError`` instead, and ``path`` is left as it was.
+    """
+    from ..storage.files import write_atomic
+
+    return write_atomic(path, bytes(fid.to_netcdf(engine="h5netcdf")), what="verify",
+                        inputs=inputs)
 
 
 def fidelity_stats(fid) -> list[dict]:

@@ -1,0 +1,148 @@
+"""Reliability of the newer surfaces (issue 48): verify and fit fe run folders, the
+fidelity outputs, init, bounds, hangs and the explorer's server.
+
+A full disk is a real one: a small tmpfs mounted in a user namespace (``unshare -rm``),
+each run in its own process, so that a segfault is seen as exit 139, not as a lost test.
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from helpers import write_config
+
+from nylonflex.cli import main
+
+#: The sweep of tests/test_reliability.py's MULTI: 64,800 designs in 6 slabs, 3.4 MB.
+BIG = {
+    "name": "big",
+    "grid": {
+        "radius": {"start": 5, "stop": 25, "num": 18, "units": "mm"},
+        "wall_thickness": {"start": 1, "stop": 6, "num": 30, "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"start": 3, "stop": 30, "num": 30, "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 40, "num": 5, "units": "kPa"}},
+    "slab_megabytes": 1,
+}
+
+
+def _env():
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+
+
+def on_tiny_disk(mount, kib, command, timeout=300):
+    """Run the shell ``command`` with a ``kib`` KiB tmpfs mounted at ``mount`` (a user
+    namespace of its own); (exit status, stderr). A segfault of Python is status 139."""
+    script = f"mount -t tmpfs -o size={kib}k tmpfs {mount} && cd {mount} && {command}"
+    proc = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True,
+                          text=True, timeout=timeout, env=_env())
+    return proc.returncode, proc.stderr
+
+
+@pytest.fixture
+def mount(tmp_path):
+    """An empty folder a tmpfs can be mounted on; skipped where no namespace allows it."""
+    where = tmp_path / "mnt"
+    where.mkdir()
+    probe = subprocess.run(["unshare", "-rm", "sh", "-c",
+                            f"mount -t tmpfs -o size=1m tmpfs {where} && echo ok"],
+                           capture_output=True, text=True)
+    if probe.stdout.strip() != "ok":
+        pytest.skip("no unprivileged tmpfs mount here")
+    return where
+
+
+# --------------------------------------------------------------------------- 1. full disks
+
+@pytest.mark.slow
+def test_a_disk_that_fills_anywhere_in_a_sweep_never_crashes_it(tmp_path, mount):
+    # The disk is sized to fill at 30 points of the sweep's last 120 KiB (the publishing
+    # close): before the fix 6 of these 30 runs segfaulted (exit 139) in CubeFile.abandon,
+    # HDF5 freeing the ids of a close that had failed partway.
+    cfg = write_config(tmp_path, BIG, "big.yaml")
+    whole = tmp_path / "whole" / "cube.h5"
+    assert main(["sweep", str(cfg), "--out", str(whole), "--quiet", "--no-charts"]) == 0
+    need = 2 * whole.stat().st_size // 1024  # cube and journal at the peak
+    sweep = (f"{sys.executable} -X faulthandler -m nylonflex sweep {cfg} --out "
+             f"{mount}/cube.h5 --quiet --no-charts")
+    outcomes = [(kib, *on_tiny_disk(mount, kib, sweep)) for kib in range(need, need - 120, -4)]
+    crashed = [(kib, rc, err[-300:]) for kib, rc, err in outcomes if rc not in (0, 1)]
+    assert not crashed, crashed
+    full = [err for _, rc, err in outcomes if rc == 1]
+    assert full and all("Traceback" not in e and "--resume" in e for e in full)
+
+
+_FIDELITY = """
+import sys
+import numpy as np, xarray as xr
+from nylonflex.fe.verify import write_fidelity
+n = 500
+fid = xr.Dataset({f"v{i}": (("design", "level"), np.random.rand(n, 2)) for i in range(12)},
+                 coords={"design": np.arange(n), "level": [0.5, 1.0]})
+write_fidelity(fid, sys.argv[1])
+"""
+
+
+@pytest.mark.slow
+def test_verify_writing_its_dataset_on_a_full_disk_never_crashes(tmp_path, mount):
+    # before the fix all 18 runs under 150 KiB segfaulted (h5netcdf's close on a full disk)
+    script = tmp_path / "fidelity.py"
+    script.write_text(_FIDELITY)
+    runs = [(kib, *on_tiny_disk(mount, kib, f"{sys.executable} {script} {mount}/c.nc",
+                                timeout=120)) for kib in range(8, 248, 8)]
+    assert not [(kib, rc) for kib, rc, _ in runs if rc not in (0, 1)], runs
+    failed = [err for _, rc, err in runs if rc == 1]
+    assert failed and all("No space left" in e for e in failed)
+    assert [rc for _, rc, _ in runs][-1] == 0  # the largest disk holds it
+
+
+def test_init_on_a_full_disk_leaves_no_truncated_file(mount):
+    # 12-40 KiB: the disk fills inside one of init's files (45 KB in all)
+    for kib in (12, 24, 40):
+        rc, err = on_tiny_disk(mount, kib, f"{sys.executable} -m nylonflex init x; "
+                                           "s=$?; find . | wc -l >&2; exit $s")
+        assert rc == 1 and "No space left" in err, (kib, err)
+        assert err.split()[-1] == "1", (kib, err)  # only the mount itself is left
+    rc, err = on_tiny_disk(mount, 40, f"{sys.executable} -m nylonflex init x "
+                                      "--example fig12 && test -s x/configs/fig12.yaml")
+    assert rc == 0, err
+
+
+def test_init_leaves_nothing_when_a_file_cannot_be_written(tmp_path, monkeypatch, capsys):
+    import errno
+
+    import nylonflex.storage.files as files
+
+    real, calls = files._link_new, []
+
+    def fail_third(tmp, path):
+        calls.append(path)
+        if len(calls) == 3:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(tmp, path)
+
+    monkeypatch.setattr(files, "_link_new", fail_third)
+    assert main(["init", str(tmp_path / "x")]) == 1
+    assert "No space left" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()  # files, temporaries and the folders it made
+
+
+@pytest.mark.parametrize("target", ["a file", "a dangling link", "a file where a folder goes",
+                                    "/proc/self"])
+def test_init_at_a_path_that_is_no_folder_is_one_line(tmp_path, capsys, target):
+    path = {"a file": tmp_path / "f", "a dangling link": tmp_path / "l",
+            "a file where a folder goes": tmp_path / "d", "/proc/self": Path("/proc/self")}
+    (tmp_path / "f").write_text("mine")
+    (tmp_path / "l").symlink_to(tmp_path / "nowhere")
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "configs").write_text("mine")
+    assert main(["init", str(path[target])]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "init" in err and "Traceback" not in err
+    assert (tmp_path / "f").read_text() == "mine"
+    assert (tmp_path / "d" / "configs").read_text() == "mine"
