@@ -146,3 +146,197 @@ def test_init_at_a_path_that_is_no_folder_is_one_line(tmp_path, capsys, target):
     assert err.count("\n") == 1 and "init" in err and "Traceback" not in err
     assert (tmp_path / "f").read_text() == "mine"
     assert (tmp_path / "d" / "configs").read_text() == "mine"
+
+
+# --------------------------------------------------------------------------- 2. run folders
+
+def _plan(seed=0):
+    designs = [{"radius": 0.01 * (k + 1), "pressures": [1e3 * (k + 1), 2e3 * (k + 1)]}
+               for k in range(4)]
+    return {"designs": designs, "mesh": "coarse", "seed": seed}
+
+
+def _solver(calls):
+    def solve(task):
+        calls.append(task["radius"])
+        return {"bend_angle": [task["radius"] * p for p in task["pressures"]],
+                "coarser_bend_angle": [0.5, None]}
+    return solve
+
+
+def _runs(parts, calls, plan=None, log=None):
+    from nylonflex.fe.runs import journaled_runs
+
+    plan = plan or _plan()
+    return journaled_runs(parts, plan, plan["designs"], _solver(calls), log=log)
+
+
+def _swap(parts):
+    a, b = parts / "design-0001.json", parts / "design-0002.json"
+    ta, tb = a.read_bytes(), b.read_bytes()
+    a.write_bytes(tb)
+    b.write_bytes(ta)
+
+
+def _one_digit(parts):
+    f = parts / "design-0001.json"
+    text = f.read_text()
+    i = text.index('"bend_angle": [') + len('"bend_angle": [')
+    assert text[i].isdigit()
+    f.write_text(text[:i] + ("7" if text[i] != "7" else "8") + text[i + 1:])
+
+
+CORRUPTIONS = {
+    "an empty mapping": lambda p: (p / "design-0001.json").write_text("{}"),
+    "a list": lambda p: (p / "design-0001.json").write_text("[1, 2]"),
+    "a bare number": lambda p: (p / "design-0001.json").write_text("3.5"),
+    "a string": lambda p: (p / "design-0001.json").write_text('"bend_angle"'),
+    "deep nesting": lambda p: (p / "design-0001.json").write_text("[" * 100000 + "]" * 100000),
+    "not JSON": lambda p: (p / "design-0001.json").write_bytes(b"\xff\x00{"),
+    "short arrays": lambda p: (p / "design-0001.json").write_text(json_swap_short(p)),
+    "one digit changed": _one_digit,
+    "two runs swapped": _swap,
+    "a huge file": lambda p: (p / "design-0001.json").write_text(" " * (2 << 20) + "{}"),
+}
+
+
+def json_swap_short(parts):
+    import json
+
+    record = json.loads((parts / "design-0001.json").read_text())
+    record["result"]["bend_angle"] = record["result"]["bend_angle"][:1]
+    return json.dumps(record)
+
+
+@pytest.mark.parametrize("corruption", CORRUPTIONS)
+def test_a_damaged_run_file_is_solved_again(tmp_path, corruption):
+    parts, calls = tmp_path / "runs.parts", []
+    first = _runs(parts, calls)
+    assert len(calls) == 4
+    CORRUPTIONS[corruption](parts)
+    calls.clear()
+    messages = []
+    again = _runs(parts, calls, log=messages.append)
+    redone = {0.02, 0.03} if corruption == "two runs swapped" else {0.02}
+    assert set(calls) == redone, messages
+    assert again == first
+    assert any("solving it again" in m for m in messages)
+    calls.clear()
+    assert _runs(parts, calls) == first and not calls  # and it is whole now
+
+
+def test_a_run_folder_of_another_plan_is_refused(tmp_path):
+    from nylonflex.units import InputError
+
+    parts = tmp_path / "runs.parts"
+    _runs(parts, [])
+    with pytest.raises(InputError, match="holds the runs of another"):
+        _runs(parts, [], plan=_plan(seed=1))
+    # a run file of another plan copied in is solved again, never used
+    other = tmp_path / "other.parts"
+    plan = _plan()
+    plan["designs"][1]["pressures"][0] = 1234.0
+    _runs(other, [], plan=plan)
+    (parts / "design-0001.json").write_bytes((other / "design-0001.json").read_bytes())
+    calls = []
+    _runs(parts, calls)
+    assert calls == [0.02]
+
+
+@pytest.mark.parametrize("what", ["a file", "a dangling link", "a fifo run file",
+                                  "a linked run file", "a fifo plan"])
+def test_a_run_folder_that_is_no_folder_is_one_line(tmp_path, what):
+    from nylonflex.units import InputError
+
+    parts = tmp_path / "runs.parts"
+    if what == "a file":
+        parts.write_text("mine")
+    elif what == "a dangling link":
+        parts.symlink_to(tmp_path / "nowhere")
+    else:
+        _runs(parts, [])
+        target = parts / ("plan.json" if what == "a fifo plan" else "design-0002.json")
+        target.unlink()
+        if what == "a linked run file":
+            target.symlink_to(tmp_path / "elsewhere.json")
+        else:
+            os.mkfifo(target)
+    with pytest.raises(InputError) as err:  # at once: a fifo is never opened to wait
+        _runs(parts, [])
+    assert "\n" not in str(err.value) and str(parts) in str(err.value)
+    if what == "a file":
+        assert parts.read_text() == "mine"
+
+
+# --------------------------------------------------------------------------- 3. verify's files
+
+FID_GRID = {
+    "name": "fid",
+    "grid": {"radius": {"values": [7.5, 20], "units": "mm"},
+             "wall_thickness": {"values": [2, 6], "units": "mm"},
+             "length": {"values": [70, 90], "units": "mm"},
+             "coil_index": {"values": [1.1, 1.7]},
+             "wrap_angle": {"values": [8], "units": "deg"}},
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 3},
+               "pressure": {"start": 0, "stop": 20, "num": 3, "units": "kPa"}},
+}
+
+
+@pytest.fixture
+def fid_cube(tmp_path, monkeypatch):
+    """A small cube, and verify's FE runs replaced by a stand-in (their count in .calls)."""
+    pytest.importorskip("felupe")
+    from helpers import write_cube
+
+    import nylonflex.fe.verify as verify
+
+    calls = []
+
+    def solve(task):
+        d = task[0]
+        calls.append(d["radius"])
+        return {k: [0.1, 0.2] for k in verify.RUN_KEYS}
+
+    monkeypatch.setattr(verify, "_solve", solve)
+    return write_cube(tmp_path, FID_GRID), calls
+
+
+def _verify(cube, *extra):
+    return main(["verify", str(cube), "--designs", "2", "--quiet", *extra])
+
+
+def test_verify_replaces_only_its_own_outputs(fid_cube, capsys):
+    fid_cube, calls = fid_cube
+    nc = fid_cube.with_name("cube.fidelity.nc")
+    png = fid_cube.with_name("cube.fidelity_map.png")
+    assert _verify(fid_cube) == 0 and nc.is_file() and png.is_file()
+    assert _verify(fid_cube) == 0  # its own: replaced
+    for mine in (nc, png):
+        mine.write_bytes(b"the user's own file")
+        capsys.readouterr()
+        calls.clear()
+        assert _verify(fid_cube) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(mine) in err and "--overwrite" in err
+        assert mine.read_bytes() == b"the user's own file" and not calls
+        assert _verify(fid_cube, "--overwrite") == 0
+        assert mine.read_bytes() != b"the user's own file"
+
+
+@pytest.mark.parametrize("what", ["a link at the dataset", "a fifo at the map",
+                                  "a link at the run folder", "a file at the run folder"])
+def test_verify_refuses_special_outputs_before_work(fid_cube, capsys, what):
+    fid_cube, calls = fid_cube
+    nc = fid_cube.with_name("cube.fidelity.nc")
+    png = fid_cube.with_name("cube.fidelity_map.png")
+    parts = fid_cube.with_name("cube.h5.fidelity.parts")
+    elsewhere = fid_cube.with_name("elsewhere")
+    {"a link at the dataset": lambda: nc.symlink_to(elsewhere),
+     "a fifo at the map": lambda: os.mkfifo(png),
+     "a link at the run folder": lambda: parts.symlink_to(elsewhere),
+     "a file at the run folder": lambda: parts.write_text("mine")}[what]()
+    capsys.readouterr()
+    assert _verify(fid_cube, "--overwrite") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not calls and not elsewhere.exists()
