@@ -62,7 +62,7 @@ def mount(tmp_path):
 @pytest.mark.slow
 def test_a_disk_that_fills_anywhere_in_a_sweep_never_crashes_it(tmp_path, mount):
     # The disk is sized to fill at 30 points of the sweep's last 120 KiB (the publishing
-    # close): before the fix 6 of these 30 runs segfaulted (exit 139) in CubeFile.abandon,
+    # close): before the fix 13 of these 30 runs segfaulted (exit 139) in CubeFile.abandon,
     # HDF5 freeing the ids of a close that had failed partway.
     cfg = write_config(tmp_path, BIG, "big.yaml")
     whole = tmp_path / "whole" / "cube.h5"
@@ -340,3 +340,108 @@ def test_verify_refuses_special_outputs_before_work(fid_cube, capsys, what):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert not calls and not elsewhere.exists()
+
+
+# --------------------------------------------------------------------------- 4. bounds, hangs
+
+SMALL = {**BIG, "name": "small", "grid": {**BIG["grid"],
+                                          "radius": {"values": [5, 10], "units": "mm"},
+                                          "wall_thickness": {"values": [1, 2], "units": "mm"}}}
+
+
+def _curve(stop=None, step=None):
+    raw = {**SMALL, "curves": dict(SMALL["curves"])}
+    if stop is not None:
+        raw["curves"]["pressure"] = {"start": 0, "stop": stop, "num": 5, "units": "kPa"}
+    return raw
+
+
+@pytest.mark.parametrize("raw,field", [
+    (_curve(stop=1e308), "curves.pressure.stop"),
+    (_curve(stop=1e-308), "curves.pressure"),
+    ({**SMALL, "cooling": [["still_air"]]}, "cooling"),
+    ({**SMALL, "cooling": [{"set": {"still_air": 1}}]}, "cooling[0].set"),
+    ({**SMALL, "cooling": {"set": ["still_air"]}}, "cooling.set"),
+    ({**SMALL, "cooling": [{"set": "forced_air", "speed": 1 + i / 100} for i in range(10_000)]},
+     "cooling"),
+])
+def test_bad_numbers_in_a_sweep_config_are_one_line(tmp_path, capsys, raw, field):
+    cfg = write_config(tmp_path, raw)
+    assert main(["sweep", str(cfg), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"error: {field}" in err, err
+
+
+@pytest.mark.parametrize("step,words", [("1e-308 ms", "samples"), ("1e308 ms", "must be in")])
+def test_a_tracking_step_out_of_any_range_is_one_line(tmp_path, capsys, step, words):
+    import yaml
+
+    from nylonflex.examples import example_text
+
+    raw = yaml.safe_load(example_text("fig12_tracking"))
+    raw["tracking"]["step"] = step
+    assert main(["sweep", str(write_config(tmp_path, raw)), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "tracking.step" in err and words in err
+
+
+@pytest.mark.parametrize("step", ["1e308 mm", "1e-308 mm", "100 mm", "0.001 mm"])
+def test_a_design_resolution_out_of_its_axis_is_refused(tmp_path, capsys, step):
+    from helpers import write_cube
+
+    cube = write_cube(tmp_path, SMALL)  # radius 5-10 mm: steps 0.005-5 mm
+    spec = write_config(tmp_path, {"name": "d", "cube": str(cube),
+                                   "objectives": [{"max": "tip_force_max"}],
+                                   "resolution": {"radius": step}}, "spec.yaml")
+    capsys.readouterr()
+    assert main(["design", str(spec)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "resolution.radius: must be in [0.005, 5] mm" in err
+
+
+@pytest.mark.parametrize("pressure", ["1e308", "1e-308", "0:10:1e-308", "0:1e308:1"])
+def test_fe_pressures_out_of_any_range_are_one_line(capsys, pressure):
+    pytest.importorskip("felupe")
+    assert main(["fe", "--at", "radius=20mm,wall_thickness=6mm,length=90mm",
+                 "--pressure", pressure]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--pressure" in err
+
+
+def test_fit_fe_with_too_few_designs_is_refused_before_any_run(tmp_path, capsys,
+                                                               monkeypatch):
+    pytest.importorskip("felupe")
+    import nylonflex.fe.calibrate as calibrate
+
+    monkeypatch.setattr(calibrate, "training_plan", lambda *a: pytest.fail("planned"))
+    assert main(["fit", "fe", "--designs", "3", "--out", str(tmp_path / "f.json")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--designs: must be in [6, 500]" in err
+
+
+def test_verify_at_a_scheduler_that_never_answers_ends_in_one_line(tmp_path):
+    # a loopback listener that accepts and never replies (no other address is used)
+    import socket
+    import time
+
+    from helpers import write_cube
+
+    pytest.importorskip("felupe")
+    pytest.importorskip("distributed")
+    cube = write_cube(tmp_path, SMALL)
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    port = srv.getsockname()[1]
+    try:
+        start = time.monotonic()
+        proc = subprocess.run([sys.executable, "-m", "nylonflex", "verify", str(cube),
+                               "--designs", "2", "--quiet", "--scheduler",
+                               f"tcp://127.0.0.1:{port}"], capture_output=True, text=True,
+                              timeout=120, env=_env())
+        took = time.monotonic() - start
+    finally:
+        srv.close()
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "--scheduler" in proc.stderr
+    assert took < 60, took  # its deadline is 5 s; the rest is the process's start
