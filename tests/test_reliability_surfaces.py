@@ -445,3 +445,71 @@ def test_verify_at_a_scheduler_that_never_answers_ends_in_one_line(tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.count("\n") == 1 and "--scheduler" in proc.stderr
     assert took < 60, took  # its deadline is 5 s; the rest is the process's start
+
+
+# --------------------------------------------------------------------------- 5. explorer
+
+_MALFORMED = [
+    b"GARBAGE\r\n\r\n",
+    b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: abc\r\n\r\n",
+    b"GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade"
+    b"\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+    b"Origin: http://127.0.0.1:{port}\r\n\r\n",  # no Bokeh subprotocol
+    b"GET /ws?bokeh-session-id=zzz HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nUpgrade: websocket"
+    b"\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+    b"Sec-WebSocket-Version: 13\r\nOrigin: http://127.0.0.1:{port}\r\n"
+    b"Sec-WebSocket-Protocol: bokeh, garbage\r\n\r\n",  # a token that is no token
+    b"GET /autoload.js?bokeh-autoload-element=\xff HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+    b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX: " + b"a" * 100_000 + b"\r\n\r\n",
+    b"POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 10\r\n\r\nabc",  # slow: stops
+    b"GET /static/../../etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+]
+
+
+def test_the_explorer_answers_malformed_requests_without_a_traceback(tmp_path):
+    pytest.importorskip("bokeh")
+    import socket
+    import threading
+    import time
+
+    from helpers import write_cube
+
+    cube = write_cube(tmp_path, SMALL)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    err = tmp_path / "server.err"
+    with open(err, "wb") as fh:
+        proc = subprocess.Popen([sys.executable, "-m", "nylonflex", "explore", str(cube),
+                                 "--no-browser", "--port", str(port)],
+                                stdout=subprocess.PIPE, stderr=fh, text=True, env=_env())
+    try:
+        assert "serving" in proc.stdout.readline()
+        answers = {}
+
+        def ask(i, raw):
+            try:
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as c:
+                    c.sendall(raw.replace(b"{port}", str(port).encode()))
+                    answers[i] = c.recv(64)
+            except OSError as exc:  # the slow request: no answer while it waits
+                answers[i] = exc
+
+        threads = [threading.Thread(target=ask, args=(i, raw))
+                   for i, raw in enumerate(_MALFORMED * 2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(30)
+        with socket.create_connection(("127.0.0.1", port), timeout=30) as c:
+            c.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+            assert c.recv(64).startswith(b"HTTP/1.1 200")  # still serving the page
+        time.sleep(0.5)
+        assert proc.poll() is None
+    finally:
+        proc.terminate()
+        proc.wait(30)
+    log = err.read_text(errors="replace")
+    assert "Traceback" not in log and "Uncaught exception GET /ws" in log, log
+    assert all(len(line) < 800 for line in log.splitlines())
+    assert sum(isinstance(a, bytes) and a.startswith(b"HTTP/1.1 4") for a in answers.values()) >= 6
