@@ -354,12 +354,11 @@ class CubeFile:
         failed is therefore never closed again (:meth:`NetCDF4File.close`).
         """
         self._pool.shutdown(cancel_futures=True)
+        with contextlib.suppress(OSError):  # the descriptor read at open: no HDF5 call
+            os.ftruncate(self.f.fd, 0)
+            _divert(self.f.fd)  # what HDF5 still writes, now or at exit, goes to memory
         if self.f.close_failed:
             return  # its objects are parked: freeing them again is what crashed
-        with contextlib.suppress(Exception):
-            fd = self.f.h5.id.get_vfd_handle()
-            os.ftruncate(fd, 0)
-            _divert(fd)
         with contextlib.suppress(Exception):
             self.f.h5.close()
 

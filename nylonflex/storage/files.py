@@ -19,6 +19,7 @@ import contextlib
 import errno
 import json
 import os
+import re
 import secrets
 import stat
 from pathlib import Path
@@ -301,8 +302,6 @@ def read_json(path, what: str, max_bytes: int = 1 << 20, max_depth: int = JSON_D
     is larger than ``max_bytes``, not UTF-8, nested deeper than ``max_depth`` or not
     JSON is a plain ``ValueError`` saying which, so a caller never meets a RecursionError.
     """
-    import re
-
     import numpy as np
 
     data = read_bounded(path, what, max_bytes)

@@ -75,6 +75,8 @@ class NetCDF4File:
 
         self.h5 = h5py.File(path, "w", track_order=True, locking=False)
         self.close_failed = False
+        #: the file's descriptor (HDF5's sec2 driver), read once while every id is sound
+        self.fd = self.h5.id.get_vfd_handle()
         self.datasets: dict = {}
         self.dims: dict = {}
         self._dimid: dict = {}
