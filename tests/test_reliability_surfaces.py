@@ -513,3 +513,18 @@ def test_the_explorer_answers_malformed_requests_without_a_traceback(tmp_path):
     assert "Traceback" not in log and "Uncaught exception GET /ws" in log, log
     assert all(len(line) < 800 for line in log.splitlines())
     assert sum(isinstance(a, bytes) and a.startswith(b"HTTP/1.1 4") for a in answers.values()) >= 6
+
+
+def test_fe_runs_at_a_scheduler_without_workers_stop_in_one_line(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    import nylonflex.engine.cluster as cluster
+
+    monkeypatch.setattr(cluster, "WORKER_WAIT", 1.0)
+    with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp",
+                                  host="127.0.0.1", dashboard_address=None) as lc:
+        with pytest.raises(RuntimeError, match="no Dask worker joined"):
+            plan = _plan()
+            from nylonflex.fe.runs import journaled_runs
+
+            journaled_runs(tmp_path / "runs.parts", plan, plan["designs"], _solver([]),
+                           scheduler=lc.scheduler_address)

@@ -101,12 +101,18 @@ def check_run(record, index: int, entry: dict, plan_digest: str, keys) -> str | 
 def _map(tasks, workers, scheduler, solve):
     """Yield (index, result) as the tasks finish: local processes, or a Dask cluster."""
     if scheduler:
-        from ..engine.cluster import connect_client
+        from ..engine.cluster import WORKER_WAIT, connect_client
 
         client = connect_client(None, scheduler)
         try:
             from distributed import as_completed
 
+            try:  # a scheduler without workers would leave the runs waiting forever
+                client.wait_for_workers(1, timeout=WORKER_WAIT)
+            except TimeoutError:
+                raise RuntimeError(f"no Dask worker joined {scheduler} within "
+                                   f"{WORKER_WAIT:g} s; start some with 'dask worker "
+                                   f"{scheduler}'") from None
             futures = {client.submit(solve, t, pure=False): i for i, t in tasks}
             for fut in as_completed(futures):
                 yield futures[fut], fut.result()
