@@ -88,10 +88,10 @@ def parse_pressures(text):
             raise InputError(f"--pressure: STEP must be > 0, got {text!r}")
         if stop < start:
             raise InputError(f"--pressure: STOP must be >= START, got {text!r}")
-        n = int(np.floor((stop - start) / step * (1 + 1e-12))) + 1
-        if n > 100:
-            raise InputError(f"--pressure: at most 100 pressures, {text!r} gives {n}")
-        return start + step * np.arange(n)
+        count = (stop - start) / step * (1 + 1e-12)  # inf for a step of 1e-308
+        if not count < 100:
+            raise InputError(f"--pressure: at most 100 pressures, {text!r} gives more")
+        return _bounded(start + step * np.arange(int(np.floor(count)) + 1))
     parts = [s for s in text.split(",") if s.strip()]
     if not parts:
         raise InputError("--pressure: need at least one pressure, e.g. 0:12:4kPa or 2,5,10")
@@ -102,7 +102,17 @@ def parse_pressures(text):
         v = v.strip()
         out.append(parse_quantity(v if re.search(r"[A-Za-z]", v) else f"{v}{unit}",
                                   "--pressure", "pressure", "kPa"))
-    return np.array(out, dtype=float)
+    return _bounded(np.array(out, dtype=float))
+
+
+def _bounded(pressures):
+    """Refuse FE pressures [Pa] above 0 and below 0.1 Pa (a millionth of a cube's pressure
+    range): ``1e-308`` solves nothing. fe_bend checks the range itself."""
+    bad = [p for p in pressures if 0.0 < p < 0.1]
+    if bad:
+        raise InputError(f"--pressure: a pressure is 0 or at least 0.0001 kPa (0.1 Pa), got "
+                         f"{bad[0] / 1e3:.3g} kPa")
+    return pressures
 
 
 def parse_strokes(text):

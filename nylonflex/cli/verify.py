@@ -37,6 +37,9 @@ def add_arguments(p):
                    help="the FE mesh (default coarse); the FE angle is its Richardson "
                         "extrapolation with the next coarser mesh")
     p.add_argument("--seed", type=_integer, default=0, help="the sample's seed (default 0)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a <cube>.fidelity.nc or its map that nylonflex did not "
+                        "write for this cube")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -45,7 +48,7 @@ def run(args) -> int:
 
     from ..charts.fidelity import fidelity_map
     from ..fe import require_felupe
-    from ..fe.verify import fidelity_summary, run_verify
+    from ..fe.verify import check_outputs, fidelity_map_path, fidelity_summary, run_verify
     from ..storage.files import save_figure
 
     require_felupe()
@@ -53,12 +56,14 @@ def run(args) -> int:
     with progress_bar("verify", unit="design", quiet=args.quiet, delay=0.0) as bar:
         path = run_verify(args.cube, args.designs, workers=args.workers,
                           scheduler=args.scheduler, mesh=args.mesh, seed=args.seed,
-                          progress=bar,
+                          progress=bar, overwrite=args.overwrite,
                           log=lambda m: bar.write(f"nylonflex verify: {m}"))
     with xr.open_dataset(path, engine="h5netcdf") as fid:
         fid.load()
-    chart = path.with_name(path.name.removesuffix(".nc") + "_map.png")
+    chart = fidelity_map_path(args.cube)
+    owned = check_outputs(args.cube, args.overwrite)  # nothing was put there meanwhile
     save_figure(fidelity_map(fid), chart, what="verify", inputs=(args.cube,), dpi=130)
+    owned.record([chart])
     print(f"fidelity  {path} ({fid.sizes['design']} designs x {fid.sizes['level']} "
           f"pressures, mesh {fid.attrs['fe_mesh']}, {time.monotonic() - start:.0f} s)")
     print(f"map       {chart}")
