@@ -6,6 +6,7 @@ import argparse
 import sys
 import time
 
+from ..units import InputError
 from ._common import progress_bar
 
 HELP = "hold a cube's models against the FE twin (needs the [fe] extra)"
@@ -41,6 +42,14 @@ def add_arguments(p):
                    help="replace a <cube>.fidelity.nc or its map that nylonflex did not "
                         "write for this cube")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--drive", default="pressure", metavar="pressure|stroke",
+                   help="pressure (default): the twin at half and all of each design's p*; "
+                        "stroke: the sealed twin at each design's full stroke s*, every "
+                        "model's pressure_max and bend_angle_max over the twin's "
+                        "(<cube>.fidelity_stroke.nc)")
+    p.add_argument("--blocked", action="store_true",
+                   help="with --drive stroke: also the held tip, tip_force_max over the "
+                        "twin's force")
 
 
 def run(args) -> int:
@@ -51,7 +60,15 @@ def run(args) -> int:
     from ..fe.verify import check_outputs, fidelity_map_path, fidelity_summary, run_verify
     from ..storage.files import save_figure
 
+    if args.drive not in ("pressure", "stroke"):
+        raise InputError(f"--drive: must be pressure or stroke, got {args.drive!r}")
+    if args.blocked and args.drive != "stroke":
+        raise InputError("--blocked: only with --drive stroke (the held tip's force at s*)")
     require_felupe()
+    if args.drive == "stroke":
+        from ._verify_stroke import run_stroke
+
+        return run_stroke(args)
     start = time.monotonic()
     with progress_bar("verify", unit="design", quiet=args.quiet, delay=0.0) as bar:
         path = run_verify(args.cube, args.designs, workers=args.workers,

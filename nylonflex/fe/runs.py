@@ -92,7 +92,7 @@ def check_run(record, index: int, entry: dict, plan_digest: str, keys) -> str | 
     if record["plan"] != plan_digest or _canonical(record["entry"]) != _canonical(entry):
         return "it belongs to another plan (design, pressures or settings)"
     result = record["result"]
-    n = len(entry.get("pressures", ()))
+    n = len(entry.get("pressures", entry.get("strokes", ())))  # a stroke drive's strokes
     if not isinstance(result, dict) or not all(_values_ok(result.get(k), n) for k in keys):
         return f"its values are not {n} numbers each of {', '.join(keys)}"
     return None

@@ -206,6 +206,9 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     finally:
         ds.close()
     parts = _parts(cube)
+    from .verify_stroke import check_drive  # a stroke-driven plan there: refused in one line
+
+    check_drive(parts, "pressure")
     tasks = [(d, plan["silicone"], mesh) for d in plan["designs"]]
     done = journaled_runs(parts, plan, tasks, _solve, keys=RUN_KEYS, workers=workers,
                           scheduler=scheduler, progress=progress, log=log, what="verify")
