@@ -111,13 +111,15 @@ def stroke_fidelity_map(fid, *, x="radius", models=None):
     """The stroke-driven fidelity (``nylonflex verify --drive stroke``): a panel a quantity
     (pressure, bend, blocked force where solved), each model's ratio to the sealed twin at
     the design's full stroke [1] over design axis ``x``, the 1.0 line and a 15 % band."""
+    from matplotlib.ticker import FuncFormatter
+
     models = list(fid["model"].values) if models is None else list(models)
     panels = [(r, q) for r, q in STROKE_PANELS if r in fid]
     fig, axes = _figure(1, len(panels), size=(4.4 * len(panels), 3.9))
     xs = np.asarray(to_display(x, fid[x].values), dtype=float)
     markers = "osD^v<>px*"
-    lo, hi = 1.0, 1.0
     for ax, (ratio, quantity) in zip(axes[0], panels):
+        lo, hi = 1 - STROKE_BAND, 1 + STROKE_BAND
         ax.axhspan(1 - STROKE_BAND, 1 + STROKE_BAND, color="0.9", zorder=0,
                    label=f"within {100 * STROKE_BAND:.0f} %")
         ax.axhline(1.0, color="0.3", lw=1.0)
@@ -130,14 +132,17 @@ def stroke_fidelity_map(fid, *, x="radius", models=None):
                     label=f"{model}{med}")
             if ok.any():
                 lo, hi = min(lo, float(r[ok].min())), max(hi, float(r[ok].max()))
+        # a log axis: a ratio and its inverse equally far from 1, a 10-fold error and the
+        # band in one panel
+        ax.set_yscale("log")
+        ax.set_ylim(lo / 1.15, hi * 1.15)
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.set_title(f"{quantity} / twin at s*")
         ax.set_xlabel(label(fid[x]))
-        ax.set_ylabel("model / stroke-driven twin [1]")
+        ax.set_ylabel("model / stroke-driven twin [1] (log)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")
-    pad = 0.05 * (hi - lo + 0.3)
-    for ax in axes[0]:
-        ax.set_ylim(min(lo, 1 - STROKE_BAND) - pad, max(hi, 1 + STROKE_BAND) + pad)
     fig.suptitle(f"Models against the sealed, stroke-driven FE twin at each design's full "
                  f"stroke s*: {fid.sizes['design']} designs, FE mesh "
                  f"{fid.attrs.get('fe_mesh', '?')}; band at 0.85-1.15", fontsize=10)
