@@ -78,8 +78,9 @@ def open_stroke_fidelity(cube):
 def check_drive(parts, drive: str, what: str = "verify"):
     """Refuse (:class:`InputError`, one line) a run folder ``parts`` whose plan is of
     another drive than ``drive`` (a plan without ``drive`` is the pressure drive's)."""
-    from ..storage.files import read_bounded
+    from ..storage.files import read_bounded, refuse_link
 
+    refuse_link(parts, f"{what}: the run folder")  # never read through a link
     try:
         text = read_bounded(Path(parts) / "plan.json", f"{what}: {parts}", MAX_PLAN_BYTES)
     except InputError:
@@ -92,7 +93,9 @@ def check_drive(parts, drive: str, what: str = "verify"):
         old = json.loads(text)
     except ValueError:
         return  # journaled_runs refuses it as another plan's
-    held = old.get("drive", "pressure") if isinstance(old, dict) else None
+    if not isinstance(old, dict):
+        return  # likewise
+    held = old.get("drive", "pressure")
     if held != drive:
         raise InputError(f"{what}: {parts} holds the runs of a {held}-driven verify, not of "
                          f"--drive {drive}; delete it to start again")
