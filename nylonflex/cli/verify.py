@@ -15,7 +15,10 @@ Sample designs over the cube's axes (the paper's examples among them where the c
 them), solve each with the finite-element twin at half and all of the pressure it reaches,
 and write a fidelity dataset beside the cube (<cube>.fidelity.nc): every variant's bend
 angle over the FE's, per design and pressure. Each FE run is journaled: a killed verify
-resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map."""
+resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map.
+--drive stroke instead drives the sealed twin by each design's full stroke s* and holds
+every model's pressure_max and bend_angle_max (tip_force_max with --blocked) against it:
+<cube>.fidelity_stroke.nc and its map."""
 
 
 def _integer(text):
