@@ -28,7 +28,8 @@ PKG = Path(__file__).resolve().parents[1] / "nylonflex"
 #: against the physics) or higher (``config.schema``, the JSON Schema of every config).
 NAMED_LAYERS = (
     ("foundation", ("_version", "units")),
-    ("files", ("config.safe_yaml", "storage.files", "examples")),
+    ("files", ("config.safe_yaml", "storage.files")),
+    ("examples", ("examples",)),  # written through storage.files (init: all or nothing)
     ("registry", ("variables",)),
     ("variant notes", ("variants",)),
     ("material files", ("config.material_files",)),

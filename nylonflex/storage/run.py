@@ -259,7 +259,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
                                "replaces": bool(replaces)})
             _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor,
                    progress, log, replaces=replaces, command=command)
-        except OSError as exc:
+        except (OSError, RuntimeError) as exc:  # h5py's failed flush is a RuntimeError
             if not _disk_full(exc):
                 raise
             raise DiskFull(f"the disk of {out.parent} is full; this run needs up to "
