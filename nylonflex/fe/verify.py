@@ -72,7 +72,7 @@ def check_outputs(cube, overwrite: bool = False):
         refuse_special(path, "verify", inputs=(cube,))
         why = owned.foreign(path)
         if why and not overwrite:
-            raise InputError(f"verify: {why}; it is not replaced: move it away or give "
+            raise InputError(f"{why}; it is not replaced: move it away or give "
                              "--overwrite")
     return owned
 
