@@ -1,6 +1,7 @@
 """The sealed, stroke-driven FE twin (``nf.fe_stroke``) over many designs at full stroke.
 
     python benchmarks/fe_stroke_records.py OUT_DIR [--designs 48] [--mesh default] [--seed 0]
+                                                   [--reverse]
 
 Designs: a Latin hypercube over radius 5-25 mm, wall 1-6 mm (base = wall), length 50-150
 mm, coil index 1.1-1.7 and wrap angle 5-20 deg (rounded to 0.5 mm, 0.05 and 1 deg). Each
@@ -95,13 +96,16 @@ def main(argv=None):
     p.add_argument("--designs", type=int, default=48)
     p.add_argument("--mesh", default="default")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--reverse", action="store_true",
+                   help="last design first (a second process on the same folder)")
     args = p.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     readme = os.path.join(args.out, "README.txt")
     if not os.path.exists(readme):
         with open(readme, "w") as f:
             f.write(README)
-    for i, row in enumerate(designs(args.designs, args.seed)):
+    rows = list(enumerate(designs(args.designs, args.seed)))
+    for i, row in rows[::-1] if args.reverse else rows:
         path = os.path.join(args.out, f"design_{i:03d}.json")
         if os.path.exists(path):
             continue
