@@ -196,8 +196,7 @@ TOO_MANY_POSITIONAL = {"nylonflex/physics/limits.py:_design_state_nodes",
                        "nylonflex/physics/limits.py:_model_state_nodes",
                        "nylonflex/physics/limits.py:_design_state",
                        "nylonflex/physics/limits.py:_dynamic_values",
-                       "nylonflex/physics/bending.py:_curvature_of",
-                       "nylonflex/fe/solve.py:_increments"}
+                       "nylonflex/physics/bending.py:_curvature_of"}
 
 
 def test_no_function_takes_more_than_twelve_positional_arguments():
