@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 
 from ..units import InputError
 from ._common import progress_bar
+from ._verify_stroke import run_stroke
 
 HELP = "hold a cube's models against the FE twin (needs the [fe] extra)"
 DESCRIPTION = """\
@@ -69,8 +69,6 @@ def run(args) -> int:
         raise InputError("--blocked: only with --drive stroke (the held tip's force at s*)")
     require_felupe()
     if args.drive == "stroke":
-        from ._verify_stroke import run_stroke
-
         return run_stroke(args)
     start = time.monotonic()
     with progress_bar("verify", unit="design", quiet=args.quiet, delay=0.0) as bar:

@@ -22,8 +22,8 @@ from pathlib import Path
 from ..units import InputError, json_text
 from .model import model_settings
 
-__all__ = ["RUN_FORMAT", "check_run", "journaled_runs", "plan_material", "plan_silicone",
-           "run_record"]
+__all__ = ["RUN_FORMAT", "check_drive", "check_run", "journaled_runs", "plan_material",
+           "plan_silicone", "run_record"]
 
 #: The format of a run file (``format`` in it).
 RUN_FORMAT = 1
@@ -218,3 +218,29 @@ def journaled_runs(parts, plan, tasks, solve, *, keys=("bend_angle", "coarser_be
         if progress is not None:
             progress(len(done), total)
     return done
+
+
+def check_drive(parts, drive: str, what: str = "verify"):
+    """Refuse (:class:`InputError`, one line) a run folder ``parts`` whose plan is of
+    another drive than ``drive`` (a plan without ``drive`` is the pressure drive's)."""
+    from ..storage.files import read_bounded, refuse_link
+
+    refuse_link(parts, f"{what}: the run folder")  # never read through a link
+    try:
+        text = read_bounded(Path(parts) / "plan.json", f"{what}: {parts}", MAX_PLAN_BYTES)
+    except InputError:
+        raise
+    except ValueError:
+        return  # too large: journaled_runs says it is another plan's
+    if text is None:
+        return
+    try:
+        old = json.loads(text)
+    except ValueError:
+        return  # journaled_runs refuses it as another plan's
+    if not isinstance(old, dict):
+        return  # likewise
+    held = old.get("drive", "pressure")
+    if held != drive:
+        raise InputError(f"{what}: {parts} holds the runs of a {held}-driven verify, not of "
+                         f"--drive {drive}; delete it to start again")

@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..units import InputError, json_text
+from ..units import InputError
 from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
-from .runs import journaled_runs, plan_material, plan_silicone
+from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_outputs",
            "fidelity_map_path", "fidelity_path",
@@ -206,7 +206,6 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     finally:
         ds.close()
     parts = _parts(cube)
-    from .verify_stroke import check_drive  # a stroke-driven plan there: refused in one line
 
     check_drive(parts, "pressure")
     tasks = [(d, plan["silicone"], mesh) for d in plan["designs"]]
@@ -215,7 +214,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     sil = plan["silicone"]
     total = len(plan["designs"])
     # the dataset: design x level (the fractions of p*)
-    n, m = total, len(FRACTIONS)
+    n = total
     rows = plan["designs"]
     coords = {"design": np.arange(n), "level": np.array(FRACTIONS)}
     data = {a: ("design", np.array([r[a] for r in rows])) for a in AXES}

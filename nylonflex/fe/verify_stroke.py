@@ -23,9 +23,10 @@ import numpy as np
 from .. import __version__
 from ..units import InputError
 from . import MESH_NAMES, fe_stroke, require_felupe
-from .runs import MAX_PLAN_BYTES, journaled_runs, plan_material, plan_silicone
+from .runs import check_drive, journaled_runs, plan_material, plan_silicone
+from .verify import AXES, MAX_DESIGNS, sample_designs, write_fidelity
 
-__all__ = ["DRIVES", "STROKE_RATIOS", "check_drive", "check_stroke_outputs", "model_values",
+__all__ = ["DRIVES", "STROKE_RATIOS", "check_stroke_outputs", "model_values",
            "open_stroke_fidelity", "run_verify_stroke", "stroke_dataset", "stroke_map_path",
            "stroke_parts", "stroke_path", "stroke_summary"]
 
@@ -75,32 +76,6 @@ def open_stroke_fidelity(cube):
         return fid.load()
 
 
-def check_drive(parts, drive: str, what: str = "verify"):
-    """Refuse (:class:`InputError`, one line) a run folder ``parts`` whose plan is of
-    another drive than ``drive`` (a plan without ``drive`` is the pressure drive's)."""
-    from ..storage.files import read_bounded, refuse_link
-
-    refuse_link(parts, f"{what}: the run folder")  # never read through a link
-    try:
-        text = read_bounded(Path(parts) / "plan.json", f"{what}: {parts}", MAX_PLAN_BYTES)
-    except InputError:
-        raise
-    except ValueError:
-        return  # too large: journaled_runs says it is another plan's
-    if text is None:
-        return
-    try:
-        old = json.loads(text)
-    except ValueError:
-        return  # journaled_runs refuses it as another plan's
-    if not isinstance(old, dict):
-        return  # likewise
-    held = old.get("drive", "pressure")
-    if held != drive:
-        raise InputError(f"{what}: {parts} holds the runs of a {held}-driven verify, not of "
-                         f"--drive {drive}; delete it to start again")
-
-
 def check_stroke_outputs(cube, overwrite=False):
     """:func:`.verify.check_outputs` for the stroke drive's dataset and map."""
     from ..storage.files import OwnedFiles, refuse_special
@@ -128,7 +103,6 @@ def _settings(attrs):
 
 def _plan(ds, attrs, n, seed, mesh, blocked):
     from ..engine import evaluate
-    from .verify import AXES, sample_designs
 
     models, kwargs = _settings(attrs)
     paper = dict(kwargs[models[0]], model="paper")
@@ -171,7 +145,6 @@ def run_verify_stroke(cube, designs=24, *, blocked=False, workers=1, scheduler=N
     compared are its own on ``mesh`` (not extrapolated); its discretisation error [1] is
     in the dataset.
     """
-    from .verify import MAX_DESIGNS
 
     if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
         raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
@@ -201,7 +174,6 @@ def run_verify_stroke(cube, designs=24, *, blocked=False, workers=1, scheduler=N
                           scheduler=scheduler, progress=progress, log=log, what="verify")
     out = stroke_dataset(plan, done, cube.name, kwargs)
     path = stroke_path(cube)
-    from .verify import write_fidelity
 
     write_fidelity(out, path, inputs=(cube,))
     owned.record([path])
@@ -213,7 +185,6 @@ def stroke_dataset(plan, done, cube_name, kwargs=None):
     (``kwargs``: :func:`model_values`'s)."""
     import xarray as xr
 
-    from .verify import AXES
 
     rows = plan["designs"]
     n = len(rows)
@@ -253,7 +224,6 @@ def model_values(plan, kwargs=None) -> dict:
     plan's designs, each model under the cube's settings (``kwargs``: {model: evaluate
     keyword arguments}; None: the paper's defaults with the plan's silicone and base)."""
     from ..engine import evaluate
-    from .verify import AXES
 
     rows = plan["designs"]
     arr = [np.array([r[a] for r in rows]) for a in AXES]
