@@ -20,6 +20,7 @@ __all__ = [
     "design_limits",
     "evaluate",
     "fe_bend",
+    "fe_stroke",
     "load_config",
     "nylon_parameters",
     "open_cube",
@@ -33,7 +34,7 @@ __all__ = [
 _LAZY = {"NYLON_PARAMETERS": "materials", "SILICONE_PARAMETERS": "materials",
          "nylon_parameters": "materials", "silicone_parameters": "materials",
          "design_limits": "engine", "evaluate": "engine", "load_config": "config",
-         "bend_angle": "engine", "fe_bend": "fe",
+         "bend_angle": "engine", "fe_bend": "fe", "fe_stroke": "fe",
          "run_sweep": "sweep.conductor", "open_cube": "storage", "run_design": "design",
          "CompileWarning": "kernels.compiling"}
 

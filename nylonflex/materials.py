@@ -261,12 +261,12 @@ def cooling_parameters(cooling) -> Cooling:
     """
     if isinstance(cooling, Cooling):
         return cooling
-    over = {}
+    over, field = {}, "cooling"
     if isinstance(cooling, Mapping):
         over = {k: v for k, v in cooling.items() if k != "set"}
-        cooling = cooling.get("set")
-    if cooling not in COOLING_PARAMETERS:
-        raise ValueError(f"cooling: must be one of {', '.join(COOLING_PARAMETERS)}, "
+        cooling, field = cooling.get("set"), "cooling.set"
+    if not isinstance(cooling, str) or cooling not in COOLING_PARAMETERS:
+        raise ValueError(f"{field}: must be one of {', '.join(COOLING_PARAMETERS)}, "
                          f"got {short(cooling)}")
     p = {**COOLING_PARAMETERS[cooling]}
     for key, value in over.items():

@@ -142,7 +142,14 @@ def to_si(value, unit: str, field: str = "value", kind: str | None = None):
                          f"{', '.join(_units_of(kind))}")
     if isinstance(value, (int, float)) and not isinstance(value, bool) and \
             math.isfinite(value) and (factor != 1.0 or offset != 0.0):
-        return decimal_to_si(value, u)
+        try:
+            si = decimal_to_si(value, u)
+        except OverflowError:
+            si = math.inf
+        if not math.isfinite(si):  # 1e308 kPa: finite as typed, not in SI
+            raise InputError(f"{field}: {value:g} {unit} is beyond any float in SI; "
+                             "give a plausible value")
+        return si
     return value * factor + offset
 
 

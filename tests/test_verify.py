@@ -176,7 +176,7 @@ import slowsolve
 tasks = [{"k": k} for k in range(6)]
 start = time.monotonic()
 try:
-    journaled_runs(sys.argv[2], {"plan": 1}, tasks, slowsolve.solve, workers=2)
+    journaled_runs(sys.argv[2], {"designs": tasks}, tasks, slowsolve.solve, workers=2)
 except KeyboardInterrupt:
     print("stopped after", round(time.monotonic() - start, 1), flush=True)
 """

@@ -13,7 +13,7 @@ import numpy as np
 from ..variables import label, to_display
 from ._common import _figure
 
-__all__ = ["fidelity_map"]
+__all__ = ["fidelity_map", "stroke_fidelity_map"]
 
 #: The bands drawn: |model/FE - 1| = 0.10 and 0.25.
 BANDS = (0.10, 0.25)
@@ -54,6 +54,8 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
     import matplotlib.colors as mcolors
     from matplotlib.tri import Triangulation
 
+    if "stroke_pressure_ratio" in fid:  # nylonflex verify --drive stroke
+        return stroke_fidelity_map(fid, x=x, models=models)
     models = list(fid["model"].values) if models is None else list(models)
     lv = float(fid["level"].values.max()) if level is None else float(level)
     fig, axes = _figure(1, len(models), size=(4.2 * len(models), 3.9))
@@ -94,4 +96,54 @@ def fidelity_map(fid, *, x="radius", y="wall_thickness", level=None, models=None
                  f"FE mesh {fid.attrs.get('fe_mesh', '?')}; lines at 0.75, 0.9, 1.1, 1.25"
                  + ("\nx: no FE angle (the FE solve stalled at a large bend)"
                     if missing else ""), fontsize=10)
+    return fig
+
+
+#: The stroke-driven map's band: |model/twin - 1| <= 0.15.
+STROKE_BAND = 0.15
+#: Its panels: (ratio variable, quantity).
+STROKE_PANELS = (("stroke_pressure_ratio", "pressure_max"),
+                 ("stroke_bend_ratio", "bend_angle_max"),
+                 ("stroke_force_ratio", "tip_force_max"))
+
+
+def stroke_fidelity_map(fid, *, x="radius", models=None):
+    """The stroke-driven fidelity (``nylonflex verify --drive stroke``): a panel a quantity
+    (pressure, bend, blocked force where solved), each model's ratio to the sealed twin at
+    the design's full stroke [1] over design axis ``x``, the 1.0 line and a 15 % band."""
+    from matplotlib.ticker import FuncFormatter
+
+    models = list(fid["model"].values) if models is None else list(models)
+    panels = [(r, q) for r, q in STROKE_PANELS if r in fid]
+    fig, axes = _figure(1, len(panels), size=(4.4 * len(panels), 3.9))
+    xs = np.asarray(to_display(x, fid[x].values), dtype=float)
+    markers = "osD^v<>px*"
+    for ax, (ratio, quantity) in zip(axes[0], panels):
+        lo, hi = 1 - STROKE_BAND, 1 + STROKE_BAND
+        ax.axhspan(1 - STROKE_BAND, 1 + STROKE_BAND, color="0.9", zorder=0,
+                   label=f"within {100 * STROKE_BAND:.0f} %")
+        ax.axhline(1.0, color="0.3", lw=1.0)
+        for k, model in enumerate(models):
+            r = fid[ratio].sel(model=model).values.astype(float)
+            ok = np.isfinite(r)
+            st = ratio_stats(r)
+            med = f" (median {st['median']:.2f})" if st else " (no twin value)"
+            ax.plot(xs[ok], r[ok], markers[k % len(markers)], ms=6, mfc="none", mew=1.2,
+                    label=f"{model}{med}")
+            if ok.any():
+                lo, hi = min(lo, float(r[ok].min())), max(hi, float(r[ok].max()))
+        # a log axis: a ratio and its inverse equally far from 1, a 10-fold error and the
+        # band in one panel
+        ax.set_yscale("log")
+        ax.set_ylim(lo / 1.15, hi * 1.15)
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.set_title(f"{quantity} / twin at s*")
+        ax.set_xlabel(label(fid[x]))
+        ax.set_ylabel("model / stroke-driven twin [1] (log)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+    fig.suptitle(f"Models against the sealed, stroke-driven FE twin at each design's full "
+                 f"stroke s*: {fid.sizes['design']} designs, FE mesh "
+                 f"{fid.attrs.get('fe_mesh', '?')}; band at 0.85-1.15", fontsize=10)
     return fig

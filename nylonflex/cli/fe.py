@@ -7,17 +7,25 @@ import sys
 
 from ..units import InputError, json_text, parse_quantity
 from ._common import progress_bar
+from ._fe_stroke import run_blocked, run_stroke
 
 HELP = "bend angle of one design by the finite-element twin (needs the [fe] extra)"
 DESCRIPTION = """\
 Solve one design with the finite-element twin (FElupe; docs/fidelity.md) at a list of
-chamber pressures and print its bend angle beside every model variant's analytic angle.
+chamber pressures and print its bend angle beside every model variant's analytic angle;
+or drive it as built, the muscle's stroke shortening the wrap of a sealed chamber.
 
   nylonflex fe --at radius=20mm,wall_thickness=6mm,length=90mm --pressure 0:12:4kPa
+  nylonflex fe --at radius=20mm,wall_thickness=6mm,length=90mm --stroke 0:0.054:4
+  nylonflex fe --at radius=20mm,wall_thickness=6mm,length=90mm --stroke 0.054 --blocked
 
 --pressure takes START:STOP:STEP (STOP included) or a comma list, with a unit
-(kPa when bare). --at takes radius, wall_thickness, length and optionally base_thickness
-(mm when bare) and silicone=NAME."""
+(kPa when bare). --stroke takes START:STOP:NUM (NUM strokes from START to STOP, both
+included) or a comma list, fractions of the muscle's length (or with %), each in
+[0, 0.5). --blocked holds the tip straight and prints the moment it takes and the
+force of eq. (16), F = M/L. --air-heating (with --stroke) warms the sealed air by a
+temperature rise in K. --at takes radius, wall_thickness, length and optionally
+base_thickness (mm when bare) and silicone=NAME."""
 
 #: --at's names and the unit a bare number means.
 AT_NAMES = ("radius", "wall_thickness", "length", "base_thickness")
@@ -27,8 +35,15 @@ def add_arguments(p):
     p.add_argument("--at", required=True, metavar="NAME=VALUE,...",
                    help="the design: radius, wall_thickness, length [, base_thickness] "
                         "(mm when bare) [, silicone=NAME]")
-    p.add_argument("--pressure", required=True, metavar="START:STOP:STEP|P,P,...",
+    p.add_argument("--pressure", metavar="START:STOP:STEP|P,P,...",
                    help="chamber pressures (kPa when bare), e.g. 0:12:4kPa or 2,5,10")
+    p.add_argument("--stroke", metavar="START:STOP:NUM|S,S,...",
+                   help="muscle strokes [-] driving the sealed twin, e.g. 0:0.054:4 "
+                        "(4 strokes) or 0.03,0.054 or 5%%")
+    p.add_argument("--blocked", action="store_true",
+                   help="hold the tip straight: print the moment and the force F = M/L")
+    p.add_argument("--air-heating", metavar="DT",
+                   help="with --stroke: the sealed air's temperature rise, in K (e.g. 20K)")
     p.add_argument("--mesh", default="default", metavar="coarse|default|fine",
                    help="mesh level (default: default)")
     p.add_argument("--format", choices=["table", "json"], default="table")
@@ -73,10 +88,10 @@ def parse_pressures(text):
             raise InputError(f"--pressure: STEP must be > 0, got {text!r}")
         if stop < start:
             raise InputError(f"--pressure: STOP must be >= START, got {text!r}")
-        n = int(np.floor((stop - start) / step * (1 + 1e-12))) + 1
-        if n > 100:
-            raise InputError(f"--pressure: at most 100 pressures, {text!r} gives {n}")
-        return start + step * np.arange(n)
+        count = (stop - start) / step * (1 + 1e-12)  # inf for a step of 1e-308
+        if not count < 100:
+            raise InputError(f"--pressure: at most 100 pressures, {text!r} gives more")
+        return _bounded(start + step * np.arange(int(np.floor(count)) + 1))
     parts = [s for s in text.split(",") if s.strip()]
     if not parts:
         raise InputError("--pressure: need at least one pressure, e.g. 0:12:4kPa or 2,5,10")
@@ -87,10 +102,88 @@ def parse_pressures(text):
         v = v.strip()
         out.append(parse_quantity(v if re.search(r"[A-Za-z]", v) else f"{v}{unit}",
                                   "--pressure", "pressure", "kPa"))
-    return np.array(out, dtype=float)
+    return _bounded(np.array(out, dtype=float))
+
+
+def _bounded(pressures):
+    """Refuse FE pressures [Pa] above 0 and below 0.1 Pa (a millionth of a cube's pressure
+    range): ``1e-308`` solves nothing. fe_bend checks the range itself."""
+    bad = [p for p in pressures if 0.0 < p < 0.1]
+    if bad:
+        raise InputError(f"--pressure: a pressure is 0 or at least 0.0001 kPa (0.1 Pa), got "
+                         f"{bad[0] / 1e3:.3g} kPa")
+    return pressures
+
+
+def parse_strokes(text):
+    """``0:0.054:4`` (START:STOP:NUM) or ``0.03,0.054`` or ``5%`` -> strokes [-]."""
+    import numpy as np
+
+    from ..fe.stroke import MAX_STROKE, MAX_STROKES
+
+    text = str(text).strip()
+    parts = text.split(":")
+    if len(parts) == 3:
+        start, stop = (parse_quantity(v.strip(), "--stroke", "dimensionless", "1")
+                       for v in parts[:2])
+        num = parts[2].strip()
+        if not re.fullmatch(r"\d+", num) or int(num) < 2:
+            raise InputError(f"--stroke: START:STOP:NUM takes a whole NUM >= 2 (the number "
+                             f"of strokes), got {text!r}")
+        if int(num) > MAX_STROKES:
+            raise InputError(f"--stroke: at most {MAX_STROKES} strokes, got {num}")
+        if stop < start:
+            raise InputError(f"--stroke: STOP must be >= START, got {text!r}")
+        out = np.linspace(start, stop, int(num))
+    elif len(parts) == 1:
+        items = [v for v in text.split(",") if v.strip()]
+        if not items:
+            raise InputError("--stroke: need at least one stroke, e.g. 0:0.054:4 or 0.054")
+        if len(items) > MAX_STROKES:
+            raise InputError(f"--stroke: at most {MAX_STROKES} strokes, got {len(items)}")
+        out = np.array([parse_quantity(v.strip(), "--stroke", "dimensionless", "1")
+                        for v in items])
+    else:
+        raise InputError(f"--stroke: expected START:STOP:NUM or S,S,..., got {text!r}")
+    bad = out[~((out >= 0) & (out < MAX_STROKE))]
+    if bad.size:
+        raise InputError(f"--stroke: each must be in [0, {MAX_STROKE:g}) [-], got {bad[0]:g}")
+    return out
+
+
+def parse_air_heating(text):
+    """``20K`` -> 20.0 [K]: a temperature rise, so only in K (a bare number or degC, which
+    units.py reads as a temperature with its offset, is refused)."""
+    from ..fe.stroke import MAX_AIR_HEATING
+
+    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*K\s*", str(text))
+    if not m:
+        raise InputError(f"--air-heating: a temperature rise needs the unit K (e.g. 20K), "
+                         f"got {str(text)!r}")
+    value = float(m.group(1))
+    if not 0.0 <= value <= MAX_AIR_HEATING:
+        raise InputError(f"--air-heating: must be in [0, {MAX_AIR_HEATING:g}] K, got {value:g} K")
+    return value
 
 
 def run(args) -> int:
+    design, silicone = parse_design(args.at)
+    if args.stroke is not None and args.pressure is not None:
+        raise InputError("--stroke: give --stroke or --pressure, not both")
+    if args.air_heating is not None and args.stroke is None:
+        raise InputError("--air-heating: only with --stroke (the sealed chamber's air)")
+    if args.stroke is None and args.pressure is None:
+        if args.blocked:
+            raise InputError("--blocked: needs --pressure or --stroke")
+        raise InputError("--pressure: needed (or --stroke), e.g. --pressure 0:12:4kPa")
+    if args.stroke is not None:
+        return run_stroke(args, design, silicone, parse_strokes(args.stroke),
+                          None if args.air_heating is None
+                          else parse_air_heating(args.air_heating))
+    return _run_pressure(args, design, silicone)
+
+
+def _run_pressure(args, design, silicone) -> int:
     import numpy as np
 
     from ..engine import bend_angle
@@ -98,10 +191,11 @@ def run(args) -> int:
     from ..fe.verify import ANGLE_MODELS
     from ..variables import MODELS
 
-    design, silicone = parse_design(args.at)
     pressures = parse_pressures(args.pressure)
     require_felupe()
     kw = {"base_thickness": design.get("base_thickness"), "silicone": silicone or "tc5005"}
+    if args.blocked:
+        return run_blocked(args, design, kw, pressures)
     with progress_bar("fe", unit="solve", quiet=args.quiet) as bar:
         res = fe_bend(design["radius"], design["wall_thickness"], design["length"],
                       pressures, mesh=args.mesh, progress=bar, **kw)

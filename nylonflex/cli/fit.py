@@ -68,7 +68,7 @@ def add_arguments(p):
     p.add_argument("--quiet", action="store_true",
                    help="no progress (a bar on a terminal, else a line a minute)")
     p.add_argument("--designs", type=int, default=48,
-                   help="fe: training designs (default 48, at most 500)")
+                   help="fe: training designs (default 48, 6 to 500)")
     p.add_argument("--workers", type=int, default=1, help="fe: local processes (default 1)")
     p.add_argument("--mesh", default="coarse", metavar="coarse|default|fine",
                    help="fe: the FE mesh (default coarse, Richardson-extrapolated)")
@@ -175,7 +175,8 @@ def run_fe(args) -> int:
     import numpy as np
 
     from ..fe import MESH_NAMES, require_felupe
-    from ..fe.calibrate import TRAINING_RANGES, fit_correction, run_training, training_plan
+    from ..fe.calibrate import (MIN_DESIGNS, TRAINING_RANGES, fit_correction, run_training,
+                                 training_plan)
     from ..physics.calibrated import CORRECTION, TERMS
     from ..fe.verify import MAX_DESIGNS
     from ..files.atomic import refuse_special, write_atomic
@@ -183,8 +184,12 @@ def run_fe(args) -> int:
     if args.data is not None:
         raise InputError(f"fit fe: takes no data file (got {args.data!r}); the FE twin "
                          "makes the data")
-    if not 1 <= args.designs <= MAX_DESIGNS:
-        raise InputError(f"--designs: must be in [1, {MAX_DESIGNS}], got {args.designs}")
+    if not MIN_DESIGNS <= args.designs <= MAX_DESIGNS:  # before any FE run
+        raise InputError(f"--designs: must be in [{MIN_DESIGNS}, {MAX_DESIGNS}] (the "
+                         f"correction's {MIN_DESIGNS - 2} terms and a leave-one-out need "
+                         f"{MIN_DESIGNS}), got {args.designs}")
+    if not 0 <= args.seed < 2**32:
+        raise InputError(f"--seed: must be an integer in [0, 2^32), got {args.seed}")
     if not 1 <= args.workers <= 64:
         raise InputError(f"--workers: must be in [1, 64], got {args.workers}")
     if args.mesh not in MESH_NAMES:

@@ -79,8 +79,27 @@ def _fidelity_lines(cube) -> list[str]:
         fid = open_fidelity(cube)
     except (OSError, ValueError) as exc:
         return [f"fidelity  {path}: unreadable ({type(exc).__name__})"]
+    lines = []
+    if fid is not None:
+        head = (f"fidelity  {path.name}: {fid.sizes.get('design', 0)} designs, FE mesh "
+                f"{fid.attrs.get('fe_mesh', '?')}, drive pressure (nylonflex verify)")
+        lines = [head] + [f"          {line}" for line in fidelity_summary(fid)]
+    return lines + _stroke_fidelity_lines(cube)
+
+
+def _stroke_fidelity_lines(cube) -> list[str]:
+    """The stroke-driven fidelity dataset beside the cube (``nylonflex verify --drive
+    stroke``), summarised, if any."""
+    from ..fe.verify_stroke import open_stroke_fidelity, stroke_path, stroke_summary
+
+    path = stroke_path(cube)
+    try:
+        fid = open_stroke_fidelity(cube)
+    except (OSError, ValueError) as exc:
+        return [f"fidelity  {path}: unreadable ({type(exc).__name__})"]
     if fid is None:
         return []
-    head = (f"fidelity  {path.name}: {fid.sizes.get('design', 0)} designs, FE mesh "
-            f"{fid.attrs.get('fe_mesh', '?')} (nylonflex verify)")
-    return [head] + [f"          {line}" for line in fidelity_summary(fid)]
+    head = (f"fidelity  {path.name}: {fid.sizes.get('design', 0)} designs at full stroke, "
+            f"FE mesh {fid.attrs.get('fe_mesh', '?')}, drive {fid.attrs.get('drive', '?')}"
+            f"{', blocked' if fid.attrs.get('blocked') else ''} (nylonflex verify)")
+    return [head] + [f"          {line}" for line in stroke_summary(fid)]

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 
+from ..units import InputError
 from ._common import progress_bar
+from ._verify_stroke import run_stroke
 
 HELP = "hold a cube's models against the FE twin (needs the [fe] extra)"
 DESCRIPTION = """\
@@ -14,7 +15,10 @@ Sample designs over the cube's axes (the paper's examples among them where the c
 them), solve each with the finite-element twin at half and all of the pressure it reaches,
 and write a fidelity dataset beside the cube (<cube>.fidelity.nc): every variant's bend
 angle over the FE's, per design and pressure. Each FE run is journaled: a killed verify
-resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map."""
+resumes where it stopped. 'nylonflex chart CUBE --figure fidelity_map' draws the map.
+--drive stroke instead drives the sealed twin by each design's full stroke s* and holds
+every model's pressure_max and bend_angle_max (tip_force_max with --blocked) against it:
+<cube>.fidelity_stroke.nc and its map."""
 
 
 def _integer(text):
@@ -37,7 +41,18 @@ def add_arguments(p):
                    help="the FE mesh (default coarse); the FE angle is its Richardson "
                         "extrapolation with the next coarser mesh")
     p.add_argument("--seed", type=_integer, default=0, help="the sample's seed (default 0)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a <cube>.fidelity.nc or its map that nylonflex did not "
+                        "write for this cube")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--drive", default="pressure", metavar="pressure|stroke",
+                   help="pressure (default): the twin at half and all of each design's p*; "
+                        "stroke: the sealed twin at each design's full stroke s*, every "
+                        "model's pressure_max and bend_angle_max over the twin's "
+                        "(<cube>.fidelity_stroke.nc)")
+    p.add_argument("--blocked", action="store_true",
+                   help="with --drive stroke: also the held tip, tip_force_max over the "
+                        "twin's force")
 
 
 def run(args) -> int:
@@ -45,20 +60,28 @@ def run(args) -> int:
 
     from ..charts.fidelity import fidelity_map
     from ..fe import require_felupe
-    from ..fe.verify import fidelity_summary, run_verify
+    from ..fe.verify import check_outputs, fidelity_map_path, fidelity_summary, run_verify
     from ..files.atomic import save_figure
 
+    if args.drive not in ("pressure", "stroke"):
+        raise InputError(f"--drive: must be pressure or stroke, got {args.drive!r}")
+    if args.blocked and args.drive != "stroke":
+        raise InputError("--blocked: only with --drive stroke (the held tip's force at s*)")
     require_felupe()
+    if args.drive == "stroke":
+        return run_stroke(args)
     start = time.monotonic()
     with progress_bar("verify", unit="design", quiet=args.quiet, delay=0.0) as bar:
         path = run_verify(args.cube, args.designs, workers=args.workers,
                           scheduler=args.scheduler, mesh=args.mesh, seed=args.seed,
-                          progress=bar,
+                          progress=bar, overwrite=args.overwrite,
                           log=lambda m: bar.write(f"nylonflex verify: {m}"))
     with xr.open_dataset(path, engine="h5netcdf") as fid:
         fid.load()
-    chart = path.with_name(path.name.removesuffix(".nc") + "_map.png")
+    chart = fidelity_map_path(args.cube)
+    owned = check_outputs(args.cube, args.overwrite)  # nothing was put there meanwhile
     save_figure(fidelity_map(fid), chart, what="verify", inputs=(args.cube,), dpi=130)
+    owned.record([chart])
     print(f"fidelity  {path} ({fid.sizes['design']} designs x {fid.sizes['level']} "
           f"pressures, mesh {fid.attrs['fe_mesh']}, {time.monotonic() - start:.0f} s)")
     print(f"map       {chart}")

@@ -28,8 +28,8 @@ from ..materials import Cooling, Nylon, Silicone, nylon_parameters, silicone_par
 from ..conditions import parse_requirements
 from ..files.material_files import anchor_material_files, read_chamber_file
 from ..files.safe_yaml import YAML_MAX_DEPTH, load_yaml, read_yaml
-from ..units import (InputError, bare_number, decimal_to_si, parse_decimal, plainly_degrees,
-                     short, to_si)
+from ..units import (InputError, bare_number, decimal_to_si, from_si, parse_decimal,
+                     plainly_degrees, short, to_si)
 from ..variables import CURVES, DESIGN, INPUTS, MODELS, VARIABLES
 from .charts import CHART_REGISTRY
 from .base import (
@@ -68,6 +68,12 @@ DESIGN_RANGES = {
                 "pressure", "base_thickness")
 }
 _MAX_POINTS = 100_000
+#: Most cooling sets of one sweep (``cooling:`` a list; 10,000 once ran past 90 s before
+#: its first slab).
+MAX_COOLING_SETS = 64
+#: Neighbouring values of an axis lie at least this fraction of its accepted range apart
+#: (0.1 Pa of pressure, 0.2 um of radius): ``stop: 1e-308 kPa`` is no curve.
+AXIS_RESOLUTION = 1e-6
 
 
 class Axis(_Strict):
@@ -304,6 +310,11 @@ def _axis_values(name: str, axis: Axis, path: str, nylon: Nylon) -> np.ndarray:
         vals = _decimal_linspace(axis, units, kind, path, start, stop)
     if len(vals) > 1 and np.any(np.diff(vals) <= 0):
         raise InputError(f"{path}: values must be strictly increasing")
+    if len(vals) > 1 and lo is not None and hi is not None and \
+            np.min(np.diff(vals)) < AXIS_RESOLUTION * (hi - lo):
+        least = from_si(AXIS_RESOLUTION * (hi - lo), shown)
+        raise InputError(f"{path}: neighbouring values must be at least {least:.3g} "
+                         f"{shown} apart (a millionth of the accepted range)")
     return vals
 
 
@@ -406,6 +417,9 @@ def _coolings(cooling, nylon: Nylon) -> tuple[Cooling, ...]:
         return () if env is None else (env,)
     if not cooling:
         raise InputError("cooling: needs at least one cooling set, got []")
+    if len(cooling) > MAX_COOLING_SETS:  # each set is a slice of the cube: a sweep each
+        raise InputError(f"cooling: at most {MAX_COOLING_SETS} cooling sets, got "
+                         f"{len(cooling):,}")
     out = []
     for i, item in enumerate(cooling):
         env = resolve_cooling(item, nylon, f"cooling[{i}]")

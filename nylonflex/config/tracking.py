@@ -189,9 +189,10 @@ def resolve_tracking(t: Tracking, supply_voltage, models, t_amb: float,
                            lo_open=True)
     step = check_range(t.step, "tracking.step", "time", "s", 0.0, duration, "ms",
                        lo_open=True)
-    samples = int(math.floor(duration / step + 1e-9)) + 1
-    if samples > _MAX_SAMPLES:
-        raise InputError(f"tracking.step: {samples:,} samples a design is more than "
+    ratio = duration / step  # inf for a step of 1e-308 ms: compared before int()
+    if not ratio + 1 <= _MAX_SAMPLES:
+        shown = f"{ratio + 1:,.0f}" if math.isfinite(ratio) else "more"
+        raise InputError(f"tracking.step: {shown} samples a design is more than "
                          f"{_MAX_SAMPLES:,}; use a longer step or a shorter duration")
     t0 = None if t.initial_temperature is None else check_range(
         t.initial_temperature, "tracking.initial_temperature", "temperature", "degC", t_amb,

@@ -30,7 +30,8 @@ from ..sweep.conductor import run_sweep
 from ..units import InputError
 from ..variables import AXES, DESIGN
 from .refine import Model, _bounds, evaluate_rows, meets, refine
-from .resolution import check_fixed, lattice_search, merge_equal, same_intervals, snap
+from .resolution import (check_fixed, check_steps, lattice_search, merge_equal, same_intervals,
+                         snap)
 from .search import CUBE_ONLY, GridScan, nondominated, scan_grid
 from .spec import DesignSpec, Objective, load_spec, parse_spec
 
@@ -200,6 +201,8 @@ def run_design(spec, cube=None, progress=None) -> DesignResult:
     ds = _open(spec, cube) if own else cube
     try:
         model = _materials(ds, spec)
+        check_steps(spec.resolution, {a: (float(ds[a].min()), float(ds[a].max()))
+                                      for a in spec.resolution})
         multi = len(spec.objectives) > 1
         scan = scan_grid(ds, spec, keep=1 if multi else max(1, spec.starts))
     finally:

@@ -28,7 +28,8 @@ from ..units import InputError, from_si, to_si
 from ..variables import AXES, VARIABLES
 from .refine import evaluate_rows, meets
 
-__all__ = ["check_fixed", "lattice_search", "merge_equal", "on_resolution", "same_intervals",
+__all__ = ["MIN_STEP_FRACTION", "check_fixed", "check_steps", "lattice_search", "merge_equal",
+           "on_resolution", "same_intervals",
            "snap"]
 
 #: |x/step - k| below this is the multiple k itself (float noise of typed values).
@@ -84,6 +85,36 @@ def check_fixed(resolution, fixed):
             raise InputError(f"resolution.{name}: the constraint {name} == "
                              f"{from_si(value, unit):g}{u} is not a multiple of the step "
                              f"{from_si(step, unit):g}{u}; change one of them")
+
+
+#: A step is at least this fraction of its axis's range in the cube (finer is no
+#: resolution a workshop has, and multiplies the neighbours to evaluate).
+MIN_STEP_FRACTION = 1e-3
+
+
+def check_steps(resolution, ranges):
+    """Refuse, before any work, a step outside [a thousandth of its axis's range in the
+    cube, that range] (``resolution`` {axis: step} and ``ranges`` {axis: (lo, hi)} [SI]):
+    a step longer than the range left no design on the resolution (an empty answer), a
+    step of 1e-308 mm none that can be built. An axis of one value takes any step.
+
+    Raises
+    ------
+    InputError
+        One line naming ``resolution.<axis>`` and the accepted range.
+    """
+    for name, step in resolution.items():
+        lo, hi = ranges[name]
+        span = hi - lo
+        if not span > 0:
+            continue
+        if not MIN_STEP_FRACTION * span <= step <= span:
+            unit = VARIABLES[name].display
+            shown = "" if unit == "1" else f" {unit}"
+            raise InputError(
+                f"resolution.{name}: must be in [{from_si(MIN_STEP_FRACTION * span, unit):.4g}"
+                f", {from_si(span, unit):.4g}]{shown} (a thousandth of the cube's {name} "
+                f"range, and that range), got {from_si(step, unit):.4g}{shown}")
 
 
 def snap(model, spec, rows, ranges, keep_bits=False) -> tuple[dict, np.ndarray, int]:

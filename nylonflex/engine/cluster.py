@@ -42,7 +42,7 @@ from ..units import InputError
 from .grid import compute_slab
 
 __all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "STALL_TIMEOUT", "WORKER_WAIT",
-           "DaskExecutor"]
+           "DaskExecutor", "connect_client"]
 
 #: Seconds to wait for the scheduler to answer before refusing the address.
 CONNECT_TIMEOUT = 5.0
@@ -112,6 +112,40 @@ def _connect(client_class, address, timeout):
     if "error" in box:
         raise box["error"]
     return box["client"]
+
+
+def connect_client(client_class, address, timeout: float = CONNECT_TIMEOUT):
+    """A Dask ``Client`` (``client_class``, None for distributed's) of the scheduler at
+    ``address`` (``tcp://HOST:PORT``, ``HOST:PORT`` or a cluster object), within
+    ``timeout`` seconds [s] whatever listens there.
+
+    Raises
+    ------
+    InputError
+        One line naming ``--scheduler``: dask.distributed is missing, the address is
+        malformed, nothing answers within ``timeout`` (a listener that accepts and never
+        replies included), or what answers is no Dask scheduler.
+    """
+    address = _normalise_address(address)
+    if client_class is None:
+        try:
+            from distributed import Client as client_class
+        except ImportError:
+            raise InputError("--scheduler: needs dask.distributed; install it with "
+                             "pip install 'nylonflex[dask]'") from None
+    try:
+        return _connect(client_class, address, timeout)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"--scheduler: no Dask scheduler answers at {address} "
+                         f"within {timeout:g} s ({type(exc).__name__}); start one with "
+                         "'dask scheduler' (its default port is 8786; 8787 is the "
+                         "dashboard)") from None
+    except Exception as exc:  # noqa: BLE001 - garbage from whatever listens there
+        reason = " ".join(str(exc).split())[:100] or type(exc).__name__
+        raise InputError(f"--scheduler: what answers at {address} is not a Dask "
+                         f"scheduler ({type(exc).__name__}: {reason}); give the "
+                         "address of 'dask scheduler' (its default port is 8786)"
+                         ) from None
 
 
 def _disarm(exc, client_class):
@@ -202,24 +236,7 @@ class DaskExecutor:
                  worker_wait: float = WORKER_WAIT, stall: float | None = None):
         self.address = _normalise_address(address)
         self.stall = _stall_seconds() if stall is None else float(stall)
-        try:
-            from distributed import Client
-        except ImportError:
-            raise InputError("--scheduler: needs dask.distributed; install it with "
-                             "pip install 'nylonflex[dask]'") from None
-        try:
-            self.client = _connect(Client, self.address, timeout)
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"--scheduler: no Dask scheduler answers at {self.address} "
-                             f"within {timeout:g} s ({type(exc).__name__}); start one with "
-                             "'dask scheduler' (its default port is 8786; 8787 is the "
-                             "dashboard)") from None
-        except Exception as exc:  # noqa: BLE001 - garbage from whatever listens there
-            reason = " ".join(str(exc).split())[:100] or type(exc).__name__
-            raise InputError(f"--scheduler: what answers at {self.address} is not a Dask "
-                             f"scheduler ({type(exc).__name__}: {reason}); give the "
-                             "address of 'dask scheduler' (its default port is 8786)"
-                             ) from None
+        self.client = connect_client(None, self.address, timeout)
         self._quiet = _quiet_dask_logs()  # its reconnect tracebacks on scheduler loss
         self._pending: set = set()
         self._used: set[str] = set()

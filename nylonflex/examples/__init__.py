@@ -9,9 +9,11 @@ a copy of ``tests/data/ecoflex_0050.csv``), so every command of the README runs 
 
 from __future__ import annotations
 
+import os
 from importlib import resources
 from pathlib import Path
 
+from ..files.atomic import create_files, path_error
 from ..units import InputError
 
 __all__ = ["DATA", "EXAMPLES", "NEEDS", "example_text", "write_examples"]
@@ -75,8 +77,6 @@ def write_examples(folder, names=None) -> list[Path]:
     for n in names:
         if n not in EXAMPLES:
             raise InputError(f"init: unknown example {n!r}; accepted: {', '.join(EXAMPLES)}")
-    if folder.exists() and not folder.is_dir():
-        raise InputError(f"init: {folder} is a file; give a folder for the example configs")
     files = {}  # target path -> package file
     for n in names:
         files[folder / "configs" / f"{n}.yaml"] = f"{n}.yaml"
@@ -85,15 +85,17 @@ def write_examples(folder, names=None) -> list[Path]:
     if everything:
         for rel in DATA:
             files[folder / "data" / rel] = f"data/{rel}"
-    existing = [str(p) for p in files if p.exists()]
+    existing = [str(p) for p in files if os.path.lexists(p)]
     if existing:
         what = existing[0] if len(existing) == 1 else \
             f"{len(existing)} of its files ({existing[0]}, ...)"
         verb = "already exists" if len(existing) == 1 else "already exist"
         raise InputError(f"init: {what} {verb}; nothing written (move them away, or init "
                          "another folder)")
-    for target, rel in files.items():
-        target.parent.mkdir(parents=True, exist_ok=True)
-        with open(target, "xb") as f:  # exclusive: never replace a file made meanwhile
-            f.write(_package_file(rel))
-    return list(files)
+    try:
+        return create_files({target: _package_file(rel) for target, rel in files.items()},
+                            "init")
+    except FileExistsError as exc:  # made meanwhile: nothing of this init is left
+        raise InputError(f"init: {exc.filename} already exists; nothing written") from None
+    except OSError as exc:
+        raise path_error(exc, exc.filename or folder, "init") from None

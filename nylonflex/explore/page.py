@@ -25,6 +25,7 @@ bokeh model named ``nf-star``) and each curve's source (``nf-curve-NAME``) carry
 from __future__ import annotations
 
 import html
+import logging
 import math
 import re
 from importlib.resources import files
@@ -527,6 +528,44 @@ def build_html(ds, *, source: str = "", where=(), fidelity=None) -> str:
     return re.sub(r'<script[^>]*\bsrc="[^"]*"[^>]*>\s*</script>\s*', "", text)
 
 
+#: The page server's bounds (tornado's HTTPServer): a request's headers and body each
+#: arrive within a minute [s] (a client that sends part of a request and stops no longer
+#: holds its connection for an hour), headers of at most 64 KiB and a body of at most
+#: 1 MiB [B] (the page sends none; its messages go over the websocket).
+SERVER_LIMITS = {"idle_connection_timeout": 60, "body_timeout": 60,
+                 "max_header_size": 64 * 1024, "max_body_size": 1 << 20}
+
+
+class _OneLine(logging.Filter):
+    """A server log record on one line: an exception a malformed request raised (tornado's
+    "Uncaught exception GET /ws" with a traceback: a websocket without Bokeh's subprotocol,
+    a session id that is no token) becomes the request, the exception's type and the
+    first 200 characters of its message."""
+
+    def filter(self, record):
+        if record.exc_info or "\n" in str(record.msg):
+            head = record.getMessage().splitlines()[0] if record.getMessage() else ""
+            exc = record.exc_info[1] if record.exc_info else None
+            why = f": {type(exc).__name__}: {' '.join(str(exc).split())[:200]}" if exc else ""
+            record.msg, record.args = f"{head[:300]}{why}", ()
+            record.exc_info = record.exc_text = record.stack_info = None
+        return True
+
+
+def one_line_server_logs():
+    """Make every record the page server logs (tornado's, Bokeh's) one line on stderr:
+    a handler of the root logger where it has none (else Python's last-resort handler
+    printed tracebacks), and :class:`_OneLine` on it and on Bokeh's own handlers."""
+    root = logging.getLogger()
+    if not root.handlers:
+        handler = logging.StreamHandler()
+        handler.setLevel(logging.WARNING)
+        root.addHandler(handler)
+    for handler in [*root.handlers, *logging.getLogger("bokeh").handlers]:
+        if not any(isinstance(f, _OneLine) for f in handler.filters):
+            handler.addFilter(_OneLine())
+
+
 def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready=None,
           fidelity=None):
     """Serve the page of :func:`build_document` on ``127.0.0.1:port`` until interrupted.
@@ -545,9 +584,11 @@ def serve(ds, *, port: int, source: str = "", where=(), show: bool = True, ready
         build_document(ds, source=source, where=conditions, served=True, payload=payload,
                        doc=doc, fidelity=fidelity)
 
+    one_line_server_logs()
     server = Server({"/": Application(FunctionHandler(session))}, port=port,
                     address="127.0.0.1",
-                    allow_websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"])
+                    allow_websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
+                    http_server_kwargs=dict(SERVER_LIMITS))
     server.start()
     if ready is not None:
         ready()

@@ -15,8 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import InputError
+from .stroke import air_heating_ratio, check_strokes
 
-__all__ = ["FE_RANGES", "MESH_NAMES", "fe_bend", "require_felupe"]
+__all__ = ["FE_RANGES", "MESH_NAMES", "fe_bend", "fe_stroke", "require_felupe"]
 
 #: The mesh levels a user may ask for, coarse to fine (:data:`.mesh.MESHES`).
 MESH_NAMES = ("coarse", "default", "fine")
@@ -76,8 +77,23 @@ def _pressures(pressures):
     return p
 
 
+def _mesh_name(mesh):
+    if not isinstance(mesh, str) or mesh not in MESH_NAMES:
+        raise InputError(f"mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    return mesh
+
+
+def _silicone(silicone):
+    from ..materials import silicone_parameters
+
+    try:
+        return silicone_parameters(silicone)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+
+
 def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
-            silicone="tc5005", mesh="default", progress=None):
+            silicone="tc5005", mesh="default", blocked=False, progress=None):
     """Bend angle of a design against chamber pressure by the FE twin.
 
     Parameters
@@ -94,6 +110,9 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         fields overridden).
     mesh : {"coarse", "default", "fine"}
         Mesh level (docs/fidelity.md: the default's discretisation error is under 3 %).
+    blocked : bool
+        Hold the tip straight (its cap's outer face clamped, the paper's force test) and
+        return the moment it takes.
     progress : callable, optional
         ``progress(done, total)`` in solved increments of both meshes (an estimate).
 
@@ -105,7 +124,10 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         coarser mesh, r = 1.5, p = 2; 0 at zero pressure), arrays in the order given; NaN
         where the solve could not reach the pressure (it stalls at large bends:
         docs/fidelity.md); ``coarser_bend_angle`` [rad], the next coarser mesh's angles the
-        estimate is taken from.
+        estimate is taken from. With ``blocked``: ``tip_moment`` [N m] (the moment the
+        body exerts on the tip's holder about the x-axis through the skin, y = 0),
+        ``tip_force`` [N] = tip_moment / length (the paper's eq. 16), their coarser
+        mesh's ``coarser_tip_moment``, and ``discretisation_error`` that of the moment.
 
     Raises
     ------
@@ -113,18 +135,13 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         A design outside the accepted range, no or negative pressures, an unknown mesh,
         or FElupe not installed.
     """
-    from ..materials import silicone_parameters
-    from .mesh import REFINEMENT, body_mesh
+    from .mesh import body_mesh
     from .solve import solve_bend
 
-    if not isinstance(mesh, str) or mesh not in MESH_NAMES:
-        raise InputError(f"mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    mesh = _mesh_name(mesh)
     a, t, L, b = _design(radius, wall_thickness, length, base_thickness)
     p = _pressures(pressures)
-    try:
-        sil = silicone_parameters(silicone)
-    except ValueError as exc:
-        raise InputError(str(exc)) from None
+    sil = _silicone(silicone)
     require_felupe()
     mu, alpha = sil.arrays()
     span = float(p.max()) if p.max() > 0 else 1.0
@@ -136,13 +153,124 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
                 progress(offset + weight * pressure / span, 1.0)
         return call
 
+    if blocked:
+        from .solve import solve_pressures
+
+        fine, coarse = (solve_pressures(body_mesh(a, t, L, base_thickness=b, mesh=level), mu,
+                                        alpha, p, progress=report(*part), partial=True,
+                                        blocked=True)
+                        for level, part in ((mesh, (0.0, share)),
+                                            (_COARSER[mesh], (share, 1.0 - share))))
+        return {"pressure": p, "bend_angle": fine["bend_angle"],
+                "tip_moment": fine["tip_moment"], "tip_force": fine["tip_moment"] / L,
+                "discretisation_error": richardson(fine["tip_moment"], coarse["tip_moment"]),
+                "mesh": mesh, "coarser_bend_angle": coarse["bend_angle"],
+                "coarser_tip_moment": coarse["tip_moment"]}
     angles = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=mesh), mu, alpha, p,
                         progress=report(0.0, share), partial=True)
     coarser = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=_COARSER[mesh]), mu,
                          alpha, p, progress=report(share, 1.0 - share), partial=True)
+    return {"pressure": p, "bend_angle": angles,
+            "discretisation_error": richardson(angles, coarser), "mesh": mesh,
+            "coarser_bend_angle": coarser}
+
+
+def richardson(fine, coarse):
+    """The Richardson estimate |f_h - f_2h| / (r^p - 1) / |f_h| [1] of values ``fine`` on a
+    mesh against ``coarse`` on the next coarser one (r = :data:`.mesh.REFINEMENT`, p =
+    :data:`ORDER`); 0 where the value is 0, NaN where either is."""
+    from .mesh import REFINEMENT
+
+    fine, coarse = np.asarray(fine, dtype=float), np.asarray(coarse, dtype=float)
     factor = REFINEMENT ** ORDER - 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
-        err = np.where(angles != 0, np.abs(angles - coarser) / factor / np.abs(angles), 0.0)
-    err[np.isnan(angles) | np.isnan(coarser)] = np.nan
-    return {"pressure": p, "bend_angle": angles, "discretisation_error": err, "mesh": mesh,
-            "coarser_bend_angle": coarser}
+        err = np.where(fine != 0, np.abs(fine - coarse) / factor / np.abs(fine), 0.0)
+    err[np.isnan(fine) | np.isnan(coarse)] = np.nan
+    return err
+
+
+def fe_stroke(radius, wall_thickness, length, strokes, *, base_thickness=None,
+              silicone="tc5005", blocked=False, air_heating=None, mesh="default",
+              progress=None):
+    """The sealed actuator against the muscle's stroke by the FE twin.
+
+    The wrap's rest length is 1 - s (bonded to the silicone: it does not slide); the
+    chamber holds its air, (p0 + p) V = p0 V0 (T0 + dT)/T0 (docs/fidelity.md).
+
+    Parameters
+    ----------
+    radius, wall_thickness, length : float
+        a, t, L [m] (the ranges of :func:`.fe_bend`).
+    strokes : float or sequence of float
+        Muscle strokes s [-], each in [0, 0.5), at most 100.
+    base_thickness : float, optional
+        b [m]; the wall thickness when None.
+    silicone : str, dict or Silicone
+        Any silicone set nylonflex knows.
+    blocked : bool
+        Hold the tip straight (its cap's outer face clamped: the paper's force test).
+    air_heating : float, optional
+        Temperature rise dT of the chamber's air over the ambient T0 [K], in [0, 200]
+        (T0: the nylon set's ambient, 298.15 K); the air is warmed at zero stroke, sealed,
+        then the wrap contracts. None: isothermal (dT = 0).
+    mesh : {"coarse", "default", "fine"}
+        Mesh level.
+    progress : callable, optional
+        ``progress(done, total)``, the solved share of the work (an estimate).
+
+    Returns
+    -------
+    dict
+        Arrays in the order of ``strokes``: ``stroke`` [-], ``pressure`` (chamber gauge)
+        [Pa], ``volume_ratio`` V/V0 [-], ``bend_angle`` [rad]; with ``blocked``
+        ``tip_moment`` [N m] (the moment the body exerts on the tip's holder about the
+        x-axis through the skin, y = 0) and ``tip_force`` [N] = tip_moment / length (the
+        paper's eq. 16). ``discretisation_error`` [1]: the larger of the Richardson
+        estimates (as :func:`.fe_bend`'s) of the pressure and of the bend angle (of the
+        tip moment when ``blocked``), against the next coarser mesh, whose values are
+        ``coarser_<name>``. NaN where the solve could not reach the stroke. ``mesh``,
+        and ``air_heating`` [K].
+
+    Raises
+    ------
+    InputError
+        A design outside the accepted range, strokes outside [0, 0.5), a negative or
+        too large air heating, an unknown mesh, or FElupe not installed.
+    """
+    from ..physics.chamber import P_ATM
+    from .mesh import body_mesh
+    from .sealed import solve_stroke
+
+    mesh = _mesh_name(mesh)
+    a, t, L, b = _design(radius, wall_thickness, length, base_thickness)
+    s = check_strokes(strokes)
+    heating = air_heating_ratio(air_heating)
+    sil = _silicone(silicone)
+    require_felupe()
+    mu, alpha = sil.arrays()
+    span = float(s.max()) if s.max() > 0 else 1.0
+    share = 0.75  # of the work: the asked-for mesh; the rest the coarser one
+
+    def report(offset, weight):
+        def call(stroke, angle, iterations):
+            if progress is not None:
+                progress(offset + weight * stroke / span, 1.0)
+        return call
+
+    fine, coarse = (solve_stroke(body_mesh(a, t, L, base_thickness=b, mesh=level), mu, alpha,
+                                 s, p_atm=P_ATM, heating=heating, blocked=bool(blocked),
+                                 progress=report(*part), partial=True)
+                    for level, part in ((mesh, (0.0, share)),
+                                        (_COARSER[mesh], (share, 1.0 - share))))
+    main = "tip_moment" if blocked else "bend_angle"
+    err = np.fmax(richardson(fine["pressure"], coarse["pressure"]),
+                  richardson(fine[main], coarse[main]))
+    err[np.isnan(fine[main]) | np.isnan(coarse[main])] = np.nan
+    out = {"stroke": s, **fine}
+    if blocked:
+        out["tip_force"] = fine["tip_moment"] / L
+    out["discretisation_error"] = err
+    out.update({f"coarser_{k}": v for k, v in coarse.items()})
+    out["mesh"] = mesh
+    out["air_heating"] = 0.0 if air_heating is None else float(air_heating)
+    return out

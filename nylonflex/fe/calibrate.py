@@ -31,7 +31,7 @@ from . import ORDER, fe_bend
 from .mesh import REFINEMENT
 from .runs import journaled_runs, plan_material, plan_silicone
 
-__all__ = ["TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
+__all__ = ["MIN_DESIGNS", "TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
            "run_training", "training_plan"]
 
 #: The design space the training designs fill [m] (the fig12 and big20m sweeps').
@@ -41,6 +41,9 @@ TRAINING_RANGES = {"radius": (5e-3, 25e-3), "wall_thickness": (1e-3, 6e-3),
 TARGET_ANGLES = (math.radians(20.0), math.radians(50.0))
 #: Number of coefficients of the correction (:func:`correction_terms`).
 N_TERMS = 4
+#: Fewest training designs a fit takes: the coefficients and two more, so that every
+#: leave-one-design-out fit is still overdetermined.
+MIN_DESIGNS = N_TERMS + 2
 
 
 def correction_terms(pressure, radius, wall_thickness, length, mu0):
@@ -131,7 +134,7 @@ def fit_correction(plan, done, *, silicone=None) -> dict:
         for p, th in zip(d["pressures"], fe):
             if np.isfinite(th) and th > 0:
                 pts.append((k, p, float(th)))
-    if len({k for k, _, _ in pts}) < N_TERMS + 2:
+    if len({k for k, _, _ in pts}) < MIN_DESIGNS:
         raise InputError("fit fe: too few FE angles to fit the correction "
                          f"({len(pts)} points)")
     idx = np.array([k for k, _, _ in pts])

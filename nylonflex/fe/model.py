@@ -23,8 +23,8 @@ import numpy as np
 
 from .mesh import BodyMesh
 
-__all__ = ["BULK_RATIO", "COMPRESSION_RATIO", "SKIN_RATIO", "WRAP_RATIO", "FibreMaterial",
-           "build_model", "element", "felupe_ogden", "model_settings"]
+__all__ = ["BULK_RATIO", "COMPRESSION_RATIO", "SKIN_RATIO", "WRAP_ITEMS", "WRAP_RATIO",
+           "FibreMaterial", "build_model", "element", "felupe_ogden", "model_settings"]
 
 #: Bulk modulus of the volumetric penalty over the initial shear modulus (Poisson's ratio
 #: 0.4999 at 5000).
@@ -75,6 +75,11 @@ class FibreMaterial:
     (I4 > 1), ``compression`` times k in compression (I4 < 1; W and its first derivative
     are continuous at I4 = 1), and ``direction`` (cells, 3) unit vectors in the reference
     configuration. Implements FElupe's material interface (``gradient``, ``hessian``).
+
+    ``rest_length`` (an attribute, 1 by default) is the fibres' rest length over their
+    length in the reference configuration [-]: the direction enters as a / rest_length,
+    so I4 = a.C.a / rest_length^2 is the squared stretch over the rest length. The wrap's
+    contraction by a muscle stroke s is a rest length 1 - s (:func:`.sealed.solve_stroke`).
     """
 
     def __init__(self, stiffness, direction, compression=1.0):
@@ -82,8 +87,16 @@ class FibreMaterial:
             raise ValueError(f"compression must be in [0, 1], got {compression!r}")
         self.compression = float(compression)
         self.k = np.asarray(stiffness, dtype=float)
-        self.a = np.asarray(direction, dtype=float).T[:, None, :]  # (3, 1, cells)
+        self.direction = np.asarray(direction, dtype=float).T[:, None, :]  # (3, 1, cells)
+        self.rest_length = 1.0
         self.x = [np.eye(3), np.zeros(0)]
+
+    @property
+    def a(self):
+        """The reference direction over the rest length, (3, 1, cells) [-]."""
+        if self.rest_length == 1.0:
+            return self.direction
+        return self.direction / self.rest_length
 
     def _parts(self, F):
         fa = np.einsum("iJqc,Jqc->iqc", F, np.broadcast_to(self.a, (3,) + F.shape[2:]))
@@ -124,10 +137,18 @@ def element(cells):
     return "hexahedron", fem.RegionHexahedron, fem.RegionHexahedronBoundary
 
 
-def build_model(body: BodyMesh, mu, alpha):
+#: Indices in :func:`build_model`'s items of the fibres the muscle's turns make: the skin's
+#: fibres across (the wrap passing under the skin) and the wrap's hoop fibres.
+WRAP_ITEMS = (2, 3)
+
+
+def build_model(body: BodyMesh, mu, alpha, *, blocked=False):
     """FElupe items of the body: (field, items, pressure item, boundaries, dof sets).
 
-    ``mu``, ``alpha``: the Ogden set in nylonflex's convention [Pa], [-].
+    ``mu``, ``alpha``: the Ogden set in nylonflex's convention [Pa], [-]. The items are
+    the silicone, the skin's fibres along z, the skin's fibres across and the wrap
+    (:data:`WRAP_ITEMS`). With ``blocked`` the tip cap's outer face z = L + t is clamped
+    too (boundary "tip"): the actuator held straight, as in the paper's force test.
     """
     import felupe as fem
 
@@ -166,5 +187,7 @@ def build_model(body: BodyMesh, mu, alpha):
         "symmetry": fem.Boundary(field[0], mask=np.abs(x) < tol, skip=(0, 1, 1)),
         "clamp": fem.Boundary(field[0], mask=np.abs(z + t) < tol),
     }
+    if blocked:
+        boundaries["tip"] = fem.Boundary(field[0], mask=np.abs(z - body.length - t) < tol)
     dof0, dof1 = fem.dof.partition(field, boundaries)
     return field, items, pressure, boundaries, (dof0, dof1)

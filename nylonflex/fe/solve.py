@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .measures import chamber_volume, tip_moment
 from .mesh import BodyMesh
-from .model import build_model, felupe_ogden
+from .model import WRAP_ITEMS, build_model, felupe_ogden
 
-__all__ = ["MAX_STEP", "FESolveError", "solve_bend"]
+__all__ = ["MAX_STEP", "FESolveError", "Path", "march", "solve_bend", "solve_pressures"]
 
 #: Largest pressure increment over the initial shear modulus [-].
 MAX_STEP = 0.1
@@ -33,6 +34,9 @@ MIN_STEP = 1e-4
 #: converges (docs/fidelity.md).
 RESCUE_BELOW = 4e-3
 RESCUE_STEP = 0.04
+#: The stroke's unit of increment [-]: the first stroke increment FIRST_STEP times it,
+#: the largest MAX_STEP times it (:func:`.sealed.solve_stroke`).
+STROKE_UNIT = 0.1
 #: Newton's tolerance (FElupe's relative residual norm) and iteration limit.
 NEWTON_TOL = 1e-7
 NEWTON_MAXITER = 25
@@ -137,6 +141,124 @@ def _extrapolate(history, p):
     return out
 
 
+class Path:
+    """One FE body followed along a load parameter: FElupe's state, the last converged
+    states (for the predictor), the unwrapped bend angle, and the Newton step.
+
+    ``load_item`` is the item last in Newton's list (the chamber's pressure, or the sealed
+    air of :mod:`.sealed`); ``newton_solve`` FElupe's ``solve`` argument where the step is
+    not FElupe's own (the sealed chamber's bordered system).
+    """
+
+    def __init__(self, body, model, solver, load_item=None, newton_solve=None):
+        field, items, pressure, boundaries, (dof0, dof1) = model
+        self.body, self.field, self.items = body, field, items
+        self.load_item = pressure if load_item is None else load_item
+        self.dof0, self.dof1, self.boundaries = dof0, dof1, boundaries
+        self.solver, self.newton_solve = solver, newton_solve
+        self.u = field[0]  # FElupe may replace u.values: always read it through the field
+        # the u-p-J body's cell-wise pressure and volume: restored with the displacement
+        # after a failed increment (left at a failed Newton iterate, they sink the next one)
+        self.solid = items[0]
+        self.saved = self.solid.checkpoint()
+        self.probes = _probes(body)
+        self.last = _section_angles(body.points, self.u.values, self.probes)
+        self.unwrapped = np.zeros(2)
+        self.residual = None
+        self.restart(0.0)
+
+    def restart(self, value):
+        """Start the predictor's history at the current state, at load ``value``."""
+        self.history = [(value, self.u.values.copy())]
+
+    def angle(self):
+        """The bend angle of the last converged state [rad]."""
+        return float(self.unwrapped[1] - self.unwrapped[0])
+
+    def attempt(self, value, set_load):
+        """Newton's method at load ``value`` (``set_load(value)`` applies it) from the
+        predictor: its iterations, or None where it failed."""
+        import felupe as fem
+
+        self.u.values[:] = _extrapolate(self.history, value)
+        set_load(value)
+        extra = {} if self.newton_solve is None else {"solve": self.newton_solve}
+        try:
+            res = fem.newtonraphson(items=self.items + [self.load_item], dof1=self.dof1,
+                                    dof0=self.dof0, verbose=0, tol=NEWTON_TOL,
+                                    maxiter=NEWTON_MAXITER, solver=self.solver,
+                                    plugins=[fem.LinesearchPlugin(residual=False)], **extra)
+            ok = bool(res.success) and np.all(np.isfinite(self.u.values))
+        except (ValueError, RuntimeError, FloatingPointError, np.linalg.LinAlgError):
+            # FElupe's NewtonConvergenceError is a ValueError; a NaN matrix fails
+            # SuperLU's factorisation with a RuntimeError
+            ok = False
+        if not ok:
+            return None
+        self.residual = res.fun
+        return res.iterations
+
+    def restore(self):
+        """Back to the last converged state."""
+        self.solid.restore(self.saved)
+        self.u.values[:] = self.history[-1][1]
+
+    def accept(self, value):
+        """Record the state just converged at load ``value``."""
+        now = _section_angles(self.body.points, self.u.values, self.probes)
+        self.unwrapped += np.angle(np.exp(1j * (now - self.last)))
+        self.last = now
+        self.history = self.history[-2:] + [(value, self.u.values.copy())]
+        self.saved = self.solid.checkpoint()
+
+
+def march(path, targets, set_load, unit, record, *, progress=None, partial=False,
+          what="{:.4g} Pa"):
+    """Follow ``path`` through the load values ``targets`` (>= the path's current value
+    0, any order), calling ``record(index, value)`` at each.
+
+    Increments of at most :data:`MAX_STEP` ``unit`` (the first :data:`FIRST_STEP` unit),
+    halved when Newton's method fails, grown after easy steps, every target landed on
+    exactly (the module's docstring). Returns the indices of the targets not reached
+    (empty unless ``partial``; without it a failure raises :class:`FESolveError`, its
+    message the load formatted by ``what``).
+    """
+    targets = np.asarray(targets, dtype=float)
+    order = np.argsort(targets)
+    step = FIRST_STEP * unit
+    now = 0.0
+    rescued = -1.0  # the load a rescue increment was last tried from
+    for k, idx in enumerate(order):
+        target = targets[idx]
+        while now < target:
+            nxt = min(target, now + step)
+            if target - nxt < 0.25 * step:  # no sliver of a step before a target
+                nxt = target
+            iterations = path.attempt(nxt, set_load)
+            if iterations is None:
+                path.restore()
+                step *= 0.5
+                if step < RESCUE_BELOW * unit and rescued != now:
+                    rescued = now  # once from each converged state
+                    step = RESCUE_STEP * unit
+                    continue
+                if step < MIN_STEP * unit:
+                    if partial:
+                        return order[k:]
+                    raise FESolveError(f"the FE solve did not converge at {what.format(nxt)}")
+                continue
+            path.accept(nxt)
+            now = nxt
+            if iterations <= EASY_STEP:
+                step = min(step * 1.5, MAX_STEP * unit)
+            elif iterations > 2 * EASY_STEP:
+                step *= 2.0 / 3.0
+            if progress is not None:
+                progress(now, path.angle(), iterations)
+        record(idx, target)
+    return order[:0]
+
+
 def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=False):
     """Bend angles [rad] of ``body`` at each of ``pressures`` [Pa] (ascending, >= 0).
 
@@ -146,79 +268,49 @@ def solve_bend(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=F
     increment cannot converge; with ``partial`` the pressures not reached get NaN instead
     (the solve stalls at large bends; docs/fidelity.md).
     """
+    return solve_pressures(body, mu, alpha, pressures, progress=progress,
+                           partial=partial)["bend_angle"]
+
+
+def solve_pressures(body: BodyMesh, mu, alpha, pressures, *, progress=None, partial=False,
+                    blocked=False, stroke=0.0):
+    """:func:`solve_bend`'s states as a dict of arrays in the order of ``pressures``:
+    ``bend_angle`` [rad], ``volume_ratio`` V/V0 of the chamber [-] and, with ``blocked`` (the tip held straight), ``tip_moment``
+    [N m] (:func:`.sealed.tip_moment`, the whole body's). With ``stroke`` s > 0 the wrap
+    is first shortened to its rest length 1 - s with the chamber vented (p = 0), then the
+    pressures are imposed at that wrap length. NaN where not reached (``partial``)."""
     targets = np.asarray(pressures, dtype=float)
-    order = np.argsort(targets)
-    field, items, pressure, _, (dof0, dof1) = build_model(body, mu, alpha)
+    model = build_model(body, mu, alpha, blocked=blocked)
     mu0 = float(sum(felupe_ogden(mu, alpha)[0]))
-    probes = _probes(body)
     solver = linear_solver()
+    out = {"bend_angle": np.full(len(targets), np.nan),
+           "volume_ratio": np.full(len(targets), np.nan)}
+    volume0 = chamber_volume(model[2], body.points)
+    if blocked:
+        out["tip_moment"] = np.full(len(targets), np.nan)
     try:
-        return _increments(body, field, items, pressure, dof0, dof1, mu0, probes, solver,
-                           targets, order, progress, partial)
+        path = Path(body, model, solver)
+        if stroke > 0:
+            wraps = [path.items[i].umat for i in WRAP_ITEMS]
+
+            def shorten(s):
+                for w in wraps:
+                    w.rest_length = 1.0 - s
+            if len(march(path, [stroke], shorten, STROKE_UNIT, lambda i, v: None,
+                         partial=partial, what="stroke {:.4g}")):
+                return out
+            path.restart(0.0)
+
+        def record(idx, target):
+            out["bend_angle"][idx] = path.angle() if target > 0 or stroke > 0 else 0.0
+            path.load_item.field.link(path.field)
+            out["volume_ratio"][idx] = chamber_volume(path.load_item, body.points) / volume0
+            if blocked:
+                out["tip_moment"][idx] = tip_moment(path)
+
+        march(path, targets, path.load_item.update, mu0, record, progress=progress,
+              partial=partial)
     finally:
         if hasattr(solver, "close"):
             solver.close()
-
-
-def _increments(body, field, items, pressure, dof0, dof1, mu0, probes, solver, targets,
-                order, progress, partial):
-    import felupe as fem
-
-    u = field[0]  # FElupe may replace u.values: always read it through the field
-    history = [(0.0, u.values.copy())]
-    # the u-p-J body's cell-wise pressure and volume: restored with the displacement after
-    # a failed increment (left at a failed Newton iterate, they sink the next attempt)
-    solid = items[0]
-    saved = solid.checkpoint()
-    last = _section_angles(body.points, u.values, probes)
-    unwrapped = np.zeros(2)
-    angles = np.empty(len(targets))
-    step = FIRST_STEP * mu0
-    p_now = 0.0
-    rescued = -1.0  # the pressure a rescue increment was last tried from
-    for idx in order:
-        target = targets[idx]
-        while p_now < target:
-            p_next = min(target, p_now + step)
-            if target - p_next < 0.25 * step:  # no sliver of a step before a target
-                p_next = target
-            u.values[:] = _extrapolate(history, p_next)
-            pressure.update(p_next)
-            try:
-                res = fem.newtonraphson(items=items + [pressure], dof1=dof1, dof0=dof0,
-                                        verbose=0, tol=NEWTON_TOL, maxiter=NEWTON_MAXITER,
-                                        solver=solver,
-                                        plugins=[fem.LinesearchPlugin(residual=False)])
-                ok = bool(res.success) and np.all(np.isfinite(u.values))
-            except (ValueError, RuntimeError, FloatingPointError, np.linalg.LinAlgError):
-                # FElupe's NewtonConvergenceError is a ValueError; a NaN matrix fails
-                # SuperLU's factorisation with a RuntimeError
-                ok = False
-            if not ok:
-                solid.restore(saved)
-                u.values[:] = history[-1][1]
-                step *= 0.5
-                if step < RESCUE_BELOW * mu0 and rescued != p_now:
-                    rescued = p_now  # once from each converged state
-                    step = RESCUE_STEP * mu0
-                    continue
-                if step < MIN_STEP * mu0:
-                    if partial:
-                        angles[order[np.searchsorted(targets[order], target):]] = np.nan
-                        return angles
-                    raise FESolveError(f"the FE solve did not converge at {p_next:.4g} Pa")
-                continue
-            now = _section_angles(body.points, u.values, probes)
-            unwrapped += np.angle(np.exp(1j * (now - last)))
-            last = now
-            p_now = p_next
-            history = history[-2:] + [(p_now, u.values.copy())]
-            saved = solid.checkpoint()
-            if res.iterations <= EASY_STEP:
-                step = min(step * 1.5, MAX_STEP * mu0)
-            elif res.iterations > 2 * EASY_STEP:
-                step *= 2.0 / 3.0
-            if progress is not None:
-                progress(p_now, float(unwrapped[1] - unwrapped[0]), res.iterations)
-        angles[idx] = unwrapped[1] - unwrapped[0] if target > 0 else 0.0
-    return angles
+    return out

@@ -17,13 +17,15 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..units import InputError, json_text
+from ..units import InputError
 from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
-from .runs import journaled_runs, plan_material, plan_silicone
+from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 
-__all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "fidelity_path",
-           "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs"]
+__all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_outputs",
+           "fidelity_map_path", "fidelity_path",
+           "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs",
+           "write_fidelity"]
 
 #: The variants whose bend angle at a given pressure differs (the others change the
 #: muscle's side only): the ones the fidelity dataset compares.
@@ -39,12 +41,40 @@ MAX_DESIGNS = 500
 FRACTIONS = (0.5, 1.0)
 
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
+#: What a verify run file holds: one number a pressure each.
+RUN_KEYS = ("bend_angle", "coarser_bend_angle", "discretisation_error")
 
 
 def fidelity_path(cube) -> Path:
     """The fidelity dataset of a cube: ``<stem>.fidelity.nc`` beside it."""
     cube = Path(cube)
     return cube.with_name(cube.stem + ".fidelity.nc")
+
+
+def fidelity_map_path(cube) -> Path:
+    """The fidelity map of a cube (``nylonflex verify`` draws it): ``<stem>.fidelity_map.png``
+    beside it."""
+    cube = Path(cube)
+    return cube.with_name(cube.stem + ".fidelity_map.png")
+
+
+def check_outputs(cube, overwrite: bool = False):
+    """Refuse, before any FE run, what verify would write over: a link, fifo, device or
+    folder at the fidelity dataset or its map (:func:`fidelity_path`,
+    :func:`fidelity_map_path`), and, unless ``overwrite``, a file there that nylonflex did
+    not write for this cube (the chart manifest beside it says which, as for charts:
+    :class:`~nylonflex.files.atomic.OwnedFiles`). Returns that manifest."""
+    from ..files.atomic import OwnedFiles, refuse_special
+
+    cube = Path(cube)
+    owned = OwnedFiles(cube.parent, str(cube.resolve()))
+    for path in (fidelity_path(cube), fidelity_map_path(cube)):
+        refuse_special(path, "verify", inputs=(cube,))
+        why = owned.foreign(path)
+        if why and not overwrite:
+            raise InputError(f"{why}; it is not replaced: move it away or give "
+                             "--overwrite")
+    return owned
 
 
 def open_fidelity(cube):
@@ -123,7 +153,7 @@ DEFAULT_MESH = "coarse"
 
 
 def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH, seed=0,
-               progress=None, log=None) -> Path:
+               progress=None, log=None, overwrite=False) -> Path:
     """Verify a cube against the FE twin; returns the fidelity dataset's path.
 
     Parameters
@@ -145,16 +175,20 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
         ``progress(done, total)`` after each FE run.
     log : callable, optional
         One-line messages (resumed runs).
+    overwrite : bool
+        Replace a fidelity dataset or map that nylonflex did not write for this cube
+        (:func:`check_outputs`; refused otherwise, before any FE run).
     """
     import xarray as xr
 
-    from ..files.atomic import replacing
     from ..engine import bend_angle
     from ..storage import open_cube
 
     if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
         raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
                          f"got {designs!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+        raise InputError(f"--seed: must be an integer in [0, 2^32), got {seed!r}")
     if not isinstance(workers, int) or not 1 <= workers <= 64:
         raise InputError(f"--workers: must be an integer in [1, 64], got {workers!r}")
     if mesh not in MESH_NAMES:
@@ -163,17 +197,24 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     cube = Path(cube)
     ds = open_cube(cube)
     try:
+        owned = check_outputs(cube, overwrite)
+    except BaseException:
+        ds.close()
+        raise
+    try:
         plan = _plan(ds, ds.attrs, designs, seed, mesh)
     finally:
         ds.close()
     parts = _parts(cube)
+
+    check_drive(parts, "pressure")
     tasks = [(d, plan["silicone"], mesh) for d in plan["designs"]]
-    done = journaled_runs(parts, plan, tasks, _solve, workers=workers, scheduler=scheduler,
-                          progress=progress, log=log, what="verify")
+    done = journaled_runs(parts, plan, tasks, _solve, keys=RUN_KEYS, workers=workers,
+                          scheduler=scheduler, progress=progress, log=log, what="verify")
     sil = plan["silicone"]
     total = len(plan["designs"])
     # the dataset: design x level (the fractions of p*)
-    n, m = total, len(FRACTIONS)
+    n = total
     rows = plan["designs"]
     coords = {"design": np.arange(n), "level": np.array(FRACTIONS)}
     data = {a: ("design", np.array([r[a] for r in rows])) for a in AXES}
@@ -218,9 +259,24 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
                       "fe_model": json.dumps(plan["fe_model"], sort_keys=True),
                       "Conventions": "CF-1.8"})
     path = fidelity_path(cube)
-    with replacing(path, what="verify", inputs=(cube,)) as tmp:
-        out.to_netcdf(tmp, engine="h5netcdf")
+    write_fidelity(out, path, inputs=(cube,))
+    owned.record([path])
     return path
+
+
+def write_fidelity(fid, path, inputs=()) -> Path:
+    """Write the fidelity dataset ``fid`` to ``path`` (netCDF-4): made whole in memory
+    (at most :data:`MAX_DESIGNS` designs, under a megabyte), then written through
+    :func:`~nylonflex.files.atomic.write_atomic`.
+
+    HDF5 never writes to the disk here: on a full disk h5netcdf's close failed partway and
+    HDF5 freed its ids a second time (a segfault, exit -11); a plain write fails with an
+    ``OSError`` instead, and ``path`` is left as it was.
+    """
+    from ..files.atomic import write_atomic
+
+    return write_atomic(path, bytes(fid.to_netcdf(engine="h5netcdf")), what="verify",
+                        inputs=inputs)
 
 
 def fidelity_stats(fid, level=None) -> list[dict]:

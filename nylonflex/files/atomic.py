@@ -16,16 +16,19 @@ material files, explorer pages, simulations, manifests) goes through this module
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
+import re
 import secrets
 import stat
 from pathlib import Path
 
 from ..units import InputError
 
-__all__ = ["OwnedFiles", "create_new", "fsync_dir", "publish", "refuse_link",
-           "refuse_special", "replacing", "save_figure", "write_atomic"]
+__all__ = ["OwnedFiles", "create_files", "create_new", "fsync_dir", "make_folder", "publish",
+           "read_bounded", "read_json", "refuse_link", "refuse_special", "replacing",
+           "save_figure", "write_atomic"]
 
 #: The flags of a file nylonflex creates: a new file, never through a link at its path.
 NEW_FILE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | \
@@ -143,6 +146,182 @@ def replacing(path, what: str = "--out", inputs=()):
     finally:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+
+
+#: OSError numbers that are no fault of the path the user gave (a full disk, an I/O
+#: error): they stay failures (exit 1) where every other error at a path is bad input.
+NOT_THE_PATH = (errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EINTR, errno.ENOMEM)
+
+
+def path_error(exc: OSError, path, what: str) -> Exception:
+    """``exc``, raised at ``path``, as the one line a user reads: an :class:`InputError`
+    naming ``what`` and the path (a file where a folder goes, a missing or unwritable
+    folder, ``/proc``), or ``exc`` itself for a full disk or an I/O error."""
+    if exc.errno in NOT_THE_PATH:
+        return exc
+    return InputError(f"{what}: {path}: {exc.strerror or exc}")
+
+
+def make_folder(folder, what: str) -> list[Path]:
+    """Make the folder ``folder`` and its missing parents; returns those it made (outermost
+    first). A file, a dangling link or anything but a folder at ``folder`` or a parent is
+    refused in one line (:func:`path_error`)."""
+    folder = Path(folder)
+    missing = []
+    for p in (folder, *folder.parents):
+        if os.path.isdir(p):
+            break
+        if os.path.lexists(p):
+            kind = "a dangling symbolic link" if os.path.islink(p) else "not a folder"
+            raise InputError(f"{what}: {p} is {kind}; give a folder")
+        missing.append(p)
+    made = []
+    for p in reversed(missing):
+        try:
+            p.mkdir()
+        except FileExistsError:
+            if not os.path.isdir(p):
+                raise InputError(f"{what}: {p} is not a folder; give a folder") from None
+            continue
+        except OSError as exc:
+            raise path_error(exc, p, what) from None
+        made.append(p)
+    return made
+
+
+def _link_new(tmp: Path, path: Path):
+    """Give the whole file ``tmp`` the name ``path`` unless something is there already
+    (``FileExistsError``): a hard link, or a rename after a check where the file system
+    has no hard links."""
+    try:
+        os.link(tmp, path, follow_symlinks=False)
+    except FileExistsError:
+        raise
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EMLINK):
+            raise
+        if os.path.lexists(path):
+            raise FileExistsError(errno.EEXIST, "File exists", str(path)) from None
+        os.rename(tmp, path)
+
+
+def create_files(contents: dict, what: str) -> list[Path]:
+    """Create every file of ``contents`` ({path: bytes}) whole, or none of them: each is
+    written into a new temporary beside it, fsynced, then given its name without replacing
+    anything (a file made meanwhile is refused, ``FileExistsError``). On any failure (a
+    full disk) the files and folders made so far are removed: no truncated file is left.
+    Returns the paths, in order."""
+    paths = [Path(p) for p in contents]
+    temps, made, folders = [], [], []
+    try:
+        for path in paths:
+            folders += make_folder(path.parent, what)
+            tmp, fd = _temporary(path)
+            temps.append(tmp)
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(contents[path])
+                fh.flush()
+                os.fsync(fh.fileno())
+        for path, tmp in zip(paths, temps):
+            _link_new(tmp, path)
+            made.append(path)
+        for folder in dict.fromkeys(p.parent for p in paths):
+            fsync_dir(folder)
+    except BaseException:
+        for path in made:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+        for tmp in temps:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        for folder in reversed(folders):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
+    for tmp in temps:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    return paths
+
+
+#: How a file nylonflex reads back is opened: never through a link, never waiting for a
+#: writer (a fifo opened for reading blocks until one comes: forever).
+READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0) | \
+    getattr(os, "O_CLOEXEC", 0)
+
+
+def read_bounded(path, what: str, max_bytes: int) -> bytes | None:
+    """The bytes of the regular file ``path`` (None when nothing is there), at most
+    ``max_bytes`` [B] of them.
+
+    Opened without following a link and without blocking, then checked on the open file:
+    a link, fifo, device, socket or folder is an :class:`InputError` naming ``what``,
+    before anything is read; a larger file is a ``ValueError`` (the caller decides whether
+    that is damage or bad input).
+    """
+    try:
+        fd = os.open(path, READ_FLAGS)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        if exc.errno == errno.ELOOP or os.path.islink(path):
+            raise _link_error(path, what) from None
+        raise path_error(exc, path, what) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise InputError(f"{what}: {path} is a folder, not a file nylonflex wrote")
+        if not stat.S_ISREG(st.st_mode):
+            raise InputError(f"{what}: {path} is a special file (device, fifo or socket); "
+                             "nylonflex reads back only regular files")
+        if st.st_size > max_bytes:
+            raise ValueError(f"{st.st_size:,} bytes, more than {max_bytes:,}")
+        chunks, left = [], max_bytes + 1
+        while left > 0:
+            block = os.read(fd, min(left, 1 << 20))
+            if not block:
+                break
+            chunks.append(block)
+            left -= len(block)
+        data = b"".join(chunks)
+        if len(data) > max_bytes:  # it grew meanwhile
+            raise ValueError(f"more than {max_bytes:,} bytes")
+        return data
+    finally:
+        os.close(fd)
+
+
+#: Nesting that a JSON file nylonflex writes never reaches (its run files: 4).
+JSON_DEPTH = 32
+
+
+def read_json(path, what: str, max_bytes: int = 1 << 20, max_depth: int = JSON_DEPTH):
+    """The JSON value of the file ``path`` (None when nothing is there).
+
+    Read by :func:`read_bounded` (links and special files: :class:`InputError`); text that
+    is larger than ``max_bytes``, not UTF-8, nested deeper than ``max_depth`` or not
+    JSON is a plain ``ValueError`` saying which, so a caller never meets a RecursionError.
+    """
+    import numpy as np
+
+    data = read_bounded(path, what, max_bytes)
+    if data is None:
+        return None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError("not UTF-8 text") from None
+    # nesting: brackets outside strings, counted at C speed
+    bare = re.sub(r'"(?:[^"\\]|\\.)*"', '""', text).encode()
+    arr = np.frombuffer(bare, dtype=np.uint8)
+    if arr.size:
+        step = np.isin(arr, (91, 123)).astype(np.int32) - np.isin(arr, (93, 125))
+        if int(np.cumsum(step).max()) > max_depth:
+            raise ValueError(f"nested deeper than {max_depth}")
+    try:
+        return json.loads(text)
+    except (ValueError, RecursionError) as exc:
+        raise ValueError(f"not JSON ({str(exc)[:80]})") from None
 
 
 def save_figure(fig, path, what: str = "--out", inputs=(), **kwargs) -> Path:

@@ -344,16 +344,23 @@ class CubeFile:
                                             self._compiled_shuffle)
 
     def abandon(self):
-        """Close after a failure (a full disk, an error) without raising.
+        """Close after a failure (a full disk, an error) without raising, and without
+        writing anything more to the disk.
 
         A failed run's file is never published (``--resume`` rebuilds it from the journal),
-        so its bytes are dropped first: HDF5's close then has room for what it still has to
-        write. A close that fails partway leaves HDF5 ids half closed, and freeing them
-        later crashed the process (a full 1 MB disk, about one run in six).
+        so its bytes are dropped and its descriptor is pointed at a memory file first
+        (:func:`_divert`): whatever HDF5 still flushes as it closes (chunk caches, metadata)
+        then cannot fail. A close that failed partway left HDF5 ids half closed, and a
+        second close freed them again: a segfault on a full disk (exit 139 when the disk
+        filled while the finished cube was being closed). A file whose close already
+        failed is therefore never closed again (:meth:`NetCDF4File.close`).
         """
         self._pool.shutdown(cancel_futures=True)
-        with contextlib.suppress(Exception):
-            os.ftruncate(self.f.h5.id.get_vfd_handle(), 0)
+        with contextlib.suppress(OSError):  # the descriptor read at open: no HDF5 call
+            os.ftruncate(self.f.fd, 0)
+            _divert(self.f.fd)  # what HDF5 still writes, now or at exit, goes to memory
+        if self.f.close_failed:
+            return  # its objects are parked: freeing them again is what crashed
         with contextlib.suppress(Exception):
             self.f.h5.close()
 
@@ -363,6 +370,19 @@ class CubeFile:
         if attrs:
             self.f.set_attrs(attrs)
         self.f.close()
+
+
+def _divert(fd: int):
+    """Point the descriptor ``fd`` at a new empty memory file (Linux ``memfd_create``):
+    writes to it then succeed whatever the disk, and the disk file's own blocks are freed
+    with its last descriptor. Does nothing where there is no memory file."""
+    if not hasattr(os, "memfd_create"):  # pragma: no cover - not Linux
+        return
+    mem = os.memfd_create("nylonflex-abandoned", getattr(os, "MFD_CLOEXEC", 0))
+    try:
+        os.dup2(mem, fd, inheritable=False)
+    finally:
+        os.close(mem)
 
 
 def encode_chunk(block, chunks, codec: Codec, compiled: bool = False):

@@ -74,6 +74,9 @@ class NetCDF4File:
         import h5py
 
         self.h5 = h5py.File(path, "w", track_order=True, locking=False)
+        self.close_failed = False
+        #: the file's descriptor (HDF5's sec2 driver), read once while every id is sound
+        self.fd = self.h5.id.get_vfd_handle()
         self.datasets: dict = {}
         self.dims: dict = {}
         self._dimid: dict = {}
@@ -132,11 +135,28 @@ class NetCDF4File:
         return ds
 
     def close(self):
-        """Write ``_NCProperties`` and close the file."""
+        """Write ``_NCProperties`` and close the file.
+
+        Everything is flushed first, while a failure (a full disk) leaves every HDF5 id
+        intact; a close that still fails partway sets :attr:`close_failed` and keeps the
+        file's Python objects alive for good (:data:`_PARKED`): HDF5 has freed some of
+        their ids already, and closing or freeing them again crashed the process.
+        """
         import h5py
 
         text = (f"version=2,nylonflex={__version__},hdf5={h5py.version.hdf5_version},"
                 f"h5py={h5py.__version__}")
         self.h5.attrs["_NCProperties"] = np.array(
             text, dtype=h5py.string_dtype(encoding="ascii", length=len(text)))
-        self.h5.close()
+        self.h5.flush()
+        try:
+            self.h5.close()
+        except BaseException:
+            self.close_failed = True
+            _PARKED.append(self)
+            raise
+
+
+#: Files whose close failed partway (a full disk): kept, never freed (see
+#: :meth:`NetCDF4File.close`).
+_PARKED: list = []

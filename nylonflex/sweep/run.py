@@ -258,8 +258,8 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
                                "compression": codec, **_versions(),
                                "replaces": bool(replaces)})
             _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor,
-                   progress, log, replaces, command)
-        except OSError as exc:
+                   progress, log, replaces=replaces, command=command)
+        except (OSError, RuntimeError) as exc:  # h5py's failed flush is a RuntimeError
             if not _disk_full(exc):
                 raise
             raise DiskFull(f"the disk of {out.parent} is full; this run needs up to "
@@ -271,7 +271,7 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
     return out
 
 
-def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log,
+def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log, *,
            replaces=False, command=None):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
