@@ -79,10 +79,32 @@ def test_progress_off_a_terminal_is_a_line_with_the_count_and_time(capsys):
             time.sleep(0.05)
     assert re.search(r"^nylonflex verify: 3 of 8 designs \(38 %\), \d+ s elapsed, "
                      r"about \d+ s left$", err, re.M), err
+    capsys.readouterr()  # a tick between the last read and the block's end
     with progress_bar("sweep", quiet=True, every=0.01) as bar:
         bar(1, 2)
         time.sleep(0.1)
     assert capsys.readouterr().err == ""  # --quiet: nothing
+
+
+def test_no_progress_line_comes_after_the_block_ends(capsys, monkeypatch):
+    # the timer is joined when the block ends: a line it is printing lands inside the
+    # block, and none after it (a stale line under the command's last output). A slow
+    # line() holds the timer mid-print while the block ends.
+    import time
+
+    from nylonflex.cli._common import progress_bar
+
+    def slow_line(self):
+        time.sleep(0.1)
+        return "tick"
+
+    monkeypatch.setattr(progress_bar, "line", slow_line)
+    with progress_bar("verify", unit="design", every=0.001) as bar:
+        bar(3, 8)
+        time.sleep(0.02)  # the timer is inside line() now
+    capsys.readouterr()
+    time.sleep(0.3)
+    assert capsys.readouterr().err == ""
 
 
 def test_the_control_chart_says_amplitude_not_span():

@@ -63,6 +63,7 @@ class progress_bar:
         self.done, self.total = 0, None
         self._bar = None
         self._stop = None
+        self._timer = None
 
     def __enter__(self):
         global ACTIVE
@@ -70,8 +71,9 @@ class progress_bar:
         self._start = time.monotonic()
         if not self.quiet:
             self._stop = threading.Event()
-            threading.Thread(target=self._tick, daemon=True,
-                             name=f"nylonflex-progress-{self.desc}").start()
+            self._timer = threading.Thread(target=self._tick, daemon=True,
+                                           name=f"nylonflex-progress-{self.desc}")
+            self._timer.start()
         return self
 
     def __call__(self, done, total=None):
@@ -129,6 +131,8 @@ class progress_bar:
         ACTIVE = self._previous
         if self._stop is not None:
             self._stop.set()
+            # a line the timer is printing lands before the block ends, never after it
+            self._timer.join(timeout=5.0)
         if self._bar is not None:
             self._bar.close()
             self._bar = None
