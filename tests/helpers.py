@@ -69,3 +69,26 @@ def tight_fit_file(folder, scale=0.01):
     path.write_text(yaml.safe_dump(doc, sort_keys=False))
     return path
 
+
+#: A sweep of 20 designs (5 radii, 2 walls, 2 coil indices): the CLI tests' config.
+TINY = {
+    "name": "tiny",
+    "grid": {
+        "radius": {"start": 5, "stop": 15, "num": 5, "units": "mm"},
+        "wall_thickness": {"values": [2, 4], "units": "mm"},
+        "length": {"values": [70], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"values": [8], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
+}
+
+
+def run(capsys, *argv):
+    """``nylonflex ARGV`` in this process: (exit status, stdout, stderr)."""
+    from nylonflex.cli import main
+
+    rc = main([*map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err

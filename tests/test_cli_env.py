@@ -9,28 +9,9 @@ import sys
 
 import h5py
 import pytest
-from helpers import write_config, write_cube
+from helpers import TINY, run, write_config, write_cube
 
-from nylonflex.cli import environment_problem, main
-
-TINY = {
-    "name": "tiny",
-    "grid": {
-        "radius": {"start": 5, "stop": 15, "num": 5, "units": "mm"},
-        "wall_thickness": {"values": [2, 4], "units": "mm"},
-        "length": {"values": [70], "units": "mm"},
-        "coil_index": {"values": [1.1, 1.7]},
-        "wrap_angle": {"values": [8], "units": "deg"},
-    },
-    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
-               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
-}
-
-
-def run(capsys, *argv):
-    rc = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return rc, out, err
+from nylonflex.cli import environment_problem
 
 
 @pytest.fixture(scope="module")

@@ -5,30 +5,10 @@ ones, ``list charts`` shows no reStructuredText, and ``list`` and ``info`` speak
 import json
 
 import pytest
-from helpers import write_cube
+from helpers import TINY, run, write_cube
 
-from nylonflex.cli import main
 from nylonflex.variables import MODELS, TRACKING
 from nylonflex.variants import VARIANTS
-
-TINY = {
-    "name": "tiny",
-    "grid": {
-        "radius": {"start": 5, "stop": 15, "num": 5, "units": "mm"},
-        "wall_thickness": {"values": [2, 4], "units": "mm"},
-        "length": {"values": [70], "units": "mm"},
-        "coil_index": {"values": [1.1, 1.7]},
-        "wrap_angle": {"values": [8], "units": "deg"},
-    },
-    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
-               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
-}
-
-
-def run(capsys, *argv):
-    rc = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return rc, out, err
 
 
 def test_every_model_variant_has_one_record():

@@ -7,36 +7,16 @@ import copy
 import math
 
 import pytest
-from helpers import write_config, write_cube
+from helpers import TINY, run, write_config, write_cube
 
-from nylonflex.cli import main
 from nylonflex.config import parse_config
 from nylonflex.units import InputError, plainly_degrees
-
-TINY = {
-    "name": "tiny",
-    "grid": {
-        "radius": {"start": 5, "stop": 15, "num": 5, "units": "mm"},
-        "wall_thickness": {"values": [2, 4], "units": "mm"},
-        "length": {"values": [70], "units": "mm"},
-        "coil_index": {"values": [1.1, 1.7]},
-        "wrap_angle": {"values": [8], "units": "deg"},
-    },
-    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
-               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
-}
 
 
 def with_axis(name, axis, where="grid"):
     raw = copy.deepcopy(TINY)
     raw[where][name] = axis
     return raw
-
-
-def run(capsys, *argv):
-    rc = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return rc, out, err
 
 
 def test_bare_radians_for_a_wrap_angle_are_refused_naming_the_slip():

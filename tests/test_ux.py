@@ -2,29 +2,10 @@
 
 import pytest
 import yaml
-from helpers import write_cube  # noqa: F401
+from helpers import TINY, run, write_cube  # noqa: F401
 
 from nylonflex.cli import main
 from nylonflex.config import parse_config
-
-TINY = {
-    "name": "tiny",
-    "grid": {
-        "radius": {"start": 5, "stop": 15, "num": 5, "units": "mm"},
-        "wall_thickness": {"values": [2, 4], "units": "mm"},
-        "length": {"values": [70], "units": "mm"},
-        "coil_index": {"values": [1.1, 1.7]},
-        "wrap_angle": {"values": [8], "units": "deg"},
-    },
-    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
-               "pressure": {"start": 0, "stop": 30, "num": 6, "units": "kPa"}},
-}
-
-
-def run(capsys, *argv):
-    rc = main([*map(str, argv)])
-    out, err = capsys.readouterr()
-    return rc, out, err
 
 
 def test_dry_run_prints_size_memory_time_and_writes_nothing(tmp_path, capsys):
