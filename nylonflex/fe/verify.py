@@ -22,7 +22,7 @@ from . import MESH_NAMES, fe_bend, require_felupe
 from .calibrate import extrapolated
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 
-__all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_outputs",
+__all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_arguments", "check_outputs",
            "fidelity_map_path", "fidelity_path",
            "fidelity_stats", "fidelity_summary", "open_fidelity", "run_verify", "sample_designs",
            "write_fidelity"]
@@ -152,6 +152,20 @@ def _solve(task):
 DEFAULT_MESH = "coarse"
 
 
+def check_arguments(designs, seed, workers, mesh):
+    """Refuse, in one line naming the flag, a verify's ``--designs``, ``--seed``,
+    ``--workers`` or ``--mesh`` outside its range (both drives)."""
+    if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
+        raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
+                         f"got {designs!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+        raise InputError(f"--seed: must be an integer in [0, 2^32), got {seed!r}")
+    if not isinstance(workers, int) or not 1 <= workers <= 64:
+        raise InputError(f"--workers: must be an integer in [1, 64], got {workers!r}")
+    if mesh not in MESH_NAMES:
+        raise InputError(f"--mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+
+
 def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH, seed=0,
                progress=None, log=None, overwrite=False) -> Path:
     """Verify a cube against the FE twin; returns the fidelity dataset's path.
@@ -184,15 +198,7 @@ def run_verify(cube, designs=24, *, workers=1, scheduler=None, mesh=DEFAULT_MESH
     from ..engine import bend_angle
     from ..storage import open_cube
 
-    if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
-        raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
-                         f"got {designs!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
-        raise InputError(f"--seed: must be an integer in [0, 2^32), got {seed!r}")
-    if not isinstance(workers, int) or not 1 <= workers <= 64:
-        raise InputError(f"--workers: must be an integer in [1, 64], got {workers!r}")
-    if mesh not in MESH_NAMES:
-        raise InputError(f"--mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    check_arguments(designs, seed, workers, mesh)
     require_felupe()
     cube = Path(cube)
     ds = open_cube(cube)

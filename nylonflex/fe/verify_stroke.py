@@ -22,9 +22,9 @@ import numpy as np
 
 from .. import __version__
 from ..units import InputError
-from . import MESH_NAMES, fe_stroke, require_felupe
+from . import fe_stroke, require_felupe
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
-from .verify import AXES, MAX_DESIGNS, sample_designs, write_fidelity
+from .verify import AXES, check_arguments, sample_designs, write_fidelity
 
 __all__ = ["DRIVES", "STROKE_RATIOS", "check_stroke_outputs", "model_values",
            "open_stroke_fidelity", "run_verify_stroke", "stroke_dataset", "stroke_map_path",
@@ -146,15 +146,7 @@ def run_verify_stroke(cube, designs=24, *, blocked=False, workers=1, scheduler=N
     in the dataset.
     """
 
-    if not isinstance(designs, int) or not 1 <= designs <= MAX_DESIGNS:
-        raise InputError(f"--designs: must be an integer in [1, {MAX_DESIGNS}], "
-                         f"got {designs!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
-        raise InputError(f"--seed: must be an integer in [0, 2^32), got {seed!r}")
-    if not isinstance(workers, int) or not 1 <= workers <= 64:
-        raise InputError(f"--workers: must be an integer in [1, 64], got {workers!r}")
-    if mesh not in MESH_NAMES:
-        raise InputError(f"--mesh: must be one of {', '.join(MESH_NAMES)}, got {mesh!r}")
+    check_arguments(designs, seed, workers, mesh)
     require_felupe()
     from ..storage import open_cube
 
