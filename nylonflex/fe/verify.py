@@ -58,17 +58,18 @@ def fidelity_map_path(cube) -> Path:
     return cube.with_name(cube.stem + ".fidelity_map.png")
 
 
-def check_outputs(cube, overwrite: bool = False):
+def check_outputs(cube, overwrite: bool = False, paths=None):
     """Refuse, before any FE run, what verify would write over: a link, fifo, device or
-    folder at the fidelity dataset or its map (:func:`fidelity_path`,
-    :func:`fidelity_map_path`), and, unless ``overwrite``, a file there that nylonflex did
-    not write for this cube (the chart manifest beside it says which, as for charts:
-    :class:`~nylonflex.files.atomic.OwnedFiles`). Returns that manifest."""
+    folder at the fidelity dataset or its map (``paths``; by default the pressure drive's,
+    :func:`fidelity_path` and :func:`fidelity_map_path`), and, unless ``overwrite``, a file
+    there that nylonflex did not write for this cube (the chart manifest beside it says
+    which, as for charts: :class:`~nylonflex.files.atomic.OwnedFiles`). Returns that
+    manifest."""
     from ..files.atomic import OwnedFiles, refuse_special
 
     cube = Path(cube)
     owned = OwnedFiles(cube.parent, str(cube.resolve()))
-    for path in (fidelity_path(cube), fidelity_map_path(cube)):
+    for path in paths or (fidelity_path(cube), fidelity_map_path(cube)):
         refuse_special(path, "verify", inputs=(cube,))
         why = owned.foreign(path)
         if why and not overwrite:

@@ -21,10 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..units import InputError
 from . import fe_stroke, require_felupe
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
-from .verify import AXES, check_arguments, sample_designs, write_fidelity
+from .verify import AXES, check_arguments, check_outputs, sample_designs, write_fidelity
 
 __all__ = ["DRIVES", "STROKE_RATIOS", "check_stroke_outputs", "model_values",
            "open_stroke_fidelity", "run_verify_stroke", "stroke_dataset", "stroke_map_path",
@@ -78,17 +77,7 @@ def open_stroke_fidelity(cube):
 
 def check_stroke_outputs(cube, overwrite=False):
     """:func:`.verify.check_outputs` for the stroke drive's dataset and map."""
-    from ..files.atomic import OwnedFiles, refuse_special
-
-    cube = Path(cube)
-    owned = OwnedFiles(cube.parent, str(cube.resolve()))
-    for path in (stroke_path(cube), stroke_map_path(cube)):
-        refuse_special(path, "verify", inputs=(cube,))
-        why = owned.foreign(path)
-        if why and not overwrite:
-            raise InputError(f"verify: {why}; it is not replaced: move it away or give "
-                             "--overwrite")
-    return owned
+    return check_outputs(cube, overwrite, (stroke_path(cube), stroke_map_path(cube)))
 
 
 def _settings(attrs):
