@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import InputError
-from .stroke import air_heating_ratio, check_strokes
+from .stroke import air_heating_ratio, check_strokes, load_list
 
 __all__ = ["FE_RANGES", "MESH_NAMES", "fe_bend", "fe_stroke", "require_felupe"]
 
@@ -63,14 +63,7 @@ def _design(radius, wall_thickness, length, base_thickness):
 
 
 def _pressures(pressures):
-    try:
-        p = np.atleast_1d(np.asarray(pressures, dtype=float))
-    except (TypeError, ValueError):
-        raise InputError("pressures: must be numbers [Pa]") from None
-    if p.ndim != 1 or p.size == 0:
-        raise InputError("pressures: need at least one pressure [Pa]")
-    if p.size > MAX_PRESSURES:
-        raise InputError(f"pressures: at most {MAX_PRESSURES}, got {p.size}")
+    p = load_list(pressures, "pressures", "pressure", "Pa", MAX_PRESSURES)
     if not np.all(np.isfinite(p)) or np.any(p < 0) or np.any(p > MAX_PRESSURE):
         bad = p[~(np.isfinite(p) & (p >= 0) & (p <= MAX_PRESSURE))][0]
         raise InputError(f"pressures: each must be in [0, {MAX_PRESSURE:g}] Pa, got {bad:g}")
@@ -90,6 +83,26 @@ def _silicone(silicone):
         return silicone_parameters(silicone)
     except ValueError as exc:
         raise InputError(str(exc)) from None
+
+
+#: The share of a two-mesh solve's work that the asked-for mesh takes (the rest: the
+#: coarser mesh of the error estimate), for its progress report.
+SHARE = 0.75
+
+
+def _reporter(progress, loads):
+    """``report(offset, weight)``: a solve's callback ``call(load, angle, iterations)``
+    that tells ``progress(done, 1.0)`` the share done, ``offset + weight * load / top``
+    over the loads (pressures [Pa] or strokes [-]) asked for."""
+    top = float(loads.max()) if loads.max() > 0 else 1.0
+
+    def report(offset, weight):
+        def call(load, angle, iterations):
+            if progress is not None:
+                progress(offset + weight * load / top, 1.0)
+        return call
+
+    return report
 
 
 def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
@@ -144,14 +157,7 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
     sil = _silicone(silicone)
     require_felupe()
     mu, alpha = sil.arrays()
-    span = float(p.max()) if p.max() > 0 else 1.0
-    share = 0.75  # of the work: the asked-for mesh; the rest the coarser one
-
-    def report(offset, weight):
-        def call(pressure, angle, iterations):
-            if progress is not None:
-                progress(offset + weight * pressure / span, 1.0)
-        return call
+    report = _reporter(progress, p)
 
     if blocked:
         from .solve import solve_pressures
@@ -159,17 +165,17 @@ def fe_bend(radius, wall_thickness, length, pressures, *, base_thickness=None,
         fine, coarse = (solve_pressures(body_mesh(a, t, L, base_thickness=b, mesh=level), mu,
                                         alpha, p, progress=report(*part), partial=True,
                                         blocked=True)
-                        for level, part in ((mesh, (0.0, share)),
-                                            (_COARSER[mesh], (share, 1.0 - share))))
+                        for level, part in ((mesh, (0.0, SHARE)),
+                                            (_COARSER[mesh], (SHARE, 1.0 - SHARE))))
         return {"pressure": p, "bend_angle": fine["bend_angle"],
                 "tip_moment": fine["tip_moment"], "tip_force": fine["tip_moment"] / L,
                 "discretisation_error": richardson(fine["tip_moment"], coarse["tip_moment"]),
                 "mesh": mesh, "coarser_bend_angle": coarse["bend_angle"],
                 "coarser_tip_moment": coarse["tip_moment"]}
     angles = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=mesh), mu, alpha, p,
-                        progress=report(0.0, share), partial=True)
+                        progress=report(0.0, SHARE), partial=True)
     coarser = solve_bend(body_mesh(a, t, L, base_thickness=b, mesh=_COARSER[mesh]), mu,
-                         alpha, p, progress=report(share, 1.0 - share), partial=True)
+                         alpha, p, progress=report(SHARE, 1.0 - SHARE), partial=True)
     return {"pressure": p, "bend_angle": angles,
             "discretisation_error": richardson(angles, coarser), "mesh": mesh,
             "coarser_bend_angle": coarser}
@@ -248,20 +254,13 @@ def fe_stroke(radius, wall_thickness, length, strokes, *, base_thickness=None,
     sil = _silicone(silicone)
     require_felupe()
     mu, alpha = sil.arrays()
-    span = float(s.max()) if s.max() > 0 else 1.0
-    share = 0.75  # of the work: the asked-for mesh; the rest the coarser one
-
-    def report(offset, weight):
-        def call(stroke, angle, iterations):
-            if progress is not None:
-                progress(offset + weight * stroke / span, 1.0)
-        return call
+    report = _reporter(progress, s)
 
     fine, coarse = (solve_stroke(body_mesh(a, t, L, base_thickness=b, mesh=level), mu, alpha,
                                  s, p_atm=P_ATM, heating=heating, blocked=bool(blocked),
                                  progress=report(*part), partial=True)
-                    for level, part in ((mesh, (0.0, share)),
-                                        (_COARSER[mesh], (share, 1.0 - share))))
+                    for level, part in ((mesh, (0.0, SHARE)),
+                                        (_COARSER[mesh], (SHARE, 1.0 - SHARE))))
     main = "tip_moment" if blocked else "bend_angle"
     err = np.fmax(richardson(fine["pressure"], coarse["pressure"]),
                   richardson(fine[main], coarse[main]))

@@ -13,7 +13,8 @@ import numpy as np
 
 from ..units import InputError
 
-__all__ = ["MAX_AIR_HEATING", "MAX_STROKE", "MAX_STROKES", "air_heating_ratio", "check_strokes"]
+__all__ = ["MAX_AIR_HEATING", "MAX_STROKE", "MAX_STROKES", "air_heating_ratio", "check_strokes",
+           "load_list"]
 
 #: At most this many strokes, each in [0, MAX_STROKE) [-].
 MAX_STROKES = 100
@@ -22,16 +23,24 @@ MAX_STROKE = 0.5
 MAX_AIR_HEATING = 200.0
 
 
+def load_list(values, field: str, noun: str, unit: str, most: int):
+    """``values`` as a 1-D float array of 1 to ``most`` entries, or :class:`InputError`
+    naming ``field`` (the FE twin's pressures [Pa] or strokes [-]; their ranges are the
+    caller's)."""
+    try:
+        out = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"{field}: must be numbers [{unit}]") from None
+    if out.ndim != 1 or out.size == 0:
+        raise InputError(f"{field}: need at least one {noun} [{unit}]")
+    if out.size > most:
+        raise InputError(f"{field}: at most {most}, got {out.size}")
+    return out
+
+
 def check_strokes(strokes):
     """``strokes`` as an array [-], or :class:`InputError`."""
-    try:
-        s = np.atleast_1d(np.asarray(strokes, dtype=float))
-    except (TypeError, ValueError):
-        raise InputError("strokes: must be numbers [-]") from None
-    if s.ndim != 1 or s.size == 0:
-        raise InputError("strokes: need at least one stroke [-]")
-    if s.size > MAX_STROKES:
-        raise InputError(f"strokes: at most {MAX_STROKES}, got {s.size}")
+    s = load_list(strokes, "strokes", "stroke", "-", MAX_STROKES)
     ok = np.isfinite(s) & (s >= 0) & (s < MAX_STROKE)
     if not np.all(ok):
         raise InputError(f"strokes: each must be in [0, {MAX_STROKE:g}) [-], got {s[~ok][0]:g}")
