@@ -154,12 +154,17 @@ def test_blocked_moment_of_the_caps_pressure_is_eq_16(a, t, L):
 def test_fe_stroke_returns_both_meshes_and_the_blocked_force():
     out = fe_stroke(7.5e-3, 2e-3, 70e-3, [0.0, 0.03], mesh="coarse", blocked=True)
     for name in ("stroke", "pressure", "volume_ratio", "bend_angle", "tip_moment",
-                 "tip_force", "discretisation_error", "coarser_pressure",
+                 "tip_force", "discretisation_error", "pressure_error", "coarser_pressure",
                  "coarser_tip_moment"):
         assert np.shape(out[name]) == (2,), name
     assert out["pressure"][0] == 0 and out["tip_force"][0] == pytest.approx(0, abs=1e-12)
     assert out["tip_force"][1] == pytest.approx(out["tip_moment"][1] / 70e-3, rel=1e-14)
     assert out["tip_force"][1] > 0 and 0 < out["discretisation_error"][1] < 0.2
+    # the pressure's estimate: first order with Roache's safety factor 3, 3 / (1.5 - 1) = 6
+    # times the relative gap between the two meshes
+    gap = abs(out["pressure"][1] / out["coarser_pressure"][1] - 1) * out["coarser_pressure"][1] \
+        / out["pressure"][1]
+    assert out["pressure_error"][1] == pytest.approx(6 * gap, rel=1e-12)
 
 
 @pytest.mark.parametrize("kw, match", [

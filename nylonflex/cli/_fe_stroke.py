@@ -34,18 +34,19 @@ def run_stroke(args, design, silicone, strokes, air_heating) -> int:
                "blocked": bool(args.blocked), "air_heating": res["air_heating"],
                **{n: res[n].tolist() for n in names},
                "discretisation_error": res["discretisation_error"].tolist(),
+               "pressure_error": res["pressure_error"].tolist(),
                "eq8_pressure": eq8.tolist(),
                "units": {"design": "m", "air_heating": "K", "stroke": "1", "pressure": "Pa",
                          "volume_ratio": "1", "bend_angle": "rad", "tip_moment": "N m",
                          "tip_force": "N", "discretisation_error": "1",
-                         "eq8_pressure": "Pa"}}
+                         "pressure_error": "1", "eq8_pressure": "Pa"}}
         sys.stdout.write(json_text(out))
         return 0
     heat = f", air +{res['air_heating']:g} K" if res["air_heating"] else ""
     held = ", tip held straight" if args.blocked else ""
     print(f"FE twin driven as built (sealed chamber{heat}{held}), mesh {args.mesh}")
-    head = f"{'stroke':>7} {'p':>8} {'p eq.8':>8} {'V/V0':>7}"
-    unit = f"{'[-]':>7} {'[kPa]':>8} {'[kPa]':>8} {'[-]':>7}"
+    head = f"{'stroke':>7} {'p':>8} {'p err':>6} {'p eq.8':>8} {'V/V0':>7}"
+    unit = f"{'[-]':>7} {'[kPa]':>8} {'[%]':>6} {'[kPa]':>8} {'[-]':>7}"
     if args.blocked:  # the bend of a body held at both ends is no result: not shown
         head += f" {'moment':>9} {'force':>7}"
         unit += f" {'[N mm]':>9} {'[N]':>7}"
@@ -55,7 +56,8 @@ def run_stroke(args, design, silicone, strokes, air_heating) -> int:
     print(head + f" {'error':>6}")
     print(unit + f" {'[%]':>6}")
     for i, s in enumerate(res["stroke"]):
-        row = (f"{s:7.4f} {_cell(res['pressure'][i] / 1e3, '.3f', 8)} {eq8[i] / 1e3:8.3f} "
+        row = (f"{s:7.4f} {_cell(res['pressure'][i] / 1e3, '.3f', 8)} "
+               f"{_cell(100 * res['pressure_error'][i], '.1f', 6)} {eq8[i] / 1e3:8.3f} "
                f"{_cell(res['volume_ratio'][i], '.4f', 7)}")
         if not args.blocked:
             row += f" {_cell(np.degrees(res['bend_angle'][i]), '.2f', 7)}"
@@ -63,6 +65,9 @@ def run_stroke(args, design, silicone, strokes, air_heating) -> int:
             row += (f" {_cell(res['tip_moment'][i] * 1e3, '.2f', 9)}"
                     f" {_cell(res['tip_force'][i], '.4f', 7)}")
         print(row + f" {_cell(100 * res['discretisation_error'][i], '.2f', 6)}")
+    main = "moment" if args.blocked else "bend"
+    print(f"error: the {main}'s Richardson estimate against the next coarser mesh; p err the "
+          "pressure's (first order, safety factor 3)")
     if not np.all(np.isfinite(res["pressure"])):
         print("-: not reached: the FE solve stalled (docs/fidelity.md)")
     sys.stdout.flush()
