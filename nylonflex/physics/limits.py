@@ -22,7 +22,7 @@ from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
-from .records import CoilRow, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
+from .records import CoilRow, Drive, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
 from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
     _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
@@ -317,16 +317,15 @@ def _curve_squeeze(model, pressure, section, ogden, table, p_atm, chamber):
 
 
 @formula
-def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coil, shape,
-                  ogden, nodes, p_atm, chamber):
+def _design_state(model, drive, section, lever, coil, shape, ogden, nodes, p_atm, chamber):
     """The stroke state of one design in any model, with or without a supply.
 
-    ``voltage`` the supply [V] (<= 0: none), ``section`` a :class:`~.records.Section`,
-    ``length`` L [m], ``wrap_angle`` psi [rad], ``pitch`` of the wrap and ``lever`` pitch
-    over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of its coil index, ``shape``
-    the muscle's :class:`~.records.StrokeShape`, ``ogden`` the silicone's
-    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
-    the initial chamber pressure [Pa], ``chamber`` the
+    ``drive`` the supply V [V] (<= 0: none), length L [m], wrap angle psi [rad] and wrap
+    pitch [m] (a :class:`~.records.Drive`), ``section`` a :class:`~.records.Section`,
+    ``lever`` the wrap's pitch over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of
+    its coil index, ``shape`` the muscle's :class:`~.records.StrokeShape`, ``ogden`` the
+    silicone's :class:`~.records.Ogden`, ``nodes`` the quadrature's
+    :class:`~.records.Nodes`, ``p_atm`` the initial chamber pressure [Pa], ``chamber`` the
     :class:`~.records.SealedCoefficients` (``sealed_chamber``).
 
     Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
@@ -336,14 +335,13 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     """
     y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
                                    nodes.w_base, nodes.phi_trig, nodes.w_phi)
-    return _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                               shape, ogden, nodes, NodeTable(y, wy, wyy, work), p_atm,
-                               chamber)
+    return _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes,
+                               NodeTable(y, wy, wyy, work), p_atm, chamber)
 
 
 @formula
-def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                        shape, ogden, nodes, table, p_atm, chamber):
+def _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes, table, p_atm,
+                        chamber):
     """:func:`_design_state` in a node table and scratch ``table`` (a
     :class:`~.records.NodeTable` of :func:`~.bending._node_count` nodes, overwritten: the
     section's nodes from the quadrature's ``nodes``), which it makes no array for: what the
@@ -352,14 +350,14 @@ def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, leve
     _section_nodes(section.radius, section.wall, section.base, nodes.x_base, nodes.w_base,
                    nodes.phi_trig, nodes.w_phi, y, wy, wyy)
     unsolved = SolvedCurve(y, y, y, y)
-    if model == PAPER and voltage <= 0.0:
+    if model == PAPER and drive.voltage <= 0.0:
         st = _stroke_state_nodes(section, lever, coil, 0.0, ogden, table, p_atm, unsolved, 0)
         return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, shape.t_max
-    t_reach, s_free, limited = _reach(coil, length, pitch, section, wrap_angle, voltage, shape)
+    t_reach, s_free, limited = _reach(coil, drive, section, shape)
     ms = _model_state_nodes(model, section, lever, coil, s_free,
                             coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, table,
                             p_atm, chamber, unsolved, 0)
-    lf = _length_factor(model, section.radius, length)
+    lf = _length_factor(model, section.radius, drive.length)
     return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
 
 
@@ -394,18 +392,18 @@ def _nylon_pressure(model, stroke, p_atm, solid, radius, wall_thickness, mu, alp
 
 
 @formula
-def _reach(coil, length, pitch, section, wrap_angle, voltage, shape):
+def _reach(coil, drive, section, shape):
     """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
 
-    ``coil`` a :class:`~.records.CoilRow`, ``length`` L and ``pitch`` [m], ``section`` a
-    :class:`~.records.Section`, ``wrap_angle`` psi [rad], ``voltage`` the supply [V],
-    ``shape`` the :class:`~.records.StrokeShape`. ``voltage`` <= 0: no supply, T_max and
-    s_max itself (docs/model.md s. 15).
+    ``coil`` a :class:`~.records.CoilRow`, ``drive`` the supply V [V], length L [m], wrap
+    angle psi [rad] and pitch [m] (a :class:`~.records.Drive`), ``section`` a
+    :class:`~.records.Section`, ``shape`` the :class:`~.records.StrokeShape`. V <= 0: no
+    supply, T_max and s_max itself (docs/model.md s. 15).
     """
-    if voltage > 0.0:
-        l_m = _muscle_length(length, pitch, section.radius, section.wall, section.base,
-                             wrap_angle)
-        t_ss = _steady_temperature(voltage, l_m, shape.t_amb, coil.r_per_len,
+    if drive.voltage > 0.0:
+        l_m = _muscle_length(drive.length, drive.pitch, section.radius, section.wall,
+                             section.base, drive.wrap_angle)
+        t_ss = _steady_temperature(drive.voltage, l_m, shape.t_amb, coil.r_per_len,
                                    coil.loss_per_len)
         if t_ss < shape.t_max:
             return t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma, shape.beta,
@@ -729,8 +727,8 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         section = Section(ai, ti, bi)
         coil = CoilRow(force_limit, s_max, s_max / top, r_per_len,
                        ny.heat_capacity_per_length, loss_per_len, ny.thermal_force_coefficient)
-        *state, closes, t_reach = _design_state(code, voltage, section, Li, pi, pitch, lever,
-                                                coil, shape, ogden, nodes, P_ATM, coef)
+        *state, closes, t_reach = _design_state(code, Drive(voltage, Li, pi, pitch), section,
+                                                lever, coil, shape, ogden, nodes, P_ATM, coef)
         values = _design_values(*state, force_limit, Li)
         temps = _working_temperatures(code, values[0], t_reach, coil.scale, shape)
         thermal = _thermal_values(Li, pitch, section, pi, voltage, temps, shape.t_amb, coil)

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilRow", "NodeTable", "Nodes", "Ogden", "SealedCoefficients", "Section",
-           "SolvedCurve", "StrokeShape"]
+__all__ = ["CoilRow", "Drive", "NodeTable", "Nodes", "Ogden", "SealedCoefficients",
+           "Section", "SolvedCurve", "StrokeShape"]
 
 #: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
 #: (bottom layer) thickness b [m] (docs/model.md s. 1).
@@ -58,3 +58,9 @@ SolvedCurve = namedtuple("SolvedCurve", "pressure kappa rate rate2")
 #: ``c1`` and the blocked moment's ``cb``. Every formula takes it (the shipped one, or a
 #: sweep's ``chamber:``); the others' variants ignore it.
 SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb")
+
+#: The supply and the muscle it heats (:func:`~.limits._reach`): the supply ``voltage`` V
+#: [V] (<= 0: none), the actuator's ``length`` L [m], the wrap angle ``wrap_angle`` psi
+#: [rad] and the wrap's ``pitch`` [m], which set the muscle's length l_m and so its steady
+#: temperature at V (docs/model.md s. 9, 15).
+Drive = namedtuple("Drive", "voltage length wrap_angle pitch")
