@@ -198,16 +198,14 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                 cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                 for il in range(nl):
                     if not _PAPER_ONLY and not default and (il == 0 or voltage > 0.0):
-                        t_reach, s_free, limited = _reach(
-                            coil_row, Drive(voltage, length[il], wrap[ip], pitch), section,
-                            shape)
-                        ms = _model_state_nodes(
-                            model, section, lever, coil_row, s_free,
-                            force_coeff * (t_reach - t_amb), limited, ogden, table, p_atm,
-                            chamber, curve, npr)
+                        reach = _reach(coil_row, Drive(voltage, length[il], wrap[ip], pitch),
+                                       section, shape)
+                        ms = _model_state_nodes(model, section, lever, coil_row, reach, ogden,
+                                                table, p_atm, chamber, curve, npr)
                         st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
                         closes = ms[7]
-                        temps = _working_temperatures(model, ms[0], t_reach, scale, shape)
+                        temps = _working_temperatures(model, ms[0], reach.temperature, scale,
+                                                      shape)
                         cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free

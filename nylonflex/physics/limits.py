@@ -22,7 +22,8 @@ from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
-from .records import CoilRow, Drive, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
+from .records import (CoilRow, Drive, NodeTable, Nodes, Ogden, Reach, Section, SolvedCurve,
+                      StrokeShape)
 from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
     _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
@@ -203,8 +204,8 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
 
 
 @formula
-def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
-                       ogden, table, p_atm, chamber, curve, n):
+def _model_state_nodes(model, section, lever, coil, reach, ogden, table, p_atm, chamber, curve,
+                       n):
     """The length-free design limits of a model variant, with a reachable free stroke.
 
     ``section`` a :class:`~.records.Section`, ``lever`` the wrap's pitch over cos psi [m],
@@ -212,9 +213,10 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     :class:`~.records.Ogden`, ``table`` the section's node table and scratch (a
     :class:`~.records.NodeTable`, :func:`~.bending._section_nodes`), ``p_atm`` the initial
     chamber pressure [Pa], ``chamber`` the :class:`~.records.SealedCoefficients`
-    (``sealed_chamber``). ``s_free`` is the free stroke at the reachable temperature (s_max
-    without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that temperature
-    (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle below
+    (``sealed_chamber``). ``reach`` is the muscle at its reachable temperature (a
+    :class:`~.records.Reach`, :func:`_reach`): its free stroke ``s_free`` [-] (s_max
+    without a supply), blocked force ``force_blocked`` F_b = c (T - T_amb) [N]
+    (``coupled_muscle``) and ``limited``, whether the supply keeps the muscle below
     T_max. ``n`` solved points of the model's kappa(p) in ``curve`` (a
     :class:`~.records.SolvedCurve`) start the curvature solves (:func:`_stroke_state_nodes`;
     none: ``n`` = 0, the full-stroke solve from its own start and the strength-limited one
@@ -230,6 +232,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     mu, alpha = ogden.mu, ogden.alpha
     y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
     pressures, kappas, rates, rates2 = curve.pressure, curve.kappa, curve.rate, curve.rate2
+    s_free, force_blocked, supply_limited = reach.s_free, reach.force_blocked, reach.limited
     cauchy = model == CAUCHY_MOMENT
     solid = 0.0
     closes = False
@@ -353,12 +356,11 @@ def _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes,
     if model == PAPER and drive.voltage <= 0.0:
         st = _stroke_state_nodes(section, lever, coil, 0.0, ogden, table, p_atm, unsolved, 0)
         return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, shape.t_max
-    t_reach, s_free, limited = _reach(coil, drive, section, shape)
-    ms = _model_state_nodes(model, section, lever, coil, s_free,
-                            coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, table,
-                            p_atm, chamber, unsolved, 0)
+    reach = _reach(coil, drive, section, shape)
+    ms = _model_state_nodes(model, section, lever, coil, reach, ogden, table, p_atm, chamber,
+                            unsolved, 0)
     lf = _length_factor(model, section.radius, drive.length)
-    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
+    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], reach.temperature
 
 
 @formula
@@ -393,12 +395,14 @@ def _nylon_pressure(model, stroke, p_atm, solid, radius, wall_thickness, mu, alp
 
 @formula
 def _reach(coil, drive, section, shape):
-    """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
+    """The muscle at its reachable temperature min(T_max, T_ss), a :class:`~.records.Reach`:
+    the temperature [K], its free stroke [-], the blocked force c (T - T_amb) [N] there,
+    and whether the supply limits it.
 
     ``coil`` a :class:`~.records.CoilRow`, ``drive`` the supply V [V], length L [m], wrap
     angle psi [rad] and pitch [m] (a :class:`~.records.Drive`), ``section`` a
     :class:`~.records.Section`, ``shape`` the :class:`~.records.StrokeShape`. V <= 0: no
-    supply, T_max and s_max itself (docs/model.md s. 15).
+    supply, T_max and s_max itself (docs/model.md s. 15, 16).
     """
     if drive.voltage > 0.0:
         l_m = _muscle_length(drive.length, drive.pitch, section.radius, section.wall,
@@ -406,9 +410,10 @@ def _reach(coil, drive, section, shape):
         t_ss = _steady_temperature(drive.voltage, l_m, shape.t_amb, coil.r_per_len,
                                    coil.loss_per_len)
         if t_ss < shape.t_max:
-            return t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma, shape.beta,
-                                      shape.t_g, shape.sigma_g), True
-    return shape.t_max, coil.s_max, False
+            return Reach(t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma,
+                                            shape.beta, shape.t_g, shape.sigma_g),
+                         coil.force_coeff * (t_ss - shape.t_amb), True)
+    return Reach(shape.t_max, coil.s_max, coil.force_coeff * (shape.t_max - shape.t_amb), False)
 
 
 @formula

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilRow", "Drive", "NodeTable", "Nodes", "Ogden", "SealedCoefficients",
-           "Section", "SolvedCurve", "StrokeShape"]
+__all__ = ["CoilRow", "Drive", "NodeTable", "Nodes", "Ogden", "Reach",
+           "SealedCoefficients", "Section", "SolvedCurve", "StrokeShape"]
 
 #: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
 #: (bottom layer) thickness b [m] (docs/model.md s. 1).
@@ -64,3 +64,9 @@ SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb")
 #: [rad] and the wrap's ``pitch`` [m], which set the muscle's length l_m and so its steady
 #: temperature at V (docs/model.md s. 9, 15).
 Drive = namedtuple("Drive", "voltage length wrap_angle pitch")
+
+#: The muscle at its reachable temperature min(T_max, T_ss) (:func:`~.limits._reach`):
+#: ``temperature`` [K], its free stroke ``s_free`` [-], the blocked force
+#: ``force_blocked`` F_b = c (T - T_amb) [N] (``coupled_muscle``) and ``limited``, whether
+#: the supply keeps the muscle below T_max (docs/model.md s. 15, 16).
+Reach = namedtuple("Reach", "temperature s_free force_blocked limited")
