@@ -38,8 +38,8 @@ from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_E
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
                               _validity, _working_temperatures)
 from ..physics.nylon import _stroke_shape
-from ..physics.records import (CoilRow, Drive, NodeTable, Ogden, Section, SolvedCurve,
-                                StrokeShape)
+from ..physics.records import (CoilRow, Cycle, Drive, NodeTable, Ogden, Section,
+                                SolvedCurve, StrokeShape)
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
@@ -238,9 +238,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                         mechanical_work = efficiency = math.nan
                     else:
                         (cycle_time, cycle_rate, heating_energy, mechanical_work,
-                         efficiency) = _dynamic_values(model, usable_stroke, section, lever,
-                                                       solid, ogden, p_atm, chamber, thermal,
-                                                       voltage, temps, t_amb, tau)
+                         efficiency) = _dynamic_values(
+                            model, usable_stroke, section, lever, solid, ogden, p_atm, chamber,
+                            Cycle(voltage, thermal, temps, t_amb, tau))
                     out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
                     out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
                     out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
@@ -328,8 +328,8 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         (cycle_time, cycle_rate, heating_energy, mechanical_work,
          efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid, ogden,
-                                       p_atm, chamber, thermal, voltage, temps, t_amb,
-                                       c_all[i] / loss_all[i])
+                                       p_atm, chamber, Cycle(voltage, thermal, temps, t_amb,
+                                                             c_all[i] / loss_all[i]))
         out_design[ROW_CYCLE_TIME, i] = cycle_time
         out_design[ROW_CYCLE_RATE, i] = cycle_rate
         out_design[ROW_HEATING_ENERGY, i] = heating_energy

@@ -22,8 +22,8 @@ from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
-from .records import (CoilRow, Drive, NodeTable, Nodes, Ogden, Reach, Section, SolvedCurve,
-                      StrokeShape)
+from .records import (CoilRow, Cycle, Drive, NodeTable, Nodes, Ogden, Reach, Section,
+                      SolvedCurve, StrokeShape)
 from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
     _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
@@ -495,32 +495,33 @@ def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha,
 
 
 @formula
-def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, chamber, thermal,
-                    voltage, temps, t_amb, tau):
+def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, chamber, cycle):
     """cycle_time [s], cycle_rate [Hz], heating_energy [J], mechanical_work [J], efficiency.
 
     Of a design with usable stroke ``s_star`` [-], ``section`` (a
     :class:`~.records.Section`), ``lever`` [m], solid fraction ``solid`` [-]
     (``incompressible_wall``, else 0), silicone ``ogden`` (an :class:`~.records.Ogden`),
     initial chamber pressure ``p_atm`` [Pa], ``chamber`` (``sealed_chamber``'s
-    :class:`~.records.SealedCoefficients`), its ``thermal`` values (the six of
-    :func:`_thermal_values`), working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
-    ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s].
+    :class:`~.records.SealedCoefficients`) and heating cycle ``cycle`` (a
+    :class:`~.records.Cycle`: the supply V [V], the six ``thermal`` values of
+    :func:`_thermal_values`, the working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
+    ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s]).
 
-    With a supply V (``voltage`` > 0; NaN without): the cycle heats at V from ambient to
-    95 % of the working stroke (``heating``, the heating time to T_95) and cools from there
-    to 5 % of it, tau ln((T_95 - T_amb)/(T_5 - T_amb)); the heating energy is V^2/R times
-    the heating time; the work l_m int_0^s* F_n ds; the efficiency their ratio
+    With a supply V (``cycle.voltage`` > 0; NaN without): the cycle heats at V from ambient
+    to 95 % of the working stroke (``heating``, the heating time to T_95) and cools from
+    there to 5 % of it, tau ln((T_95 - T_amb)/(T_5 - T_amb)); the heating energy is V^2/R
+    times the heating time; the work l_m int_0^s* F_n ds; the efficiency their ratio
     (docs/model.md s. 20).
     """
+    voltage, thermal, temps = cycle.voltage, cycle.thermal, cycle.temps
     if not voltage > 0.0:
         return math.nan, math.nan, math.nan, math.nan, math.nan
     muscle_length, resistance, heating = thermal[0], thermal[1], thermal[5]
-    cycle = heating + _cooling_time(temps[2], temps[1], t_amb, tau)
+    cycle_time = heating + _cooling_time(temps[2], temps[1], cycle.t_amb, cycle.tau)
     energy = voltage * voltage / resistance * heating
     work = muscle_length * _stroke_work(model, s_star, section.radius, section.wall, lever,
                                         solid, ogden.mu, ogden.alpha, p_atm, chamber)
-    return cycle, 1.0 / cycle, energy, work, work / energy
+    return cycle_time, 1.0 / cycle_time, energy, work, work / energy
 
 
 @formula
@@ -739,8 +740,8 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         thermal = _thermal_values(Li, pitch, section, pi, voltage, temps, shape.t_amb, coil)
         solid = _solid_fraction(ai, ti, bi) if code == INCOMPRESSIBLE_WALL else 0.0
         dynamic = _dynamic_values(code, values[0], section, lever, solid, ogden, P_ATM, coef,
-                                  thermal, voltage, temps, shape.t_amb,
-                                  coil.c_per_len / coil.loss_per_len)
+                                  Cycle(voltage, thermal, temps, shape.t_amb,
+                                        coil.c_per_len / coil.loss_per_len))
         flags = _validity(values[5], state[4], section, stretch_max, Li / pitch, closes,
                           dynamic[4])
         r_all[idx], loss_all[idx] = r_per_len, loss_per_len

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilRow", "Drive", "NodeTable", "Nodes", "Ogden", "Reach",
+__all__ = ["CoilRow", "Cycle", "Drive", "NodeTable", "Nodes", "Ogden", "Reach",
            "SealedCoefficients", "Section", "SolvedCurve", "StrokeShape"]
 
 #: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
@@ -70,3 +70,11 @@ Drive = namedtuple("Drive", "voltage length wrap_angle pitch")
 #: ``force_blocked`` F_b = c (T - T_amb) [N] (``coupled_muscle``) and ``limited``, whether
 #: the supply keeps the muscle below T_max (docs/model.md s. 15, 16).
 Reach = namedtuple("Reach", "temperature s_free force_blocked limited")
+
+#: What a design's heating cycle runs on (:func:`~.limits._dynamic_values`): the supply
+#: ``voltage`` V [V] (<= 0: none), the design's ``thermal`` values (the six of
+#: :func:`~.limits._thermal_values`: muscle length [m], resistance [ohm], heating power
+#: [W], heating voltage [V], cooling time [s], heating time [s]), its working temperatures
+#: ``temps`` (T*, T_5, T_95) [K] (:func:`~.limits._working_temperatures`), the ambient
+#: ``t_amb`` [K] and the time constant ``tau`` = c'/lambda' [s] (docs/model.md s. 20).
+Cycle = namedtuple("Cycle", "voltage thermal temps t_amb tau")
