@@ -179,16 +179,8 @@ def test_importing_the_package_changes_nothing_in_the_process():
 
 
 #: The most positional parameters a function of the package may take: past it, a record
-#: (kernels/records.py, physics/records.py) carries the group.
+#: (kernels/records.py, physics/records.py) carries the group. No function is past it.
 MAX_POSITIONAL = 12
-#: Functions still past it, each to be given records.
-#: (sealed_chamber's coefficients, a record of their own, made the three limits formulas
-#: one longer: they are to travel with the Ogden set.)
-TOO_MANY_POSITIONAL = {"nylonflex/physics/limits.py:_design_state_nodes",
-                       "nylonflex/physics/limits.py:_model_state_nodes",
-                       "nylonflex/physics/limits.py:_design_state",
-                       "nylonflex/physics/limits.py:_dynamic_values",
-                       "nylonflex/physics/bending.py:_curvature_of"}
 
 
 def test_no_function_takes_more_than_twelve_positional_arguments():
@@ -198,7 +190,7 @@ def test_no_function_takes_more_than_twelve_positional_arguments():
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and \
                     len(node.args.posonlyargs) + len(node.args.args) > MAX_POSITIONAL:
                 found.add(f"{path.relative_to(PKG.parent).as_posix()}:{node.name}")
-    assert found == TOO_MANY_POSITIONAL
+    assert found == set(), f"give these records: {sorted(found)}"
 
 
 #: The longest body (docstring not counted) a function may have [lines].
