@@ -28,7 +28,6 @@ import html
 import logging
 import math
 import re
-from importlib.resources import files
 
 import numpy as np
 
@@ -40,6 +39,8 @@ from .data import (PAPER_EXAMPLES, design_config, design_variables, display_unit
                    validity_names)
 from .fidelity import fidelity_widgets
 from .model_spread import spread_args
+from .views import (CURVES, curve_views, flag_key, lines_view, map_view, script,
+                    state_widgets, where_view)
 
 #: The most designs a page carries (the rest of a larger cube is left out, and it says so).
 MAX_DESIGNS = 120_000
@@ -49,25 +50,14 @@ MAX_ROWS = 2000
 #: 2 mm, 70 mm, C 1.7, 8 deg); a page opens on it where the cube holds it, valid, else on
 #: the valid design nearest it (:func:`nylonflex.explore.data.first_design`).
 DEFAULT_DESIGN = dict(PAPER_EXAMPLES[0][1])
-#: Flagged designs (``validity`` != 0): grey, as on the charts.
-_FLAG_GREY = "#9e9e9e"
-_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
-            "#000000")
 _SYMBOL = {"radius": "a", "wall_thickness": "t", "length": "L", "coil_index": "C",
            "wrap_angle": "\u03c8"}
-_CURVES = {"nylon_force": ("stroke", ("radius", "wall_thickness", "coil_index", "wrap_angle")),
-           "bend_angle": ("pressure", ("radius", "wall_thickness", "length")),
-           "tip_force": ("pressure", ("radius", "wall_thickness", "length"))}
 
 
 def _conditions(where):
     """``--where`` texts parsed by the query's parser (Condition objects pass through)."""
     return [c for w in (where or ()) for c in (parse_where([w]) if isinstance(w, str)
                                                else [w])]
-
-
-def _script(name: str) -> str:
-    return files(__package__).joinpath(name).read_text(encoding="utf-8")
 
 
 def _subset(ds) -> dict:
@@ -172,7 +162,7 @@ def build_payload(ds, where=()):
                        + ("" if display_unit(ds, a) == "1" else f" {display_unit(ds, a)}")
                        for v in grid[a]] for a in AXES}
     curves = {}
-    for name, (axis, dims) in _CURVES.items():
+    for name, (axis, dims) in CURVES.items():
         if name not in ds:
             continue
         da = part[name]
@@ -294,200 +284,26 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     bokeh.document.Document
     """
     from bokeh.document import Document
-    from bokeh.layouts import column, row
-    from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter,
-                              DataTable, Div, HoverTool, LinearColorMapper, NumberFormatter,
-                              RadioButtonGroup, Range1d, Select, Slider, Span, TableColumn,
-                              TapTool, Title)
-    from bokeh.plotting import figure
+    from bokeh.models import CustomJS, Div
 
     conditions = _conditions(where)
     if payload is None:
         payload = build_payload(ds, conditions)
     p = payload
-    variables, models, sizes = p["variables"], p["models"], p["sizes"]
-
-    # ---- widgets: the page's whole state
+    variables = p["variables"]
     default_var = variables.index("tip_force_max") if "tip_force_max" in variables else 0
-    variable = Select(title="variable (map, lines and read-out)", width=280,
-                      options=[(str(i), label(ds[n])) for i, n in enumerate(variables)],
-                      value=str(default_var), name="nf-variable")
-    model = RadioButtonGroup(labels=models, active=0, name="nf-model") if models else None
-    axis_options = [(a, label(ds[a])) for a in AXES]
-    map_x = Select(title="map across", options=axis_options, value="radius", width=135,
-                   name="nf-map-x")
-    map_y = Select(title="map up", options=axis_options, value="wall_thickness", width=135,
-                   name="nf-map-y")
-    sliders = {}
-    for j, a in enumerate(AXES):
-        start = p["first"][a]
-        fmt = CustomJSTickFormatter(args={"labels": p["labels"][a]},
-                                    code="return labels[Math.round(tick)] || '';")
-        sliders[a] = Slider(start=0, end=max(1, sizes[j] - 1), step=1, value=start,
-                            title=label(ds[a]).split(" [")[0], format=fmt, width=280,
-                            disabled=sizes[j] < 2, name=f"nf-slider-{a}",
-                            css_classes=[f"nf-slider-{a}"])
-    # ---- the map (its cells are laid out by update.js for the chosen axes)
-    map_src = ColumnDataSource({k: [] for k in ("left", "right", "bottom", "top", "z", "zc",
-                                                "h", "hc", "vf", "xv", "yv")},
-                               name="nf-map")
-    # flagged cells: zc is NaN there, so they take the mapper's grey, never a scale colour
-    mapper = LinearColorMapper(palette="Viridis256", low=0, high=1, nan_color=_FLAG_GREY)
-    map_fig = figure(height=400, min_width=380, sizing_mode="stretch_width",
-                     tools="tap,reset,save", name="nf-map-figure",
-                     x_axis_label=label(ds["radius"]), y_axis_label=label(ds["wall_thickness"]),
-                     x_range=(p["edges"]["radius"][0], p["edges"]["radius"][-1]),
-                     y_range=(p["edges"]["wall_thickness"][0],
-                              p["edges"]["wall_thickness"][-1]))
-    cells = map_fig.quad(source=map_src, left="left", right="right", bottom="bottom",
-                         top="top", fill_color={"field": "zc", "transform": mapper},
-                         line_color=None, hatch_pattern="h", hatch_color="hc",
-                         hatch_alpha=0.8, hatch_scale=8, nonselection_fill_alpha=1.0,
-                         selection_fill_alpha=1.0)
-    hover = HoverTool(renderers=[cells], tooltips=[(label(ds[variables[default_var]]),
-                                                    "@z{0.000}")])
-    map_fig.add_tools(hover)
-    colorbar = ColorBar(color_mapper=mapper, width=12, title=label(ds[variables[default_var]]))
-    map_fig.add_layout(colorbar, "right")
-    match_src = ColumnDataSource({"x": [], "y": []}, name="nf-match")
-    if p["match"] is not None:
-        map_fig.scatter("x", "y", source=match_src, marker="circle", size=6,
-                        fill_color="white", line_color="black",
-                        legend_label="meets --where: " + "; ".join(p["where"]))
-        map_fig.add_layout(map_fig.legend[0], "below")  # not over the cells
-    star = ColumnDataSource({"x": [], "y": [], "design": []}, name="nf-star")
-    map_fig.scatter("x", "y", source=star, marker="star", size=20, fill_color="gold",
-                    line_color="black")
-    map_fig.select_one(TapTool).mode = "replace"
-    # ---- figure 12 style lines
-    # explicit ranges, set by update.js from the valid designs (an auto range would take
-    # in the flagged ones, and starts empty: "could not set initial ranges")
-    lines_fig = figure(height=400, min_width=380, sizing_mode="stretch_width",
-                       x_axis_label=label(ds["radius"]), tools="pan,box_zoom,reset,save",
-                       x_range=Range1d(p["gx"]["radius"][0], p["gx"]["radius"][-1]),
-                       y_range=Range1d(0, 1), name="nf-lines-figure")
-    line_srcs, solid_srcs = [], []
-    for k, c in enumerate(p["gx"]["coil_index"]):
-        colour = _COLOURS[k % len(_COLOURS)]
-        line_srcs.append(ColumnDataSource({"x": [], "y": []}))
-        solid_srcs.append(ColumnDataSource({"x": [], "y": []}))
-        lines_fig.line("x", "y", source=line_srcs[-1], color=colour, line_dash="dashed",
-                       legend_label=f"C = {c:.3g}")
-        lines_fig.line("x", "y", source=solid_srcs[-1], color=colour, line_width=3)
-    flag_pts = ColumnDataSource({"x": [], "y": []}, name="nf-lines-flagged")
-    if p["validity"] is not None:
-        lines_fig.scatter("x", "y", source=flag_pts, size=7, color=_FLAG_GREY, alpha=0.8,
-                          legend_label="flagged design (grey)")
-    lines_fig.legend.location = "top_left"
-    lines_fig.add_layout(Title(text="solid: full range of motion; dashed: strength-limited",
-                               text_font_style="italic", text_font_size="11px"), "above")
-    # ---- the curves of the selected design
-    titles = {"nylon_force": "nylon force vs stroke (dashed: its limit)",
-              "bend_angle": "bend angle against chamber pressure",
-              "tip_force": "tip force against chamber pressure"}
-    curve_figs, curve_srcs, curve_by_name = [], {}, {}
-    for k, (name, (axis, _)) in enumerate(_CURVES.items()):
-        if name not in p["curves"]:
-            continue
-        xs = p["curves"][name]["x"]
-        f = figure(height=280, min_width=300, sizing_mode="stretch_width", title=titles[name],
-                   x_axis_label=label(ds[axis]), y_axis_label=label(ds[name]),
-                   tools="pan,box_zoom,reset,save", x_range=Range1d(min(xs), max(xs)),
-                   y_range=Range1d(0, 1))
-        src = ColumnDataSource({"x": [], "y": [], "design": []}, name=f"nf-curve-{name}")
-        f.line("x", "y", source=src, color=_COLOURS[k], line_width=2)
-        curve_figs.append(f)
-        curve_srcs[name] = src
-        curve_by_name[name] = f
-    flim_span = None
-    if p["flim"] is not None and "nylon_force" in curve_srcs:
-        flim_span = Span(location=0, dimension="width", line_dash="dashed", line_color="black")
-        curve_figs[0].add_layout(flim_span)
-    readout = Div(sizing_mode="stretch_width", name="nf-readout")
-    table = Div(min_width=300, sizing_mode="stretch_width")
-    note = Div(text="", visible=False)
-    hold = Div(text="", visible=False)
-
-    args = dict(variable=variable, model=model, sliders=sliders, map_x=map_x, map_y=map_y,
-                data=p["data"], limit=p["limit"], validity=p["validity"], match=p["match"],
-                flags=[[m, n.replace("_", " ")] for m, n in flag_meanings(ds)],
-                config=(html.escape(design_config(ds, DEFAULT_DESIGN, placeholders=True),
-                                    quote=False) if "config_yaml" in ds.attrs else ""),
-                cfgvals={a: [f"{float(to_display_any(ds, a, v)):.12g}" for v in p["grid"][a]]
-                         for a in AXES},
-                colorbar=colorbar, hover=hover, sizes=sizes, AXES=list(AXES),
-                map_src=map_src, match_src=match_src, mapper=mapper, star=star, gx=p["gx"],
-                edges=p["edges"], names=_SYMBOL, labels=p["labels"],
-                alabels={a: label(ds[a]) for a in AXES}, map_fig=map_fig,
-                map_xaxis=map_fig.xaxis[0], map_yaxis=map_fig.yaxis[0], lines_fig=lines_fig,
-                lines_yaxis=lines_fig.yaxis[0], line_srcs=line_srcs, solid_srcs=solid_srcs,
-                flag_pts=flag_pts, curve_figs=curve_by_name,
-                curves=p["curves"], curve_srcs=curve_srcs, flim=p["flim"],
-                flim_span=flim_span, readout=readout, table=table, note=note, hold=hold,
-                vnames=variables, vlabels=[label(ds[n]) for n in variables],
-                vshort=[label(ds[n]).split(" [")[0] for n in variables],
-                vunits=[display_unit(ds, n) for n in variables],
-                vany=p["validity_any"], **spread_args(ds, variables))
-    update = CustomJS(args=args, code=_script("update.js"))
-    for w in (variable, map_x, map_y):
-        w.js_on_change("value", update)
-    if model is not None:
-        model.js_on_change("active", update)
-    for s in sliders.values():
-        s.js_on_change("value", update)
-    pick_args = dict(sizes=sizes, AXES=list(AXES), sliders=sliders, model=model,
-                     map_x=map_x, map_y=map_y, labels=p["labels"], note=note, hold=hold,
-                     update=update)
-    map_src.selected.js_on_change("indices", CustomJS(args={**pick_args, "rows": None},
-                                                      code=_script("pick.js")))
-
-    where_box = []
-    if p["rows"] is not None:
-        rows = p["rows"]
-        rows_src = ColumnDataSource(rows["data"], name="nf-where-rows")
-        columns = []
-        for n in rows["columns"]:
-            title = label(ds[n]) if n in ds.variables else name_label(n)
-            fmt = {} if n in ("model", "validity") else \
-                {"formatter": NumberFormatter(format="0.[000]")}
-            # wide enough for its whole title (the table scrolls sideways, not the page)
-            columns.append(TableColumn(field=n, title=title, width=_title_width(title),
-                                       **fmt))
-        where_table = DataTable(source=rows_src, columns=columns, sizing_mode="stretch_width",
-                                height=260, autosize_mode="none", sortable=True,
-                                reorderable=False,
-                                index_position=None, name="nf-where-table")
-        rows_src.selected.js_on_change("indices", CustomJS(args={**pick_args, "rows": rows_src},
-                                                           code=_script("pick.js")))
-        listed = min(rows["matching"], MAX_ROWS)
-        where_box = [Div(sizing_mode="stretch_width", name="nf-where-note", text=(
-            f"<b>{rows['matching']:,} designs of this page meet --where "
-            f"{html.escape(' and '.join(p['where']))}</b>"
-            + (f" (the first {listed:,} in grid order listed; sorting sorts those)"
-               if listed < rows["matching"] else "")
-            + ": click a column's title to sort, a row to pick that design; the map marks "
-            "the matching designs of its slice with a white dot.")), where_table]
-
-    fidelity_box = []
-    if fidelity is not None:
-        fidelity_box = fidelity_widgets(ds, fidelity[0], fidelity[1])
-    controls = [variable] + ([Div(text="model variant"), model] if model else []) + \
-        [row(map_x, map_y)] + list(sliders.values())
-    flag_key = Div(sizing_mode="stretch_width", name="nf-map-key", text=(
-        "<span style='font-size:12px'><span style='display:inline-block;width:14px;"
-        f"height:10px;background:{_FLAG_GREY};border:1px solid #555'></span> grey, hatched "
-        "/: flagged design (" + ", ".join(m.replace("_", " ") for _, m in
-                                          flag_meanings(ds)) + "), not on the colour scale"
-        "; x: strength-limited</span>") if p["validity"] is not None else "")
-    # fits a 1,280 px window: the controls keep 300 px, the rest stretches (issue 46)
-    layout = column(Div(sizing_mode="stretch_width", text=_header(ds, p, source, served)),
-                    row(column(*controls, width=300),
-                        column(readout, row(map_fig, lines_fig, sizing_mode="stretch_width"),
-                               flag_key, sizing_mode="stretch_width"),
-                        sizing_mode="stretch_width"),
-                    *where_box,
-                    row(*curve_figs, sizing_mode="stretch_width"),
-                    table, note, hold, *fidelity_box, sizing_mode="stretch_width")
+    state = state_widgets(ds, p, default_var)
+    views = {**map_view(ds, p, variables[default_var]), **lines_view(ds, p),
+             **curve_views(ds, p),
+             "readout": Div(sizing_mode="stretch_width", name="nf-readout"),
+             "table": Div(min_width=300, sizing_mode="stretch_width"),
+             "note": Div(text="", visible=False), "hold": Div(text="", visible=False)}
+    update = CustomJS(args=_update_args(ds, p, state, views), code=script("update.js"))
+    pick_args = _on_change(update, state, views, p)
+    views["where_box"] = where_view(ds, p, pick_args, MAX_ROWS)
+    views["fidelity_box"] = [] if fidelity is None else \
+        fidelity_widgets(ds, fidelity[0], fidelity[1])
+    layout = _layout(ds, p, state, views, _header(ds, p, source, served))
     doc = Document() if doc is None else doc
     doc.add_root(layout)
     doc.title = f"nylonflex explorer: {ds.attrs.get('name', '')}"
@@ -495,9 +311,82 @@ def build_document(ds, *, source: str = "", where=(), served: bool = False, payl
     return doc
 
 
-def _title_width(title) -> int:
-    """A table column wide enough for its title [px] (about 7 px a character)."""
-    return max(70, 7 * len(title) + 24)
+def _update_args(ds, p, state, views) -> dict:
+    """What ``update.js`` reads, by name: the state's widgets (:func:`~.views.state_widgets`),
+    the views it draws (:mod:`.views`), the payload's numbers and the labels in display
+    units."""
+    variables = p["variables"]
+    return dict(variable=state["variable"], model=state["model"], sliders=state["sliders"],
+                map_x=state["map_x"], map_y=state["map_y"],
+                data=p["data"], limit=p["limit"], validity=p["validity"], match=p["match"],
+                flags=[[m, n.replace("_", " ")] for m, n in flag_meanings(ds)],
+                config=(html.escape(design_config(ds, DEFAULT_DESIGN, placeholders=True),
+                                    quote=False) if "config_yaml" in ds.attrs else ""),
+                cfgvals={a: [f"{float(to_display_any(ds, a, v)):.12g}" for v in p["grid"][a]]
+                         for a in AXES},
+                colorbar=views["colorbar"], hover=views["hover"], sizes=p["sizes"],
+                AXES=list(AXES), map_src=views["map_src"], match_src=views["match_src"],
+                mapper=views["mapper"], star=views["star"], gx=p["gx"],
+                edges=p["edges"], names=_SYMBOL, labels=p["labels"],
+                alabels={a: label(ds[a]) for a in AXES}, map_fig=views["map_fig"],
+                map_xaxis=views["map_xaxis"], map_yaxis=views["map_yaxis"],
+                lines_fig=views["lines_fig"], lines_yaxis=views["lines_yaxis"],
+                line_srcs=views["line_srcs"], solid_srcs=views["solid_srcs"],
+                flag_pts=views["flag_pts"], curve_figs=views["curve_figs"],
+                curves=p["curves"], curve_srcs=views["curve_srcs"], flim=p["flim"],
+                flim_span=views["flim_span"], readout=views["readout"],
+                table=views["table"], note=views["note"], hold=views["hold"],
+                vnames=variables, vlabels=[label(ds[n]) for n in variables],
+                vshort=[label(ds[n]).split(" [")[0] for n in variables],
+                vunits=[display_unit(ds, n) for n in variables],
+                vany=p["validity_any"], **spread_args(ds, variables))
+
+
+def _on_change(update, state, views, p) -> dict:
+    """Run ``update`` (``update.js``) on every change of the state's widgets, and
+    ``pick.js`` on a click on the map. Returns the arguments ``pick.js`` reads, all but
+    ``rows``: the ``--where`` table's rows pick with them too (:func:`~.views.where_view`)."""
+    from bokeh.models import CustomJS
+
+    for w in (state["variable"], state["map_x"], state["map_y"]):
+        w.js_on_change("value", update)
+    if state["model"] is not None:
+        state["model"].js_on_change("active", update)
+    for s in state["sliders"].values():
+        s.js_on_change("value", update)
+    pick_args = dict(sizes=p["sizes"], AXES=list(AXES), sliders=state["sliders"],
+                     model=state["model"], map_x=state["map_x"], map_y=state["map_y"],
+                     labels=p["labels"], note=views["note"], hold=views["hold"],
+                     update=update)
+    views["map_src"].selected.js_on_change("indices", CustomJS(args={**pick_args,
+                                                                     "rows": None},
+                                                               code=script("pick.js")))
+    return pick_args
+
+
+def _layout(ds, p, state, views, header):
+    """The page's layout: the ``header`` text (HTML), the state's widgets (300 px wide)
+    beside the read-out, the map, the lines and the map's key, then the ``--where`` part
+    (``views["where_box"]``), the curves, the table of values and the fidelity part
+    (``views["fidelity_box"]``)."""
+    from bokeh.layouts import column, row
+    from bokeh.models import Div
+
+    model = state["model"]
+    controls = [state["variable"]] + ([Div(text="model variant"), model] if model else []) + \
+        [row(state["map_x"], state["map_y"])] + list(state["sliders"].values())
+    key = flag_key(ds, p)
+    # fits a 1,280 px window: the controls keep 300 px, the rest stretches (issue 46)
+    return column(Div(sizing_mode="stretch_width", text=header),
+                  row(column(*controls, width=300),
+                      column(views["readout"], row(views["map_fig"], views["lines_fig"],
+                                                   sizing_mode="stretch_width"),
+                             key, sizing_mode="stretch_width"),
+                      sizing_mode="stretch_width"),
+                  *views["where_box"],
+                  row(*views["figures"], sizing_mode="stretch_width"),
+                  views["table"], views["note"], views["hold"], *views["fidelity_box"],
+                  sizing_mode="stretch_width")
 
 
 def build_html(ds, *, source: str = "", where=(), fidelity=None) -> str:

@@ -38,7 +38,8 @@ from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_E
                               _stroke_state_nodes, _thermal_values, _thermal_values_at,
                               _validity, _working_temperatures)
 from ..physics.nylon import _stroke_shape
-from ..physics.records import CoilRow, NodeTable, Ogden, Section, SolvedCurve, StrokeShape
+from ..physics.records import (CoilRow, Cycle, Drive, NodeTable, Ogden, Section,
+                                SolvedCurve, StrokeShape)
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
@@ -197,15 +198,14 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                 cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                 for il in range(nl):
                     if not _PAPER_ONLY and not default and (il == 0 or voltage > 0.0):
-                        t_reach, s_free, limited = _reach(coil_row, length[il], pitch, section,
-                                                          wrap[ip], voltage, shape)
-                        ms = _model_state_nodes(
-                            model, section, lever, coil_row, s_free,
-                            force_coeff * (t_reach - t_amb), limited, ogden, table, p_atm,
-                            chamber, curve, npr)
+                        reach = _reach(coil_row, Drive(voltage, length[il], wrap[ip], pitch),
+                                       section, shape)
+                        ms = _model_state_nodes(model, section, lever, coil_row, reach, ogden,
+                                                table, p_atm, chamber, curve, npr)
                         st = (ms[0], ms[1], ms[2], ms[3], ms[4], ms[5], ms[6])
                         closes = ms[7]
-                        temps = _working_temperatures(model, ms[0], t_reach, scale, shape)
+                        temps = _working_temperatures(model, ms[0], reach.temperature, scale,
+                                                      shape)
                         cooling = _cooling_time(temps[0], temps[1], t_amb, tau)
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free
@@ -238,9 +238,9 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                         mechanical_work = efficiency = math.nan
                     else:
                         (cycle_time, cycle_rate, heating_energy, mechanical_work,
-                         efficiency) = _dynamic_values(model, usable_stroke, section, lever,
-                                                       solid, ogden, p_atm, chamber, thermal,
-                                                       voltage, temps, t_amb, tau)
+                         efficiency) = _dynamic_values(
+                            model, usable_stroke, section, lever, solid, ogden, p_atm, chamber,
+                            Cycle(voltage, thermal, temps, t_amb, tau))
                     out_design[ROW_CYCLE_TIME, ia, it, il, ic, ip] = cycle_time
                     out_design[ROW_CYCLE_RATE, ia, it, il, ic, ip] = cycle_rate
                     out_design[ROW_HEATING_ENERGY, ia, it, il, ic, ip] = heating_energy
@@ -300,7 +300,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         section = Section(a, t, b)
         pitch = _pitch(a, t, b, psi, width_all[i])
         lever = pitch / math.cos(psi)
-        st = _design_state_nodes(model, voltage, section, length[i], psi, pitch, lever,
+        st = _design_state_nodes(model, Drive(voltage, length[i], psi, pitch), section, lever,
                                  coil_row, shape, ogden, nodes, table, p_atm, chamber)
         (usable_stroke, limit, pressure_max, torque_max, tip_force_max, bend_angle_max,
          range_fraction, nylon_force_max, nylon_use) = _design_values(
@@ -328,8 +328,8 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
         solid = _solid_fraction(a, t, b) if model == INCOMPRESSIBLE_WALL else 0.0
         (cycle_time, cycle_rate, heating_energy, mechanical_work,
          efficiency) = _dynamic_values(model, usable_stroke, section, lever, solid, ogden,
-                                       p_atm, chamber, thermal, voltage, temps, t_amb,
-                                       c_all[i] / loss_all[i])
+                                       p_atm, chamber, Cycle(voltage, thermal, temps, t_amb,
+                                                             c_all[i] / loss_all[i]))
         out_design[ROW_CYCLE_TIME, i] = cycle_time
         out_design[ROW_CYCLE_RATE, i] = cycle_rate
         out_design[ROW_HEATING_ENERGY, i] = heating_energy

@@ -25,7 +25,7 @@ import numpy as np
 from ..materials import silicone_parameters
 from ._formula import check, check_section, formula, scalar_or_array
 from .elementary import _exp, _log
-from .records import NodeTable
+from .records import NodeTable, Nodes
 
 __all__ = [
     "QUADRATURE_ORDERS",
@@ -270,24 +270,25 @@ def _material_moment_of(kappa, radius, wall_thickness, base_thickness, mu, alpha
 
 
 @formula
-def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha,
-               x_base, w_base, phi_trig, w_phi, guess, rtol):
+def _curvature(moment, radius, wall_thickness, base_thickness, mu, alpha, nodes, guess, rtol):
     """Solve M_S(kappa) = moment for kappa >= 0 [1/m] (nominal stress; :func:`_curvature_of`)."""
-    return _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
-                         x_base, w_base, phi_trig, w_phi, guess, rtol, False)
+    return _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha, nodes,
+                         guess, rtol, False)
 
 
 @formula
-def _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha,
-                  x_base, w_base, phi_trig, w_phi, guess, rtol, cauchy):
-    """Solve M_S(kappa) = moment for kappa >= 0 [1/m] (:func:`_curvature_solve`).
+def _curvature_of(moment, radius, wall_thickness, base_thickness, mu, alpha, nodes, guess,
+                  rtol, cauchy):
+    """Solve M_S(kappa) = moment [N m] for kappa >= 0 [1/m] (:func:`_curvature_solve`).
 
-    ``cauchy`` integrates the Cauchy stress l S(l) instead of the nominal S(l)
-    (``cauchy_moment``, docs/model.md s. 16). ``guess`` <= 0 starts from the small-angle
-    solution.
+    The section a, t, b [m], the silicone's Ogden ``mu`` [Pa] and ``alpha`` [-], and the
+    quadrature's ``nodes`` (a :class:`~.records.Nodes`, :func:`quadrature_nodes`), from
+    which it makes the section's node table. ``cauchy`` integrates the Cauchy stress
+    l S(l) instead of the nominal S(l) (``cauchy_moment``, docs/model.md s. 16). ``guess``
+    <= 0 starts from the small-angle solution; ``rtol`` [-] as :data:`NEWTON_RTOL`.
     """
-    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, x_base, w_base,
-                                   phi_trig, w_phi)
+    y, wy, wyy, work = _node_table(radius, wall_thickness, base_thickness, nodes.x_base,
+                                   nodes.w_base, nodes.phi_trig, nodes.w_phi)
     return _curvature_nodes(moment, y, wy, wyy, work, mu, alpha, guess, rtol, cauchy)
 
 
@@ -504,10 +505,10 @@ def curvature(pressure, radius, wall_thickness, base_thickness=None, silicone="t
     p = check("pressure", pressure, 0.0, unit="Pa")
     a, t, b = check_section(radius, wall_thickness, base_thickness)
     mu, alpha = silicone_parameters(silicone).arrays()
-    nodes = quadrature_nodes(orders)
+    nodes = Nodes(*quadrature_nodes(orders))
 
     def one(p_, a_, t_, b_):
-        return _curvature(_pressure_moment(p_, a_, b_), a_, t_, b_, mu, alpha, *nodes, 0.0,
+        return _curvature(_pressure_moment(p_, a_, b_), a_, t_, b_, mu, alpha, nodes, 0.0,
                           NEWTON_RTOL)
 
     return scalar_or_array(np.vectorize(one, otypes=[float])(p, a, t, b))

@@ -22,7 +22,8 @@ from .calibrated import _length_correction, _section_correction
 from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pressure_wall,
                       _solid_fraction)
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
-from .records import CoilRow, NodeTable, Nodes, Ogden, Section, SolvedCurve, StrokeShape
+from .records import (CoilRow, Cycle, Drive, NodeTable, Nodes, Ogden, Reach, Section,
+                      SolvedCurve, StrokeShape)
 from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
     _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
@@ -203,8 +204,8 @@ def _model_moment(model, pressure, radius, wall_thickness, base_thickness):
 
 
 @formula
-def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, supply_limited,
-                       ogden, table, p_atm, chamber, curve, n):
+def _model_state_nodes(model, section, lever, coil, reach, ogden, table, p_atm, chamber, curve,
+                       n):
     """The length-free design limits of a model variant, with a reachable free stroke.
 
     ``section`` a :class:`~.records.Section`, ``lever`` the wrap's pitch over cos psi [m],
@@ -212,9 +213,10 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     :class:`~.records.Ogden`, ``table`` the section's node table and scratch (a
     :class:`~.records.NodeTable`, :func:`~.bending._section_nodes`), ``p_atm`` the initial
     chamber pressure [Pa], ``chamber`` the :class:`~.records.SealedCoefficients`
-    (``sealed_chamber``). ``s_free`` is the free stroke at the reachable temperature (s_max
-    without a supply), ``force_blocked`` F_b = c (T - T_amb) [N] at that temperature
-    (``coupled_muscle``), ``supply_limited`` whether the supply keeps the muscle below
+    (``sealed_chamber``). ``reach`` is the muscle at its reachable temperature (a
+    :class:`~.records.Reach`, :func:`_reach`): its free stroke ``s_free`` [-] (s_max
+    without a supply), blocked force ``force_blocked`` F_b = c (T - T_amb) [N]
+    (``coupled_muscle``) and ``limited``, whether the supply keeps the muscle below
     T_max. ``n`` solved points of the model's kappa(p) in ``curve`` (a
     :class:`~.records.SolvedCurve`) start the curvature solves (:func:`_stroke_state_nodes`;
     none: ``n`` = 0, the full-stroke solve from its own start and the strength-limited one
@@ -230,6 +232,7 @@ def _model_state_nodes(model, section, lever, coil, s_free, force_blocked, suppl
     mu, alpha = ogden.mu, ogden.alpha
     y, wy, wyy, work = table.y, table.wy, table.wyy, table.work
     pressures, kappas, rates, rates2 = curve.pressure, curve.kappa, curve.rate, curve.rate2
+    s_free, force_blocked, supply_limited = reach.s_free, reach.force_blocked, reach.limited
     cauchy = model == CAUCHY_MOMENT
     solid = 0.0
     closes = False
@@ -317,16 +320,15 @@ def _curve_squeeze(model, pressure, section, ogden, table, p_atm, chamber):
 
 
 @formula
-def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coil, shape,
-                  ogden, nodes, p_atm, chamber):
+def _design_state(model, drive, section, lever, coil, shape, ogden, nodes, p_atm, chamber):
     """The stroke state of one design in any model, with or without a supply.
 
-    ``voltage`` the supply [V] (<= 0: none), ``section`` a :class:`~.records.Section`,
-    ``length`` L [m], ``wrap_angle`` psi [rad], ``pitch`` of the wrap and ``lever`` pitch
-    over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of its coil index, ``shape``
-    the muscle's :class:`~.records.StrokeShape`, ``ogden`` the silicone's
-    :class:`~.records.Ogden`, ``nodes`` the quadrature's :class:`~.records.Nodes`, ``p_atm``
-    the initial chamber pressure [Pa], ``chamber`` the
+    ``drive`` the supply V [V] (<= 0: none), length L [m], wrap angle psi [rad] and wrap
+    pitch [m] (a :class:`~.records.Drive`), ``section`` a :class:`~.records.Section`,
+    ``lever`` the wrap's pitch over cos psi [m], ``coil`` the :class:`~.records.CoilRow` of
+    its coil index, ``shape`` the muscle's :class:`~.records.StrokeShape`, ``ogden`` the
+    silicone's :class:`~.records.Ogden`, ``nodes`` the quadrature's
+    :class:`~.records.Nodes`, ``p_atm`` the initial chamber pressure [Pa], ``chamber`` the
     :class:`~.records.SealedCoefficients` (``sealed_chamber``).
 
     Returns (s*, limit, p*, M*, kappa*, F_n(s*), kappa_full, closes, T_reach): the paper's
@@ -336,14 +338,13 @@ def _design_state(model, voltage, section, length, wrap_angle, pitch, lever, coi
     """
     y, wy, wyy, work = _node_table(section.radius, section.wall, section.base, nodes.x_base,
                                    nodes.w_base, nodes.phi_trig, nodes.w_phi)
-    return _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                               shape, ogden, nodes, NodeTable(y, wy, wyy, work), p_atm,
-                               chamber)
+    return _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes,
+                               NodeTable(y, wy, wyy, work), p_atm, chamber)
 
 
 @formula
-def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, lever, coil,
-                        shape, ogden, nodes, table, p_atm, chamber):
+def _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes, table, p_atm,
+                        chamber):
     """:func:`_design_state` in a node table and scratch ``table`` (a
     :class:`~.records.NodeTable` of :func:`~.bending._node_count` nodes, overwritten: the
     section's nodes from the quadrature's ``nodes``), which it makes no array for: what the
@@ -352,15 +353,14 @@ def _design_state_nodes(model, voltage, section, length, wrap_angle, pitch, leve
     _section_nodes(section.radius, section.wall, section.base, nodes.x_base, nodes.w_base,
                    nodes.phi_trig, nodes.w_phi, y, wy, wyy)
     unsolved = SolvedCurve(y, y, y, y)
-    if model == PAPER and voltage <= 0.0:
+    if model == PAPER and drive.voltage <= 0.0:
         st = _stroke_state_nodes(section, lever, coil, 0.0, ogden, table, p_atm, unsolved, 0)
         return st[0], st[1], st[2], st[3], st[4], st[5], st[6], False, shape.t_max
-    t_reach, s_free, limited = _reach(coil, length, pitch, section, wrap_angle, voltage, shape)
-    ms = _model_state_nodes(model, section, lever, coil, s_free,
-                            coil.force_coeff * (t_reach - shape.t_amb), limited, ogden, table,
-                            p_atm, chamber, unsolved, 0)
-    lf = _length_factor(model, section.radius, length)
-    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], t_reach
+    reach = _reach(coil, drive, section, shape)
+    ms = _model_state_nodes(model, section, lever, coil, reach, ogden, table, p_atm, chamber,
+                            unsolved, 0)
+    lf = _length_factor(model, section.radius, drive.length)
+    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], reach.temperature
 
 
 @formula
@@ -394,23 +394,26 @@ def _nylon_pressure(model, stroke, p_atm, solid, radius, wall_thickness, mu, alp
 
 
 @formula
-def _reach(coil, length, pitch, section, wrap_angle, voltage, shape):
-    """Reachable temperature min(T_max, T_ss) [K], its free stroke [-], supply-limited?
+def _reach(coil, drive, section, shape):
+    """The muscle at its reachable temperature min(T_max, T_ss), a :class:`~.records.Reach`:
+    the temperature [K], its free stroke [-], the blocked force c (T - T_amb) [N] there,
+    and whether the supply limits it.
 
-    ``coil`` a :class:`~.records.CoilRow`, ``length`` L and ``pitch`` [m], ``section`` a
-    :class:`~.records.Section`, ``wrap_angle`` psi [rad], ``voltage`` the supply [V],
-    ``shape`` the :class:`~.records.StrokeShape`. ``voltage`` <= 0: no supply, T_max and
-    s_max itself (docs/model.md s. 15).
+    ``coil`` a :class:`~.records.CoilRow`, ``drive`` the supply V [V], length L [m], wrap
+    angle psi [rad] and pitch [m] (a :class:`~.records.Drive`), ``section`` a
+    :class:`~.records.Section`, ``shape`` the :class:`~.records.StrokeShape`. V <= 0: no
+    supply, T_max and s_max itself (docs/model.md s. 15, 16).
     """
-    if voltage > 0.0:
-        l_m = _muscle_length(length, pitch, section.radius, section.wall, section.base,
-                             wrap_angle)
-        t_ss = _steady_temperature(voltage, l_m, shape.t_amb, coil.r_per_len,
+    if drive.voltage > 0.0:
+        l_m = _muscle_length(drive.length, drive.pitch, section.radius, section.wall,
+                             section.base, drive.wrap_angle)
+        t_ss = _steady_temperature(drive.voltage, l_m, shape.t_amb, coil.r_per_len,
                                    coil.loss_per_len)
         if t_ss < shape.t_max:
-            return t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma, shape.beta,
-                                      shape.t_g, shape.sigma_g), True
-    return shape.t_max, coil.s_max, False
+            return Reach(t_ss, _free_stroke(t_ss, coil.scale, shape.t_amb, shape.gamma,
+                                            shape.beta, shape.t_g, shape.sigma_g),
+                         coil.force_coeff * (t_ss - shape.t_amb), True)
+    return Reach(shape.t_max, coil.s_max, coil.force_coeff * (shape.t_max - shape.t_amb), False)
 
 
 @formula
@@ -492,32 +495,33 @@ def _stroke_work(model, stroke, radius, wall_thickness, lever, solid, mu, alpha,
 
 
 @formula
-def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, chamber, thermal,
-                    voltage, temps, t_amb, tau):
+def _dynamic_values(model, s_star, section, lever, solid, ogden, p_atm, chamber, cycle):
     """cycle_time [s], cycle_rate [Hz], heating_energy [J], mechanical_work [J], efficiency.
 
     Of a design with usable stroke ``s_star`` [-], ``section`` (a
     :class:`~.records.Section`), ``lever`` [m], solid fraction ``solid`` [-]
     (``incompressible_wall``, else 0), silicone ``ogden`` (an :class:`~.records.Ogden`),
     initial chamber pressure ``p_atm`` [Pa], ``chamber`` (``sealed_chamber``'s
-    :class:`~.records.SealedCoefficients`), its ``thermal`` values (the six of
-    :func:`_thermal_values`), working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
-    ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s].
+    :class:`~.records.SealedCoefficients`) and heating cycle ``cycle`` (a
+    :class:`~.records.Cycle`: the supply V [V], the six ``thermal`` values of
+    :func:`_thermal_values`, the working temperatures ``temps`` (T*, T_5, T_95) [K], ambient
+    ``t_amb`` [K] and time constant ``tau`` = c'/lambda' [s]).
 
-    With a supply V (``voltage`` > 0; NaN without): the cycle heats at V from ambient to
-    95 % of the working stroke (``heating``, the heating time to T_95) and cools from there
-    to 5 % of it, tau ln((T_95 - T_amb)/(T_5 - T_amb)); the heating energy is V^2/R times
-    the heating time; the work l_m int_0^s* F_n ds; the efficiency their ratio
+    With a supply V (``cycle.voltage`` > 0; NaN without): the cycle heats at V from ambient
+    to 95 % of the working stroke (``heating``, the heating time to T_95) and cools from
+    there to 5 % of it, tau ln((T_95 - T_amb)/(T_5 - T_amb)); the heating energy is V^2/R
+    times the heating time; the work l_m int_0^s* F_n ds; the efficiency their ratio
     (docs/model.md s. 20).
     """
+    voltage, thermal, temps = cycle.voltage, cycle.thermal, cycle.temps
     if not voltage > 0.0:
         return math.nan, math.nan, math.nan, math.nan, math.nan
     muscle_length, resistance, heating = thermal[0], thermal[1], thermal[5]
-    cycle = heating + _cooling_time(temps[2], temps[1], t_amb, tau)
+    cycle_time = heating + _cooling_time(temps[2], temps[1], cycle.t_amb, cycle.tau)
     energy = voltage * voltage / resistance * heating
     work = muscle_length * _stroke_work(model, s_star, section.radius, section.wall, lever,
                                         solid, ogden.mu, ogden.alpha, p_atm, chamber)
-    return cycle, 1.0 / cycle, energy, work, work / energy
+    return cycle_time, 1.0 / cycle_time, energy, work, work / energy
 
 
 @formula
@@ -729,15 +733,15 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
         section = Section(ai, ti, bi)
         coil = CoilRow(force_limit, s_max, s_max / top, r_per_len,
                        ny.heat_capacity_per_length, loss_per_len, ny.thermal_force_coefficient)
-        *state, closes, t_reach = _design_state(code, voltage, section, Li, pi, pitch, lever,
-                                                coil, shape, ogden, nodes, P_ATM, coef)
+        *state, closes, t_reach = _design_state(code, Drive(voltage, Li, pi, pitch), section,
+                                                lever, coil, shape, ogden, nodes, P_ATM, coef)
         values = _design_values(*state, force_limit, Li)
         temps = _working_temperatures(code, values[0], t_reach, coil.scale, shape)
         thermal = _thermal_values(Li, pitch, section, pi, voltage, temps, shape.t_amb, coil)
         solid = _solid_fraction(ai, ti, bi) if code == INCOMPRESSIBLE_WALL else 0.0
         dynamic = _dynamic_values(code, values[0], section, lever, solid, ogden, P_ATM, coef,
-                                  thermal, voltage, temps, shape.t_amb,
-                                  coil.c_per_len / coil.loss_per_len)
+                                  Cycle(voltage, thermal, temps, shape.t_amb,
+                                        coil.c_per_len / coil.loss_per_len))
         flags = _validity(values[5], state[4], section, stretch_max, Li / pitch, closes,
                           dynamic[4])
         r_all[idx], loss_all[idx] = r_per_len, loss_per_len

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["CoilRow", "NodeTable", "Nodes", "Ogden", "SealedCoefficients", "Section",
-           "SolvedCurve", "StrokeShape"]
+__all__ = ["CoilRow", "Cycle", "Drive", "NodeTable", "Nodes", "Ogden", "Reach",
+           "SealedCoefficients", "Section", "SolvedCurve", "StrokeShape"]
 
 #: The chamber's cross-section: inner ``radius`` a, ``wall`` thickness t and ``base``
 #: (bottom layer) thickness b [m] (docs/model.md s. 1).
@@ -58,3 +58,23 @@ SolvedCurve = namedtuple("SolvedCurve", "pressure kappa rate rate2")
 #: ``c1`` and the blocked moment's ``cb``. Every formula takes it (the shipped one, or a
 #: sweep's ``chamber:``); the others' variants ignore it.
 SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb")
+
+#: The supply and the muscle it heats (:func:`~.limits._reach`): the supply ``voltage`` V
+#: [V] (<= 0: none), the actuator's ``length`` L [m], the wrap angle ``wrap_angle`` psi
+#: [rad] and the wrap's ``pitch`` [m], which set the muscle's length l_m and so its steady
+#: temperature at V (docs/model.md s. 9, 15).
+Drive = namedtuple("Drive", "voltage length wrap_angle pitch")
+
+#: The muscle at its reachable temperature min(T_max, T_ss) (:func:`~.limits._reach`):
+#: ``temperature`` [K], its free stroke ``s_free`` [-], the blocked force
+#: ``force_blocked`` F_b = c (T - T_amb) [N] (``coupled_muscle``) and ``limited``, whether
+#: the supply keeps the muscle below T_max (docs/model.md s. 15, 16).
+Reach = namedtuple("Reach", "temperature s_free force_blocked limited")
+
+#: What a design's heating cycle runs on (:func:`~.limits._dynamic_values`): the supply
+#: ``voltage`` V [V] (<= 0: none), the design's ``thermal`` values (the six of
+#: :func:`~.limits._thermal_values`: muscle length [m], resistance [ohm], heating power
+#: [W], heating voltage [V], cooling time [s], heating time [s]), its working temperatures
+#: ``temps`` (T*, T_5, T_95) [K] (:func:`~.limits._working_temperatures`), the ambient
+#: ``t_amb`` [K] and the time constant ``tau`` = c'/lambda' [s] (docs/model.md s. 20).
+Cycle = namedtuple("Cycle", "voltage thermal temps t_amb tau")
