@@ -529,3 +529,19 @@ def test_fe_runs_at_a_scheduler_without_workers_stop_in_one_line(tmp_path, monke
 
             journaled_runs(tmp_path / "runs.parts", plan, plan["designs"], _solver([]),
                            scheduler=lc.scheduler_address)
+
+
+def test_a_dry_run_of_several_models_and_coolings_estimates_their_cube(tmp_path, capsys):
+    # the estimate chunks each array as the cube stores it: a model (and cooling)
+    # dimension included (it indexed a 5-dim array with the 6 dims of the cube once)
+    raw = {**SMALL, "model": ["paper", "sealed_chamber"]}
+    assert main(["sweep", str(write_config(tmp_path, raw)), "--dry-run"]) == 0
+    one = capsys.readouterr().out
+    assert main(["sweep", str(write_config(tmp_path, SMALL, "one.yaml")), "--dry-run"]) == 0
+    import re
+
+    def raw_bytes(text):  # "(6.73 MB uncompressed"
+        number, unit = re.search(r"\(([0-9.]+) (\w+) uncompressed", text).groups()
+        return float(number) * {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9}[unit]
+
+    assert raw_bytes(one) > 1.5 * raw_bytes(capsys.readouterr().out)  # two models' arrays

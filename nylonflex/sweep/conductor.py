@@ -15,11 +15,10 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..engine.grid import (bytes_per_radius, check_physics, compute_slab, coords,
-                           global_arrays, plan_slabs)
+                           cube_variables, global_arrays, plan_slabs)
 from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
 from ..engine.warmup import grid_families, warm_up_aside, warm_up_codec, warm_up_grid
-from ..variables import VARIABLES
 from ..storage.cube import CODECS, chunk_shape, encode_chunk, compiled_shuffle
 from ..storage.reader import open_cube
 from .run import sweep_to_file
@@ -230,7 +229,10 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
     groups = 1 if k >= n_radius else min(4, k)
     size = -(-k // groups)
     starts = np.unique(np.linspace(0, n_radius - size, groups).round().astype(int))
-    sizes = {name: len(v) for name, v in coords(cfg).items()}  # as the cube file has them
+    # as the cube file has them: with several models or cooling sets, their dimensions too
+    sizes = {name: len(v) for name, v in coords(cfg).items()}
+    sizes.update(model=len(cfg.models), cooling=len(cfg.cooling_names))
+    dims = {name: d for name, (_, d) in cube_variables(cfg).items()}
     globals_bytes = sum(v.nbytes for v in global_arrays(cfg).values())
     axes_bytes = 8 * sum(len(v) for v in (*cfg.axes.values(), *cfg.curves.values()))
     raw_total = n_radius * bytes_per_radius(cfg) + globals_bytes + axes_bytes
@@ -248,7 +250,7 @@ def estimate(cfg: ResolvedConfig, *, workers=None, notice=None) -> dict:
         t0 = time.perf_counter()
         for name, value in arrays.items():
             raw += value.nbytes
-            packed += _packed_bytes(value, chunk_shape(VARIABLES[name].dims, sizes,
+            packed += _packed_bytes(value, chunk_shape(dims[name], sizes,
                                                    min(radius_chunk, size)), cfg.compression,
                                   shuffle_compiled)
         compress += time.perf_counter() - t0
