@@ -16,7 +16,8 @@ Each group is fitted by linear least squares on what a record says of it:
   v_free), only from records with ``free_volume`` (without: k0 = k1 = 0, Lame's);
 - rounding: gamma_i = ln(v_free / (1 - s)^2) / s = g0 + g1 ln(t/a), v_free = V/V0 - p/K;
 - squeeze: c_i = (theta - theta_lateral(p)) h / (s L) = c0 + c1 ln(t/a);
-- blocked: (F L - M_lateral(p)) / M_S(kappa_sq) = c_b, relative least squares.
+- blocked: (F L - M_lateral(p)) / M_S(kappa_sq) = c_b, relative least squares, with p the
+  pressure the fitted stiffness and rounding predict (what the model adds c_b's moment to).
 
 Left out one design at a time, the others' coefficients predict its pressure, bend and
 blocked force through the whole model (:func:`~nylonflex.physics.sealed_model.sealed_state`
@@ -94,10 +95,10 @@ def _design(rec):
 def record_groups(records, silicone="tc5005", p_atm=P_ATM) -> dict:
     """Per record, the regressor ln(t/a) and what it says of each group (arrays):
     ``lame`` [Pa] mu0 (1 - (a/(a+t))^2), ``stiffness`` K_i [Pa] (NaN without
-    ``free_volume``), ``volume`` V/V0 [-], and the lateral balance's ``theta_p`` [rad] and
-    ``moment_p`` [N m] at the record's pressure, ``moment_b`` [N m] at its blocked one."""
+    ``free_volume``), ``volume`` V/V0 [-], the lateral balance's bend ``theta_p`` [rad] at the record's
+    pressure, and ``h`` = b + a + t/2 [m]."""
     mu0 = silicone_parameters(silicone).initial_shear_modulus
-    out = {k: [] for k in ("x", "lame", "stiffness", "volume", "theta_p", "moment_b", "h")}
+    out = {k: [] for k in ("x", "lame", "stiffness", "volume", "theta_p", "h")}
     for rec in records:
         a, t, b, L = _design(rec)
         p = float(rec["pressure"])
@@ -109,7 +110,6 @@ def record_groups(records, silicone="tc5005", p_atm=P_ATM) -> dict:
                                 else math.nan)
         out["volume"].append(v)
         out["theta_p"].append(lateral_state(p, a, t, b, silicone)[0] * L)
-        out["moment_b"].append(lateral_state(p, a, t, b, silicone)[1])
         out["h"].append(b + a + 0.5 * t)
     return {k: np.asarray(v, dtype=float) for k, v in out.items()}
 
@@ -127,7 +127,7 @@ def _linear(x, y):
     return float(c0), float(c1)
 
 
-def _fit(records, groups, idx, silicone):
+def _fit(records, groups, idx, silicone, p_atm=P_ATM):
     """Coefficients (the COEFFICIENT_NAMES order) from the records ``idx``."""
     g = {k: v[idx] for k, v in groups.items()}
     recs = [records[i] for i in idx]
@@ -151,8 +151,14 @@ def _fit(records, groups, idx, silicone):
     blocked = np.isfinite(force) & (force > 0)  # records whose blocked solve was reached
     m_sq = np.array([squeeze_moment(k, *_design(r)[:3], silicone)
                      for k, r, ok in zip(k_sq, recs, blocked) if ok])
+    # the pressure moment the model itself will add: at the pressure it predicts from the
+    # coefficients just fitted, not the record's (c_b is fitted to what it completes)
+    free = (k0, k1, g0, g1, c0, c1, 1.0)
+    moment_p = np.array([lateral_state(_predict(r, free, silicone, p_atm)["pressure"],
+                                       *_design(r)[:3], silicone)[1]
+                         for r, ok in zip(recs, blocked) if ok])
     z = m_sq / (force * L)[blocked]
-    r = ((force * L - g["moment_b"]) / (force * L))[blocked]
+    r = ((force * L)[blocked] - moment_p) / (force * L)[blocked]
     cb = float(z @ r / (z @ z)) if np.any(z > 0) else 1.0
     return (k0, k1, g0, g1, c0, c1, cb)
 
@@ -190,10 +196,10 @@ def fit_sealed_chamber(records, silicone="tc5005", p_atm=P_ATM, tolerance=TOLERA
         raise ValueError(f"records: need at least 3 designs, got {len(records)}")
     groups = record_groups(records, silicone, p_atm)
     n = len(records)
-    coef = _fit(records, groups, np.arange(n), silicone)
+    coef = _fit(records, groups, np.arange(n), silicone, p_atm)
     loo = {"pressure": [], "bend_angle": [], "tip_force": []}
     for j in range(n):
-        c = _fit(records, groups, np.delete(np.arange(n), j), silicone)
+        c = _fit(records, groups, np.delete(np.arange(n), j), silicone, p_atm)
         pred = _predict(records[j], c, silicone, p_atm)
         for name in loo:
             loo[name].append(pred[name] / float(records[j][name]))
