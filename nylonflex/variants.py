@@ -112,18 +112,20 @@ VARIANTS = {v.name: v for v in [
             "L/a beyond 2-30), run nylonflex verify on the cube. Its full-stroke answers "
             "take eq. 8's pressure, 3-10x the sealed FE twin's (see sealed_chamber)",
             "s. 21"),
-    Variant("sealed_chamber", "the sealed chamber as built (uncalibrated)",
+    Variant("sealed_chamber", "the sealed chamber as built, fitted to the sealed FE twin",
             "the chamber's real pressure when the wrap squeezes the sealed air: Boyle with a "
             "compliant chamber that rounds out, (p0 + p)(v_free(s) + p/K) = p0, instead of "
             "eq. 8's rigid section; lateral_pressure's balance at that pressure plus the "
             "wall's squeeze bend c_sq s L / h",
-            "against the stroke-driven, sealed FE twin (docs/fidelity.md, \"Driven as "
-            "built\"), on 5 designs only: full-stroke bend within 15 % on 3 of 5 (paper 0 of "
-            "5, fe_calibrated 1 of 5), blocked force within 15 % on 0 of 3; its coefficients "
-            "are closed forms (Lame's stiffness, a rigid section), not yet fitted to the twin",
-            "not yet for design answers: it shows how far below eq. 8 the sealed chamber's "
-            "pressure may fall (a tenth, at the worked examples); settle it for your "
-            "actuator on the bench (docs/bench.md, nylonflex fit chamber)", "s. 22"),
+            "against the stroke-driven, sealed FE twin at full stroke (docs/fidelity.md), 48 "
+            "designs, each left out of the fit: bend 1.02 (0.83-1.15), 47 of 48 within 15 % "
+            "(paper 2 of 48, fe_calibrated 0); blocked force 0.94 (0.58-1.56), 22 of 48 "
+            "within 15 % (paper 4)",
+            "the full-stroke bend, range of motion and which limit binds, as the FE twin "
+            "driven as built sees them; its blocked force is an estimate within about 0.6-1.6 "
+            "of the twin's. Fitted on tc5005 with b = t on the coarse mesh: for your own "
+            "actuator settle it on the bench (docs/bench.md, nylonflex fit chamber)",
+            "s. 22"),
 ]}
 
 
