@@ -196,6 +196,17 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
     text = runnable_config(back.attrs)
     assert yaml.safe_load(text)["chamber"] == {"file": str(out)}
     assert parse_config(yaml.safe_load(text)).sha256 == cfg.sha256
+    # the explorer's "copy as config" of one design keeps both models and the chamber file:
+    # its sweep gives that design's values of the cube, the anchored chamber's included
+    from nylonflex.explore.data import design_config
+    from nylonflex.variables import AXES
+    at = {a: float(back[a].values[-1]) for a in AXES}
+    doc = yaml.safe_load(design_config(back, at))
+    assert doc["model"] == ["paper", "sealed_chamber"] and doc["chamber"] == {"file": str(out)}
+    one = run_sweep(parse_config(doc))
+    for name in ("pressure_max", "bend_angle_max", "tip_force_max", "limit"):
+        np.testing.assert_array_equal(one[name].squeeze().values,
+                                      back[name].sel(at).values, err_msg=name)
     out.write_text(out.read_text().replace("squeeze: ", "squeeze: 1", 1))
     with pytest.raises(ValueError, match="chamber file .* has changed since the sweep"):
         runnable_config(back.attrs)

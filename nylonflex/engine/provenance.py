@@ -25,9 +25,9 @@ from .model_slab import chamber_coefficients
 from ..variables import is_complete  # noqa: F401 - re-exported
 from ..variables import AXES, VARIABLES
 
-__all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "cube_settings",
-           "is_complete", "provenance", "run_attrs", "runnable_config", "settings_attrs",
-           "typed_info"]
+__all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "chamber_spec",
+           "cube_settings", "is_complete", "provenance", "run_attrs", "runnable_config",
+           "settings_attrs", "typed_info"]
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format:
 #: "3" stores the pressure curves over the dimension ``pressure_point``, with ``pressure``
@@ -494,7 +494,7 @@ def runnable_config(attrs) -> str:
     if isinstance(doc.get("fidelity"), dict):  # docs/model.md s. 23
         out["fidelity"] = {"spread": [str(m) for m in doc["fidelity"]["spread"]]}
     if "chamber" in doc:  # docs/bench.md: by its file, while that still says the same
-        out["chamber"] = _chamber_spec(doc["chamber"])
+        out["chamber"] = chamber_spec(doc["chamber"])
     if attrs.get("compression"):
         out["compression"] = str(attrs["compression"])
     out["charts"] = []
@@ -511,9 +511,10 @@ def runnable_config(attrs) -> str:
     return head + yaml.safe_dump(out, sort_keys=False, default_flow_style=None, width=100)
 
 
-def _chamber_spec(chamber: dict) -> dict:
-    """``chamber: {file: ...}`` of a cube's config, its file checked to hold the values the
-    cube ran with (a ValueError naming it otherwise: no other form can recompute it)."""
+def chamber_spec(chamber: dict) -> dict:
+    """``chamber: {file: ...}`` of a cube's config (its resolved ``chamber``, the file and
+    the values read from it), the file checked to hold the values the cube ran with (a
+    ValueError naming it otherwise: no other form can recompute it)."""
     path = str(chamber.get("file", ""))
     try:
         now = read_chamber_file(path)

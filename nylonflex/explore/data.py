@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import yaml
 
-from ..engine.provenance import cube_settings
+from ..engine.provenance import chamber_spec, cube_settings
 from ..materials import NYLON_PARAMETERS, SILICONE_PARAMETERS
 from ..units import InputError
 from ..variables import AXES, VARIABLES, to_display
@@ -123,9 +123,10 @@ def _curve_axis(name, si) -> dict:
 
 def design_config(ds, at: dict, placeholders: bool = False) -> str:
     """The selected design as a runnable sweep config (YAML, display units): one grid value
-    per axis, the cube's curves, and its materials as ``{set: NAME, field: value, ...}``
-    with every field of the cube's resolved sets, so that ``nylonflex sweep`` of it gives
-    this design's values of the cube ("copy as config"). With ``placeholders`` each grid
+    per axis, the cube's curves, its materials as ``{set: NAME, field: value, ...}`` with
+    every field of the cube's resolved sets, its models, supply, cooling set and
+    ``sealed_chamber``'s chamber file (docs/bench.md), so that ``nylonflex sweep`` of it
+    gives this design's values of the cube ("copy as config"). With ``placeholders`` each grid
     value is ``'@AXIS@'``, for a page to fill in."""
     try:
         settings = cube_settings(ds)
@@ -142,8 +143,15 @@ def design_config(ds, at: dict, placeholders: bool = False) -> str:
     b = settings.base_thickness
     out["base_thickness"] = "wall" if b is None else \
         {"value": float(f"{float(to_display('wall_thickness', b)):.12g}"), "units": "mm"}
-    if len(settings.models) == 1 and settings.models[0] != "paper":
-        out["model"] = settings.models[0]
+    models = list(settings.models)
+    if models != ["paper"]:  # every model the cube holds, so each one's values come back
+        out["model"] = models[0] if len(models) == 1 else models
+    chamber = (yaml.safe_load(ds.attrs.get("config_yaml") or "null") or {}).get("chamber")
+    if isinstance(chamber, dict):  # sealed_chamber anchored on a bench fit (docs/bench.md)
+        try:
+            out["chamber"] = chamber_spec(chamber)
+        except ValueError as err:
+            raise InputError(str(err)) from None
     if settings.supply_voltage is not None:
         out["supply"] = {"voltage": settings.supply_voltage, "units": "V"}
     if settings.cooling is not None:
