@@ -209,3 +209,35 @@ def test_a_killed_stroke_verify_resumes_to_the_uninterrupted_dataset(tmp_path):
     resumed, uninterrupted = (_load(vs.stroke_path(c)) for c in cubes)
     assert resumed.equals(uninterrupted)
     assert np.isfinite(resumed["stroke_fe_pressure"].values).all()
+
+
+def test_each_model_is_held_against_the_twin_at_its_own_full_stroke(tmp_path, monkeypatch):
+    """sealed_chamber's s* is longer where the paper's muscle breaks first (the 20/6 mm
+    chamber at C 1.1 here): the twin is marched through both strokes and each model's ratio
+    takes the twin at its own s*."""
+    cube = write_cube(tmp_path, {**GRID, "model": ["paper", "sealed_chamber"]})
+
+    def solve(task):  # a stand-in twin whose values are the stroke's multiples
+        d = task[0]
+        s = np.asarray(d["strokes"], dtype=float)
+        return {"pressure": (1e5 * s).tolist(), "bend_angle": (10 * s).tolist(),
+                "discretisation_error": [0.0] * len(s), "coarser_pressure": (1e5 * s).tolist(),
+                "coarser_bend_angle": (10 * s).tolist()}
+
+    monkeypatch.setattr(vs, "_solve_stroke", solve)
+    fid = _load(vs.run_verify_stroke(cube, 12, mesh="coarse"))
+    plan = json.loads((cube.with_name(cube.name + ".fidelity_stroke.parts")
+                       / "plan.json").read_text())
+    own = fid["stroke_model_stroke"]
+    paper_s = fid["stroke"].values
+    np.testing.assert_array_equal(own.sel(model="paper").values, paper_s)
+    sealed_s = own.sel(model="sealed_chamber").values
+    longer = sealed_s > paper_s * (1 + 1e-9)
+    assert longer.any() and np.isfinite(sealed_s).all()
+    for k in np.flatnonzero(longer):  # both strokes solved, the paper's first
+        assert plan["designs"][k]["strokes"][0] == paper_s[k]
+        assert sealed_s[k] in plan["designs"][k]["strokes"]
+    for model, s in (("paper", paper_s), ("sealed_chamber", sealed_s)):
+        np.testing.assert_allclose(fid["stroke_model_bend_angle_max"].sel(model=model).values
+                                   / fid["stroke_bend_ratio"].sel(model=model).values,
+                                   10 * s, rtol=1e-12)

@@ -16,6 +16,7 @@ cube, so that the two drives' results stand side by side.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -99,11 +100,38 @@ def _plan(ds, attrs, n, seed, mesh, blocked):
     designs = sample_designs(ds, n, seed)
     arr = [np.array([d[a] for d in designs]) for a in AXES]
     s_star = np.atleast_1d(evaluate(*arr, **paper)["usable_stroke"])
-    runs = [{**d, "strokes": [float(s_star[k])], "base_thickness": paper.get("base_thickness")}
-            for k, d in enumerate(designs)]
+    # each model's own s* as well (sealed_chamber's is longer where the paper's muscle
+    # breaks first): the twin is marched through all of them, the paper's first
+    own = [np.atleast_1d(evaluate(*arr, **kwargs[m])["usable_stroke"]) for m in models]
+    runs = [{**d, "strokes": _strokes(float(s_star[k]), [float(o[k]) for o in own]),
+             "base_thickness": paper.get("base_thickness")} for k, d in enumerate(designs)]
     return {"drive": "stroke", "blocked": bool(blocked), "designs": runs, "mesh": mesh,
             "seed": int(seed), "models": models, **plan_material(paper["silicone"]),
             "cube_config_sha256": str(attrs.get("config_sha256", ""))}
+
+
+def _strokes(paper, others) -> list:
+    """The strokes [-] the twin is solved at for one design: the paper model's s* first,
+    then every other model's own s* that differs from it (finite, in (0, 0.5))."""
+    out = [paper]
+    for s in sorted(others):
+        if math.isfinite(s) and 0.0 < s < 0.5 and all(abs(s - o) > 1e-9 for o in out):
+            out.append(s)
+    return out
+
+
+def _at_own_stroke(rows, done, key, strokes):
+    """The twin's ``key`` at each design's stroke in ``strokes`` (per design; the nearest
+    solved one, NaN where none is within 1e-9)."""
+    out = np.full(len(rows), np.nan)
+    for k, row in enumerate(rows):
+        solved = np.asarray(row["strokes"], dtype=float)
+        if not np.isfinite(strokes[k]):
+            continue
+        j = int(np.argmin(np.abs(solved - strokes[k])))
+        if abs(solved[j] - strokes[k]) <= 1e-9 and key in done[k]:
+            out[k] = done[k][key][j]
+    return out
 
 
 def _solve_stroke(task):
@@ -187,16 +215,35 @@ def stroke_dataset(plan, done, cube_name, kwargs=None):
         data["stroke_fe_blocked_discretisation_error"] = \
             ("design", fe("blocked_discretisation_error"))
     vals = model_values(plan, kwargs)
+    # each model against the twin at its own s* (a run made before the twin was solved at
+    # every model's stroke has the paper's alone: the others' ratios are NaN there)
+    own = {model: _model_strokes(rows, vals[model]["usable_stroke"]) for model in models}
+    data["stroke_model_stroke"] = (("model", "design"), np.array([own[m] for m in models]))
+    keys = {"stroke_fe_pressure": "pressure", "stroke_fe_bend_angle": "bend_angle",
+            "stroke_fe_tip_force": "tip_force"}
     for ratio, var, twin, _ in STROKE_RATIOS:
         if twin not in data:
             continue
         m = np.array([vals[model][var] for model in models])
+        fe_own = np.array([_at_own_stroke(rows, done, keys[twin], own[model])
+                           for model in models])
         data[f"stroke_model_{var}"] = (("model", "design"), m)
         with np.errstate(invalid="ignore", divide="ignore"):
-            data[ratio] = (("model", "design"),
-                           np.where(data[twin][1] > 0, m / data[twin][1], np.nan))
+            data[ratio] = (("model", "design"), np.where(fe_own > 0, m / fe_own, np.nan))
     out = xr.Dataset(data, coords={"design": np.arange(n), "model": np.array(models)})
     _attrs(out, plan, cube_name)
+    return out
+
+
+def _model_strokes(rows, usable) -> np.ndarray:
+    """A model's s* per design [-]: its own ``usable`` stroke where the twin was solved
+    there, else the paper's (the run's first), which a run of the paper's alone holds."""
+    out = np.array([r["strokes"][0] for r in rows], dtype=float)
+    for k, row in enumerate(rows):
+        if any(abs(s - usable[k]) <= 1e-9 for s in row["strokes"]):
+            out[k] = usable[k]
+        elif abs(usable[k] - out[k]) > 1e-9:
+            out[k] = np.nan  # solved at another stroke only: no ratio
     return out
 
 
@@ -215,7 +262,8 @@ def model_values(plan, kwargs=None) -> dict:
             "base_thickness": rows[0]["base_thickness"] if rows else None}
         res = evaluate(*arr, **kw)
         out[model] = {v: np.atleast_1d(np.asarray(res[v], dtype=float))
-                      for v in ("pressure_max", "bend_angle_max", "tip_force_max")}
+                      for v in ("pressure_max", "bend_angle_max", "tip_force_max",
+                                "usable_stroke")}
     return out
 
 
@@ -234,6 +282,7 @@ def _attrs(out, plan, cube_name):
         elif "force" in name:
             out[name].attrs["units"] = "N"
     long = {"stroke": "the design's usable stroke s* (paper model), the twin's drive",
+            "stroke_model_stroke": "the model's own s*, where its ratios are taken",
             "stroke_fe_pressure": "sealed twin's chamber pressure at s* (free)",
             "stroke_fe_bend_angle": "sealed twin's bend angle at s* (free)",
             "stroke_fe_discretisation_error": "twin's Richardson error estimate at s* (free)",
@@ -244,7 +293,7 @@ def _attrs(out, plan, cube_name):
             "stroke_fe_blocked_discretisation_error":
                 "twin's Richardson error estimate at s* (tip held)"}
     for ratio, var, twin, what in STROKE_RATIOS:
-        long[ratio] = f"model {var} / stroke-driven twin's {what} at s*"
+        long[ratio] = f"model {var} / stroke-driven twin's {what}, both at the model's s*"
         long[f"stroke_model_{var}"] = f"model's {var} (its own s*)"
     for name, text in long.items():
         if name in out.variables:
