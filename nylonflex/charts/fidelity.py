@@ -107,6 +107,17 @@ STROKE_PANELS = (("stroke_pressure_ratio", "pressure_max"),
                  ("stroke_force_ratio", "tip_force_max"))
 
 
+def _minor_label(span):
+    """A log axis's minor tick label: every one over less than a decade ``span`` [1], the
+    2s and 5s of each decade up to three decades, none beyond (no two labels overlap)."""
+    def text(v, _):
+        if span < 10.0:
+            return f"{v:g}"
+        mantissa = round(v / 10.0 ** np.floor(np.log10(v)), 6)
+        return f"{v:g}" if span < 1000.0 and mantissa in (2.0, 5.0) else ""
+    return text
+
+
 def stroke_fidelity_map(fid, *, x="radius", models=None):
     """The stroke-driven fidelity (``nylonflex verify --drive stroke``): a panel a quantity
     (pressure, bend, blocked force where solved), each model's ratio to the sealed twin at
@@ -137,7 +148,7 @@ def stroke_fidelity_map(fid, *, x="radius", models=None):
         ax.set_yscale("log")
         ax.set_ylim(lo / 1.15, hi * 1.15)
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(_minor_label(hi / lo)))
         ax.set_title(f"{quantity} / twin at s*")
         ax.set_xlabel(label(fid[x]))
         ax.set_ylabel("model / stroke-driven twin [1] (log)")
