@@ -35,6 +35,7 @@ from nylonflex.sweep.conductor import run_sweep, sweep_file
 from .first_use import cold_compiles, command_costs
 from .flops import kernel_flops_per_design
 from .kernel_cpu import kernel_seconds
+from .ratios import kernel_ratios, process_ratios, ratio_lines
 from .yardstick import grid_numpy
 
 #: The checkout's tests/naive.py, the slow reference of the tests.
@@ -240,6 +241,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         size_mb = (Path(tmp) / "cube.h5").stat().st_size / 2**20
         ds.close()
         light = command_costs(Path(tmp) / "cube.h5")
+        whole = process_ratios(Path(tmp) / "cube.h5", pairs=1 if quick else 3)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t_numpy, t_kernel_whole = _numpy_yardstick(cfg)
 
@@ -302,6 +304,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "light_commands": light,
         "cold_compile": cold,
     }
+    result["ratios"] = {**kernel_ratios(result), **whole}
     say(f"  kernels only               {t_kernel:8.2f} s  {result['kernel_designs_per_s']:>12,.0f}"
         f" designs/s  {result['angle_solves_per_s']:>10,.0f} angle solves/s")
     say(f"  sweep end to end (+ HDF5)  {t_total:8.2f} s  {result['sweep_designs_per_s']:>12,.0f}"
@@ -345,4 +348,6 @@ def run_bench(quick: bool = False, log=None) -> dict:
         say("  cold compile, empty cache  " + ", ".join(
             f"{k} {w:.1f} s ({c:.1f} CPU-s)" for k, (w, c) in cold["kernels"].items()) +
             f"; nylonflex warmup's whole process {cold['process_cpu_s']:.1f} CPU-s")
+    for line in ratio_lines(result["ratios"]):
+        say(line)
     return result

@@ -37,6 +37,10 @@ def test_quick_bench_reports_every_figure():
     assert set(result["light_commands"]) >= {"info", "query --where", "query --at", "list materials"}
     assert all(cpu > 0 and (mb is None or mb > 0)
                for cpu, mb in result["light_commands"].values())
+    # issue 49's ratios, each of two things measured in this run, with its target
+    assert set(result["ratios"]) == {"K1", "K2", "S1", "L1q", "L1i", "P1s", "P1b"}
+    assert all(v > 0 for v in result["ratios"].values())
+    assert "ratios (issue 49" in text and "target <= 5600" in text
 
 
 def test_the_flop_count_counts_each_operation_once_and_runs_the_kernels_own_numbers():
