@@ -27,8 +27,7 @@ import math
 import numpy as np
 from ..physics import specialised
 from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
-                               _curvature_start, _pressure_moment, _section_nodes,
-                               node_scratch)
+                               _curvature_start, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
                               SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes, _design_values,
@@ -51,6 +50,7 @@ from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYC
                    ROW_NYLON_FORCE_MAX, ROW_NYLON_USE, ROW_PRESSURE_MAX, ROW_RANGE_FRACTION,
                    ROW_RESISTANCE, ROW_TIP_FORCE_MAX, ROW_TORQUE_MAX, ROW_USABLE_STROKE,
                    ROW_VALIDITY)
+from .scratch import node_scratch
 
 
 def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0, k1):
@@ -268,7 +268,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
     :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
     design. ``silicone`` holds 2-D arrays (row, term) with one row for all designs or one
     row a design. ``table`` is the thread's node table and scratch
-    (:func:`nylonflex.physics.bending.node_scratch`).
+    (:func:`.scratch.node_scratch`).
     The loop body is the one :func:`nylonflex.physics.design_limits` runs, so both give the
     same numbers.
     """
@@ -359,7 +359,7 @@ def grid_scratch(grid, nodes):
     """The grid kernel's working arrays for a call on ``grid`` (a :class:`~.records.GridAxes`)
     with the quadrature ``nodes`` (a :class:`~.records.Nodes`): a
     :class:`~.records.GridScratch`, one a thread (each call fills what it reads): the
-    section's node table (:func:`~nylonflex.physics.bending.node_scratch`) and the curves."""
+    section's node table (:func:`.scratch.node_scratch`) and the curves."""
     npr, ns = len(grid.pressure), len(grid.stroke)
     return GridScratch(*node_scratch(nodes), np.empty(npr), np.empty(npr), np.empty(npr),
                        np.empty(ns), np.empty(ns))

@@ -41,7 +41,8 @@ from ..config.simulate import (  # noqa: F401 - the config layer's names, import
     top_temperature,
 )
 from ..kernels.records import AngleTables, Control, Muscles, Ogden, SimOut, Supply
-from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
+from ..kernels.scratch import node_scratch
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length
