@@ -147,6 +147,27 @@ def test_physics_imports_no_numba_xarray_matplotlib():
                                                   "h5netcdf"), (path, name)
 
 
+def test_physics_holds_no_compiler_machinery():
+    # physics/ holds formulas and records (issue 47): a copy of a formula with its globals
+    # fixed for Numba (kernels.specialise) or the kernels' scratch (kernels.scratch) lives in
+    # kernels/, so every function of a physics module runs in its own module's globals
+    import importlib
+    import pkgutil
+    import types
+
+    from nylonflex import physics
+
+    found = []
+    for info in pkgutil.iter_modules(physics.__path__):
+        module = importlib.import_module(f"{physics.__name__}.{info.name}")
+        found += [f"{module.__name__}.{name}" for name, f in vars(module).items()
+                  if isinstance(f, types.FunctionType) and f.__module__ == module.__name__
+                  and f.__globals__ is not vars(module)]
+        found += [f"{module.__name__}.{name}" for name in ("specialised", "node_scratch")
+                  if name in vars(module)]
+    assert not found, "compiler machinery in physics/: " + "; ".join(found)
+
+
 #: Modules outside kernels/ that import Numba, each with its reason (none).
 NUMBA_OUTSIDE_KERNELS = set()
 
