@@ -105,8 +105,8 @@ def _physics_modules():
 
 @contextlib.contextmanager
 def counting(*functions):
-    """While inside: every physics module (and the globals of ``functions`` and of the
-    physics layer's specialised copies) sees the counting ``math``, and the branch-free
+    """While inside: every physics module (and the globals of ``functions``, such as the
+    kernels' specialised copies of formulas) sees the counting ``math``, and the branch-free
     exp and log build Flops from their bits. Yields a callable giving the count so far."""
     from nylonflex.physics import elementary
 
@@ -151,15 +151,17 @@ def counted_kernel(cfg, ia: int, it: int) -> tuple[int, tuple]:
     of one radius, the pair's wall filled)."""
     from nylonflex.engine.model_slab import grid_axes, grid_out, kernel_inputs
     from nylonflex.kernels import design
-    from nylonflex.physics import specialised
+    from nylonflex.kernels.specialise import specialised
 
-    body = specialised(design._design_slab, "_design_slab_counted", _PAPER_ONLY=True)
+    body = specialised(design._design_slab, "_design_slab_counted", **design.PAPER_ONLY_GLOBALS)
     grid, inputs = grid_axes(cfg, ia, ia + 1), kernel_inputs(cfg, 0)
     out = grid_out(cfg, 1)
     out = type(out)(*(np.empty(a.shape, dtype=object) for a in out))
     scratch = design.grid_scratch(grid, inputs[2])
     scratch = type(scratch)(*(np.empty(a.shape, dtype=object) for a in scratch))
-    with counting(body) as count:
+    copies = [f for f in vars(design).values()  # the kernels' specialised formulas too
+              if isinstance(f, types.FunctionType) and f.__globals__ is not vars(design)]
+    with counting(body, *copies) as count:
         body(_flops_of(grid), *(_flops_of(v) for v in inputs), out, scratch, it, it + 1)
         return count(), out
 

@@ -147,6 +147,27 @@ def test_physics_imports_no_numba_xarray_matplotlib():
                                                   "h5netcdf"), (path, name)
 
 
+def test_physics_holds_no_compiler_machinery():
+    # physics/ holds formulas and records (issue 47): a copy of a formula with its globals
+    # fixed for Numba (kernels.specialise) or the kernels' scratch (kernels.scratch) lives in
+    # kernels/, so every function of a physics module runs in its own module's globals
+    import importlib
+    import pkgutil
+    import types
+
+    from nylonflex import physics
+
+    found = []
+    for info in pkgutil.iter_modules(physics.__path__):
+        module = importlib.import_module(f"{physics.__name__}.{info.name}")
+        found += [f"{module.__name__}.{name}" for name, f in vars(module).items()
+                  if isinstance(f, types.FunctionType) and f.__module__ == module.__name__
+                  and f.__globals__ is not vars(module)]
+        found += [f"{module.__name__}.{name}" for name in ("specialised", "node_scratch")
+                  if name in vars(module)]
+    assert not found, "compiler machinery in physics/: " + "; ".join(found)
+
+
 #: Modules outside kernels/ that import Numba, each with its reason (none).
 NUMBA_OUTSIDE_KERNELS = set()
 
@@ -218,9 +239,14 @@ def test_no_function_body_is_longer_than_the_line():
     assert found == LONG_KERNEL_BODIES
 
 
+#: What charts may import from the engine: its core count (how many charts to draw at once,
+#: ``charts/_parallel.py``), which computes no physics (issue 47: one ``cores()``).
+CHARTS_FROM_ENGINE = {"nylonflex.engine.threads"}
+
+
 def test_charts_compute_no_physics():
     for path, module, target in _edges():
-        if _unit(module) == "charts":
+        if _unit(module) == "charts" and target not in CHARTS_FROM_ENGINE:
             assert _unit(target) not in ("physics", "kernels", "engine"), (module, target)
 
 
@@ -370,10 +396,12 @@ def _private_imports():
 
 
 def test_no_private_name_is_imported_across_packages():
-    # the kernels compile the physics' private Numba formulas by name (their one exception)
+    # the kernels compile the physics' private Numba formulas by name (their one exception;
+    # kernels.scratch sizes the node table with the formula the kernels compile)
     found = {f for f in _private_imports()
              if not f.startswith(("kernels.design -> physics.", "kernels.control -> physics.",
-                                  "kernels.tracking -> physics."))}
+                                  "kernels.tracking -> physics.",
+                                  "kernels.scratch -> physics.bending._node_count"))}
     assert not found, "private names imported across packages: " + "; ".join(sorted(found))
 
 
@@ -481,6 +509,7 @@ HEAVY_IMPORTS = {
     "multiprocessing": 15,
     "dataclasses": 14,
     "concurrent.futures": 14,
+    "concurrent.futures.process": 34,  # beyond concurrent.futures: multiprocessing's queues
     "logging": 12,
     "secrets": 12,
     "subprocess": 10,

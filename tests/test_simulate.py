@@ -23,7 +23,8 @@ from nylonflex.cli import main
 from nylonflex.materials import silicone_parameters
 from nylonflex.kernels.control import _switch, angle_table, estimate_angle, plant_angle
 from nylonflex.kernels.records import Ogden
-from nylonflex.physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
+from nylonflex.kernels.scratch import node_scratch
+from nylonflex.physics.bending import NEWTON_RTOL, quadrature_nodes
 from nylonflex.sim import (
     PLANT_TABLE_POINTS,
     parse_sim_config,

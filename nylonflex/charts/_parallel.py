@@ -9,19 +9,14 @@ chart, the charts are drawn one by one in this process.
 
 from __future__ import annotations
 
-import os
 import sys
+from concurrent.futures import as_completed
+
+from ..engine.threads import cores
 
 #: What the forked workers inherit: the drawing function and the cube (set before the
 #: pool forks, never pickled).
 _INHERITED: dict = {}
-
-
-def _cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
 
 
 def _draw_inherited(job):
@@ -49,7 +44,7 @@ def draw_all(draw, ds, jobs, processes=None, on_done=None) -> list:
     list
         What ``draw`` returned, in the order of ``jobs``.
     """
-    n = min(len(jobs), processes or _cores())
+    n = min(len(jobs), processes or cores())
     if n <= 1 or not sys.platform.startswith("linux"):
         out = []
         for k, job in enumerate(jobs, 1):
@@ -58,7 +53,7 @@ def draw_all(draw, ds, jobs, processes=None, on_done=None) -> list:
                 on_done(k, len(jobs), out[-1])
         return out
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import ProcessPoolExecutor
 
     _INHERITED.update(draw=draw, ds=ds)
     try:

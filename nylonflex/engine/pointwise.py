@@ -19,11 +19,12 @@ import numpy as np
 
 from ..kernels.records import CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut
 from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
+from ..kernels.scratch import node_scratch
 from ..materials import (NYLON_PARAMETERS, NYLON_TABLES, SILICONE_PARAMETERS, Nylon, Silicone,
                          check_nylon, check_silicone, cooling_parameters, nylon_parameters,
                          silicone_kind, silicone_parameters)
 from ..physics import check_input, check_section, check_wrap_angle
-from ..physics.bending import node_scratch, quadrature_nodes
+from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
 from ..physics.nylon import check_stroke_shape

@@ -20,7 +20,8 @@ import numpy as np
 
 from ..config import ResolvedConfig
 from ..kernels.rows import N_TRACKING, TRACKING_ROWS
-from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
+from ..kernels.scratch import node_scratch
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import stroke, stroke_scale
 from ..physics.records import Ogden

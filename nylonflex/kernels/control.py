@@ -50,7 +50,7 @@ def _angle_table(pressure_step, radius, wall_thickness, base_thickness, length, 
         Tolerance of the curvature solve [-] (``physics.bending.NEWTON_RTOL``).
     table : NodeTable
         The section's node table and scratch, overwritten
-        (:func:`nylonflex.physics.bending.node_scratch` of the same nodes).
+        (:func:`nylonflex.kernels.scratch.node_scratch` of the same nodes).
     out_angle, out_slope : ndarray, shape (points,)
         Written with theta(p_k) [rad] and d theta/dp [rad/Pa].
 

@@ -25,18 +25,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from ..physics import specialised
+
 from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
-                               _curvature_start, _pressure_moment, _section_nodes,
-                               node_scratch)
+                               _curvature_start, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes, _design_values,
-                              _dynamic_values,
-                              _length_factor, _model_moment, _model_state_nodes,
-                              _nylon_force_model, _reach,
-                              _stroke_state_nodes, _thermal_values, _thermal_values_at,
-                              _validity, _working_temperatures)
+                              SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes,
+                              _design_values, _dynamic_values, _length_factor, _model_moment,
+                              _model_state_nodes, _nylon_force_model, _paper_force, _reach,
+                              _stroke_limit_model, _stroke_state_nodes, _thermal_values,
+                              _thermal_values_at, _validity, _working_temperatures)
 from ..physics.nylon import _stroke_shape
 from ..physics.records import (CoilRow, Cycle, Drive, NodeTable, Ogden, Section,
                                 SolvedCurve, StrokeShape)
@@ -51,6 +49,8 @@ from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYC
                    ROW_NYLON_FORCE_MAX, ROW_NYLON_USE, ROW_PRESSURE_MAX, ROW_RANGE_FRACTION,
                    ROW_RESISTANCE, ROW_TIP_FORCE_MAX, ROW_TORQUE_MAX, ROW_USABLE_STROKE,
                    ROW_VALIDITY)
+from .scratch import node_scratch
+from .specialise import specialised
 
 
 def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0, k1):
@@ -268,7 +268,7 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
     :class:`~.records.CoilTable` and ``muscle`` a :class:`~.records.Muscle`, one entry a
     design. ``silicone`` holds 2-D arrays (row, term) with one row for all designs or one
     row a design. ``table`` is the thread's node table and scratch
-    (:func:`nylonflex.physics.bending.node_scratch`).
+    (:func:`.scratch.node_scratch`).
     The loop body is the one :func:`nylonflex.physics.design_limits` runs, so both give the
     same numbers.
     """
@@ -344,6 +344,22 @@ def _design_points(designs, coil, silicone, nodes, muscle, options, p_atm, out, 
 _PAPER_ONLY = False
 
 
+#: The paper's stroke limit: :func:`~nylonflex.physics.limits._stroke_limit_model` whose
+#: calls of ``_nylon_force_model`` call the paper's F_n
+#: (:func:`~nylonflex.physics.limits._paper_force`), the branch it takes for the model code
+#: PAPER: the same lines and numbers, none of the variants' forces to compile.
+_stroke_limit_paper = specialised(_stroke_limit_model, "_stroke_limit_paper",
+                                  _nylon_force_model=_paper_force)
+
+#: The paper's stroke state: :func:`~nylonflex.physics.limits._stroke_state_nodes` calling
+#: :data:`_stroke_limit_paper`, so that the paper's grid kernel compiles no variant force.
+_stroke_state_paper = specialised(_stroke_state_nodes, "_stroke_state_nodes_paper",
+                                  _stroke_limit_model=_stroke_limit_paper)
+
+#: The globals that :data:`design_slab_paper`'s copy of the grid kernel's body fixes
+#: (:func:`~.specialise.specialised`): ``_PAPER_ONLY`` and the paper's stroke state.
+PAPER_ONLY_GLOBALS = {"_PAPER_ONLY": True, "_stroke_state_nodes": _stroke_state_paper}
+
 #: The compiled loops: one body each, for threaded runs (chunks on the engine's threads,
 #: :mod:`nylonflex.engine.threads`) and serial ones (Dask workers) alike.
 design_slab = jit_kernel(_design_slab, callee_body=True, borrows=True)
@@ -351,7 +367,8 @@ design_points = jit_kernel(_design_points, callee_body=True, borrows=True)
 #: The grid kernel of the paper's model without a supply (the main job, figure 12): the
 #: same source as :data:`design_slab`, the same numbers bit for bit, about 30 % less to
 #: compile (:func:`grid_kernel` chooses).
-design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper", _PAPER_ONLY=True),
+design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper",
+                                           **PAPER_ONLY_GLOBALS),
                                callee_body=True, borrows=True)
 
 
@@ -359,7 +376,7 @@ def grid_scratch(grid, nodes):
     """The grid kernel's working arrays for a call on ``grid`` (a :class:`~.records.GridAxes`)
     with the quadrature ``nodes`` (a :class:`~.records.Nodes`): a
     :class:`~.records.GridScratch`, one a thread (each call fills what it reads): the
-    section's node table (:func:`~nylonflex.physics.bending.node_scratch`) and the curves."""
+    section's node table (:func:`.scratch.node_scratch`) and the curves."""
     npr, ns = len(grid.pressure), len(grid.stroke)
     return GridScratch(*node_scratch(nodes), np.empty(npr), np.empty(npr), np.empty(npr),
                        np.empty(ns), np.empty(ns))

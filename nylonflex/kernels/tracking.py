@@ -19,7 +19,6 @@ import math
 
 import numpy as np
 
-from ..physics.bending import node_scratch
 from ..physics.chamber import _gauge_pressure
 from ..physics.nylon import _stroke_shape
 from ..physics.thermal import _temperature_step
@@ -29,6 +28,7 @@ from .records import (Estimator, LoopControl, LoopMuscle, LoopPlant, LoopReferen
                       TableSpec)
 from .rows import (ROW_TRACKING_BANDWIDTH, ROW_TRACKING_ENERGY, ROW_TRACKING_MAX_TEMPERATURE,
                    ROW_TRACKING_RMS_ERROR)
+from .scratch import node_scratch
 
 __all__ = ["kappa_tables", "run_loop", "track_scratch", "track_slab"]
 
@@ -38,7 +38,7 @@ def _kappa_tables(p_max, radius, wall, base, silicone, nodes, rtol, table, out_k
     the (radius i, wall j) pairs q0 <= q = i nt + j < q1 (a thread's chunk); ``base`` <= 0
     means b = t; ``silicone`` an :class:`~.records.Ogden`, ``nodes`` the quadrature
     (:class:`~.records.Nodes`). NaN rows where p_max is NaN. ``table`` is the thread's node
-    table and scratch (:func:`nylonflex.physics.bending.node_scratch`)."""
+    table and scratch (:func:`.scratch.node_scratch`)."""
     na, nt = p_max.shape
     points = out_kappa.shape[2]
     for q in range(q0, q1):
@@ -262,5 +262,5 @@ track_slab = jit_kernel(_track_slab, callee_body=True, borrows=True)
 def track_scratch(nodes, points: int) -> tuple:
     """A thread's working arrays for :data:`track_slab`: the estimator table and its slopes
     (``points`` entries each) and a node table for the quadrature ``nodes``
-    (:func:`nylonflex.physics.bending.node_scratch`)."""
+    (:func:`.scratch.node_scratch`)."""
     return np.empty(points), np.empty(points), node_scratch(nodes)

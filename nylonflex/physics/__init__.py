@@ -4,9 +4,9 @@ One module per domain: :mod:`.nylon` (stroke, coil-index table, eq. 1), :mod:`.t
 (eq. 3), :mod:`.chamber` (Boyle), :mod:`.silicone` (Ogden), :mod:`.wrap` (wrap geometry and
 nylon force), :mod:`.bending` (moments, curvature, angle, tip force) and :mod:`.limits`
 (design limits); :func:`check_input` and its two shorthands check an input against the
-registry's range for callers above (the evaluator, the FE twin), and :func:`specialised`
-copies a formula or kernel body with some of its globals fixed (the kernels). This package
-imports neither Numba, xarray nor matplotlib.
+registry's range for callers above (the evaluator, the FE twin). This package holds
+formulas and records, nothing about compilers (the kernels compile the formulas,
+:mod:`nylonflex.kernels`), and imports neither Numba, xarray nor matplotlib.
 """
 
 from .bending import (
@@ -16,7 +16,7 @@ from .bending import (
     pressure_moment,
     tip_force,
 )
-from ._formula import check_input, check_section, check_wrap_angle, specialised
+from ._formula import check_input, check_section, check_wrap_angle
 from .chamber import P_ATM, chamber_pressure, volume_ratio
 from .limits import design_limits, stroke_limit
 from .nylon import (
@@ -66,7 +66,6 @@ __all__ = [
     "nylon_force_limit",
     "outer_perimeter",
     "pressure_moment",
-    "specialised",
     "steady_temperature",
     "strain_energy",
     "stroke",

@@ -10,7 +10,6 @@ without the physics layer importing Numba.
 from __future__ import annotations
 
 import math
-import types
 
 import numpy as np
 
@@ -22,26 +21,6 @@ def formula(func):
     """Mark ``func`` as a Numba-compilable formula (it is returned unchanged)."""
     func.__nylonflex_formula__ = True
     return func
-
-
-def specialised(func, name, **names):
-    """A copy of ``func`` named ``name`` (same code, module and docstring) in which the
-    global ``names`` are the values given: a compile-time constant (``_PAPER_ONLY=True``) or
-    another formula to call.
-
-    Numba compiles a formula's globals as constants and prunes the branches that a constant
-    decides before typing, so a copy that serves one case compiles none of the formulas of
-    the others (the grid kernel of the paper's model; the paper's stroke limit). In Python
-    the copy runs the same lines. Its globals are those of ``func``'s module when the copy
-    is made, so it is made after everything it calls. A marked ``@formula`` stays one.
-    """
-    scope = {**func.__globals__, **names}
-    copy = types.FunctionType(func.__code__.replace(co_name=name, co_qualname=name), scope,
-                              name, func.__defaults__)
-    copy.__module__, copy.__qualname__, copy.__doc__ = func.__module__, name, func.__doc__
-    if getattr(func, "__nylonflex_formula__", False):
-        formula(copy)
-    return copy
 
 
 def primitive(func):

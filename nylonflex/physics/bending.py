@@ -25,7 +25,7 @@ import numpy as np
 from ..materials import silicone_parameters
 from ._formula import check, check_section, formula, scalar_or_array
 from .elementary import _exp, _log
-from .records import NodeTable, Nodes
+from .records import Nodes
 
 __all__ = [
     "QUADRATURE_ORDERS",
@@ -123,15 +123,6 @@ def _node_count(x_base, w_phi):
     """Entries of a section's node table: the quadrature's nodes, padded (:data:`NODE_PAD`)."""
     n = x_base.shape[0] + 2 * w_phi.shape[0]
     return (n + NODE_PAD - 1) // NODE_PAD * NODE_PAD
-
-
-def node_scratch(nodes):
-    """An unfilled node table and scratch for the quadrature ``nodes`` (a
-    :class:`~.records.Nodes`, or its four arrays): a :class:`~.records.NodeTable` of
-    :func:`_node_count` nodes that :func:`_section_nodes` fills, one a thread, for the
-    kernels that make no arrays of their own."""
-    n = _node_count(nodes[0], nodes[3])
-    return NodeTable(np.empty(n), np.empty(n), np.empty(n), np.empty((MOMENT_WORK_ROWS, n)))
 
 
 @formula

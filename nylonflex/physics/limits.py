@@ -14,7 +14,7 @@ import numpy as np
 
 from ..materials import nylon_parameters, silicone_parameters
 from ._formula import (check, check_input, check_section, check_wrap_angle, formula,
-                       scalar_or_array, specialised)
+                       scalar_or_array)
 from .bending import (NEWTON_RTOL, _curvature_nodes, _curvature_rates, _curvature_solve,
                       _curvature_start, _lateral_lever, _node_table, _pressure_moment,
                       _section_moment, _section_nodes, _taylor_start, quadrature_nodes)
@@ -139,15 +139,9 @@ def _stroke_limit_model(model, force_limit, s_max, radius, wall_thickness, lever
 @formula
 def _paper_force(model, stroke, radius, wall_thickness, lever, solid, mu, alpha, p_atm, chamber):
     """:func:`_nylon_force_model` of the paper's model: F_n(s) and dF_n/ds [N] (``model``,
-    ``solid`` and ``chamber`` unused)."""
+    ``solid`` and ``chamber`` unused), in its signature: what the paper's grid kernel calls
+    in its place (:mod:`nylonflex.kernels.design`)."""
     return _nylon_force_and_slope(stroke, radius, wall_thickness, lever, mu, alpha, p_atm)
-
-
-#: :func:`_stroke_limit_model` of the paper's F_n alone (its calls of ``_nylon_force_model``
-#: call :func:`_paper_force`): the kernels' stroke limit of the paper's model compiles none
-#: of the variants' forces.
-_stroke_limit = specialised(_stroke_limit_model, "_stroke_limit",
-                            _nylon_force_model=_paper_force)
 
 
 @formula
@@ -576,8 +570,8 @@ def _stroke_state_nodes(section, lever, coil, kappa_full, ogden, table, p_atm, c
             _curvature_start(p_full, pressures, kappas, rates, rates2, n), NEWTON_RTOL, False)
         rate_full, rate2_full = _curvature_rates(_pressure_moment(1.0, radius, base_thickness),
                                                  dm, d2m)
-    s, limit, force = _stroke_limit(PAPER, force_limit, s_max, radius, wall_thickness, lever,
-                                    0.0, mu, alpha, p_atm, _SEALED, STROKE_RTOL)
+    s, limit, force = _stroke_limit_model(PAPER, force_limit, s_max, radius, wall_thickness,
+                                          lever, 0.0, mu, alpha, p_atm, _SEALED, STROKE_RTOL)
     p = _gauge_pressure(s, p_atm)
     moment = _pressure_moment(p, radius, base_thickness)
     if limit == 0:

@@ -11,8 +11,9 @@ voltage sags over its internal resistance.
 A config (YAML) is validated by :mod:`nylonflex.config.simulate` before any kernel runs (its
 names are re-exported here); every refusal is one :class:`~nylonflex.units.InputError` line
 naming the field. :func:`run_simulation` returns an :class:`xarray.Dataset` in SI with
-``units`` and ``long_name`` on every variable; :func:`summary` gives the lines the
-``nylonflex simulate`` command prints.
+``units`` and ``long_name`` on every variable, and the run's metrics, from which
+:mod:`nylonflex.cli.simulate` writes the lines the ``nylonflex simulate`` command prints
+(:func:`settled_errors` gives the settled errors it quotes).
 
 Overheating [choice]: the temperature is not clamped. Above T_max the stroke keeps
 following the same eq. (2) shape (a little past s_max(C)); the run records the highest
@@ -41,7 +42,8 @@ from ..config.simulate import (  # noqa: F401 - the config layer's names, import
     top_temperature,
 )
 from ..kernels.records import AngleTables, Control, Muscles, Ogden, SimOut, Supply
-from ..physics.bending import NEWTON_RTOL, node_scratch, quadrature_nodes
+from ..kernels.scratch import node_scratch
+from ..physics.bending import NEWTON_RTOL, quadrature_nodes
 from ..physics.chamber import P_ATM, chamber_pressure
 from ..physics.nylon import nylon_force_limit, stroke, stroke_scale
 from ..physics.thermal import coil_resistance_per_length
@@ -59,7 +61,6 @@ __all__ = [
     "parse_sim_config",
     "reference_signal",
     "run_simulation",
-    "summary",
     "step_metrics",
     "write_simulation",
 ]
@@ -358,12 +359,8 @@ def _is_simulation(path) -> bool:
 
 
 # ---------------------------------------------------------------------------------------
-# command line
+# metrics the command line quotes
 # ---------------------------------------------------------------------------------------
-
-def _deg(x):
-    return math.degrees(x)
-
 
 def settled_errors(time, angle, reference) -> np.ndarray:
     """|angle - reference| [rad] at the end of each level of a piecewise-constant reference
@@ -373,51 +370,3 @@ def settled_errors(time, angle, reference) -> np.ndarray:
     ends = np.flatnonzero(np.diff(reference) != 0)
     ends = np.append(ends[ends > 0], len(reference) - 1)
     return np.abs(np.asarray(angle, float)[ends] - reference[ends])
-
-
-def summary(cfg: SimConfig, ds) -> list[str]:
-    """Lines of the run's summary: tracking, step response, power and warnings."""
-    lines = [f"{cfg.name}: {len(cfg.actuators)} actuator(s) on {cfg.supply_voltage:g} V, "
-             f"{cfg.duration:g} s at {cfg.step * 1e3:g} ms ({cfg.n_steps} steps), loop "
-             f"{ds.attrs['loop_time'] * 1e3:.1f} ms"]
-    for j, a in enumerate(cfg.actuators):
-        get = (lambda k: float(ds[k].values[j])) if cfg.gripper else \
-            (lambda k: float(ds.attrs[k]))
-        tag = f"  {a.name}: " if cfg.gripper else "  "
-        span = a.reference.span
-        what = {"sine": "amplitude", "step": "step", "schedule": "range"}[a.reference.kind]
-        if a.reference.kind == "sine":
-            lines.append(f"{tag}RMS error {_deg(get('rms_error')):.2f} deg = "
-                         f"{100 * get('rms_error_fraction'):.1f} % of the {_deg(span):.0f} "
-                         f"deg {what} (from t = {a.rms_from:g} s)")
-        else:  # an RMS over a step's thermal rise measures the rise, not the tracking
-            pick = (lambda k: ds[k].values[j]) if cfg.gripper else (lambda k: ds[k].values)
-            settled = settled_errors(ds["time"].values, pick("bend_angle"),
-                                     pick("bend_angle_reference"))
-            lines.append(f"{tag}settled error {_deg(float(np.max(settled))):.2f} deg at most "
-                         f"= {100 * float(np.max(settled)) / span:.1f} % of the "
-                         f"{_deg(span):.0f} deg {what} (at the end of each of the "
-                         f"{len(settled)} reference level(s))")
-        if a.reference.kind == "step":
-            rise = get("rise_time")
-            rise_s = "never reaches 90 %" if math.isnan(rise) else f"{rise:.2f} s"
-            lines.append(f"{tag}rise time (10-90 %) {rise_s}, overshoot "
-                         f"{100 * get('overshoot'):.2f} %")
-        lines.append(f"{tag}power mean {get('mean_power'):.2f} W, peak "
-                     f"{get('peak_power'):.2f} W, energy {get('energy'):.1f} J; "
-                     f"max temperature {get('temperature_max') - 273.15:.0f} degC")
-        ref_max = float(np.max(reference_signal(a.reference, ds["time"].values)))
-        if ref_max > get("reach") + 1e-9:
-            lines.append(f"{tag}warning: the reference reaches {_deg(ref_max):.0f} deg, "
-                         f"beyond the {_deg(get('reach')):.0f} deg the design settles at "
-                         f"with full heating")
-        if get("time_above_t_max") > 0:
-            lines.append(f"{tag}warning: the muscle spent {get('time_above_t_max'):.1f} s "
-                         f"above its highest safe temperature "
-                         f"{a.nylon.t_max - 273.15:.0f} degC")
-        if get("nylon_use_max") > 1.0:
-            lines.append(f"{tag}warning: the muscle load reached "
-                         f"{100 * get('nylon_use_max'):.0f} % of its breaking force")
-    if cfg.gripper:
-        lines.append(f"  supply current peak {1e3 * ds.attrs['supply_current_max']:.0f} mA")
-    return lines
