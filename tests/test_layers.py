@@ -264,13 +264,14 @@ def test_the_contract_fails_when_an_arrow_runs_back(tmp_path, monkeypatch):
 # ------------------------------------------------------------- the commands that stay light
 #: What each light command may not import, run as a user runs it (its own process, the
 #: console script): no Numba anywhere; no dask; ``info`` no xarray either (it reads the
-#: cube through h5py), ``chart --help`` nothing that draws or reads.
+#: cube through h5py), ``chart --help`` nothing that draws or reads; none the shell
+#: completion's shtab (70 ms here), which only ``nylonflex completion`` needs.
 _HEAVY = {
-    "info": ("numba", "dask", "xarray", "pandas", "nylonflex.engine"),
-    "query": ("numba", "dask", "nylonflex.kernels"),
-    "chart": ("numba", "dask", "xarray", "matplotlib", "h5py"),
-    "list": ("numba", "dask", "xarray", "h5py"),
-    "init": ("numba", "dask", "xarray", "h5py"),
+    "info": ("numba", "dask", "xarray", "pandas", "nylonflex.engine", "shtab"),
+    "query": ("numba", "dask", "nylonflex.kernels", "shtab"),
+    "chart": ("numba", "dask", "xarray", "matplotlib", "h5py", "shtab"),
+    "list": ("numba", "dask", "xarray", "h5py", "shtab"),
+    "init": ("numba", "dask", "xarray", "h5py", "shtab"),
 }
 
 _PROBE = """
@@ -499,6 +500,7 @@ HEAVY_IMPORTS = {
     "pydantic": 102,
     "tqdm": 128,
     "psutil": 40,
+    "shtab": 70,  # the shell completion alone (cli/completion.py)
     "zstandard": 13,
     "isal.isal_zlib": 5,
     # the standard library's

@@ -3,8 +3,6 @@ from the same parser the console script builds (every command, flag and choice).
 
 from __future__ import annotations
 
-import shtab
-
 from . import build_parser
 
 HELP = "print a shell completion script (bash, zsh, tcsh)"
@@ -24,5 +22,7 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    import shtab  # here, not at the top: every command's parser imports this module
+
     print(shtab.complete(build_parser(), shell=args.shell))
     return 0
