@@ -198,6 +198,16 @@ def richardson(fine, coarse):
     return err
 
 
+def extrapolated(fine, coarse):
+    """Richardson's extrapolation of two mesh levels' values (ratio
+    :data:`.mesh.REFINEMENT`, order :data:`ORDER`), in their unit (the angles: [rad])."""
+    from .mesh import REFINEMENT
+
+    fine = np.asarray(fine, float)
+    coarse = np.asarray(coarse, float)
+    return fine + (fine - coarse) / (REFINEMENT ** ORDER - 1.0)
+
+
 def pressure_error(fine, coarse):
     """The sealed chamber's pressure error estimate [1]: Roache's grid convergence index for
     two meshes, F_s |p_h - p_2h| / (r^p - 1) / |p_h|, with the safety factor F_s =

@@ -27,8 +27,7 @@ from ..materials import silicone_parameters
 from ..physics.calibrated import TERMS
 from ..physics.limits import model_bend_angle
 from ..units import InputError
-from . import ORDER, fe_bend
-from .mesh import REFINEMENT
+from . import extrapolated, fe_bend
 from .runs import journaled_runs, plan_material, plan_silicone
 
 __all__ = ["MIN_DESIGNS", "TARGET_ANGLES", "TRAINING_RANGES", "correction_terms", "fit_correction",
@@ -110,13 +109,6 @@ def run_training(parts, plan, *, workers=1, scheduler=None, progress=None, log=N
     tasks = [(d, plan["silicone"], plan["mesh"]) for d in plan["designs"]]
     return journaled_runs(parts, plan, tasks, _solve, workers=workers, scheduler=scheduler,
                           progress=progress, log=log, what="fit fe")
-
-
-def extrapolated(fine, coarse):
-    """Richardson's extrapolation of two mesh levels' angles (ratio 1.5, order 2) [rad]."""
-    fine = np.asarray(fine, float)
-    coarse = np.asarray(coarse, float)
-    return fine + (fine - coarse) / (REFINEMENT ** ORDER - 1.0)
 
 
 def fit_correction(plan, done, *, silicone=None) -> dict:

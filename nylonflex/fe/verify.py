@@ -18,8 +18,7 @@ import numpy as np
 
 from .. import __version__
 from ..units import InputError
-from . import MESH_NAMES, fe_bend, require_felupe
-from .calibrate import extrapolated
+from . import MESH_NAMES, extrapolated, fe_bend, require_felupe
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_arguments", "check_outputs",
