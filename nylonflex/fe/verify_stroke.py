@@ -242,8 +242,8 @@ def _model_strokes(rows, usable) -> np.ndarray:
     for k, row in enumerate(rows):
         if any(abs(s - usable[k]) <= 1e-9 for s in row["strokes"]):
             out[k] = usable[k]
-        elif abs(usable[k] - out[k]) > 1e-9:
-            out[k] = np.nan  # solved at another stroke only: no ratio
+        elif not abs(usable[k] - out[k]) <= 1e-9:
+            out[k] = np.nan  # solved at other strokes only (or none of its own): no ratio
     return out
 
 
