@@ -208,6 +208,9 @@ def test_a_sweep_names_a_chamber_file_and_runs_its_chamber(tmp_path):
         np.testing.assert_array_equal(one[name].squeeze().values,
                                       back[name].sel(at).values, err_msg=name)
     out.write_text(out.read_text().replace("squeeze: ", "squeeze: 1", 1))
+    # the explorer still opens the cube: its copy names the file and warns it has changed
+    changed = design_config(back, at)
+    assert "has changed since the sweep" in changed.splitlines()[1]
     with pytest.raises(ValueError, match="chamber file .* has changed since the sweep"):
         runnable_config(back.attrs)
 

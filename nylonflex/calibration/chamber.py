@@ -95,8 +95,8 @@ def _design(rec):
 def record_groups(records, silicone="tc5005", p_atm=P_ATM) -> dict:
     """Per record, the regressor ln(t/a) and what it says of each group (arrays):
     ``lame`` [Pa] mu0 (1 - (a/(a+t))^2), ``stiffness`` K_i [Pa] (NaN without
-    ``free_volume``), ``volume`` V/V0 [-], the lateral balance's bend ``theta_p`` [rad] at the record's
-    pressure, and ``h`` = b + a + t/2 [m]."""
+    ``free_volume``), ``volume`` V/V0 [-], the lateral balance's bend ``theta_p`` [rad] at
+    the record's pressure, and ``h`` = b + a + t/2 [m]."""
     mu0 = silicone_parameters(silicone).initial_shear_modulus
     out = {k: [] for k in ("x", "lame", "stiffness", "volume", "theta_p", "h")}
     for rec in records:
