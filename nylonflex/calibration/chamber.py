@@ -154,8 +154,7 @@ def _fit(records, groups, idx, silicone, p_atm=P_ATM):
     # the pressure moment the model itself will add: at the pressure it predicts from the
     # coefficients just fitted, not the record's (c_b is fitted to what it completes)
     free = (k0, k1, g0, g1, c0, c1, 1.0)
-    moment_p = np.array([lateral_state(_predict(r, free, silicone, p_atm)["pressure"],
-                                       *_design(r)[:3], silicone)[1]
+    moment_p = np.array([_predict(r, free, silicone, p_atm)["pressure_moment"]
                          for r, ok in zip(recs, blocked) if ok])
     z = m_sq / (force * L)[blocked]
     r = ((force * L)[blocked] - moment_p) / (force * L)[blocked]

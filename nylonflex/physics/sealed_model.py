@@ -118,8 +118,8 @@ def sealed_state(stroke, radius, wall_thickness, length, base_thickness=None, si
     Returns ``pressure`` [Pa], ``volume_ratio`` V/V0 and ``free_volume`` [-], ``stiffness``
     K [Pa], ``squeeze_curvature`` [1/m], ``bend_angle`` [rad] (``lateral_pressure``'s
     balance at p plus the squeeze), ``pressure_angle`` [rad] (the balance alone),
-    ``torque`` [N m] and ``tip_force`` [N] (blocked: M_lateral(p) + c_b M_S(kappa_sq), over
-    L) (docs/model.md s. 22).
+    ``pressure_moment`` M_lateral(p) [N m], ``torque`` [N m] and ``tip_force`` [N]
+    (blocked: M_lateral(p) + c_b M_S(kappa_sq), over L) (docs/model.md s. 22).
     """
     s = float(check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-"))
     a, t, b = (float(x) for x in check_section(radius, wall_thickness, base_thickness))
@@ -134,5 +134,5 @@ def sealed_state(stroke, radius, wall_thickness, length, base_thickness=None, si
     m_sq = coef[6] * squeeze_moment(k_sq, a, t, b, silicone)
     return {"pressure": p, "volume_ratio": v + p / k, "free_volume": v, "stiffness": k,
             "squeeze_curvature": k_sq, "bend_angle": (kappa_p + k_sq) * L,
-            "pressure_angle": kappa_p * L, "torque": moment + m_sq,
-            "tip_force": (moment + m_sq) / L}
+            "pressure_angle": kappa_p * L, "pressure_moment": moment,
+            "torque": moment + m_sq, "tip_force": (moment + m_sq) / L}
