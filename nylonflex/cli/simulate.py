@@ -40,10 +40,6 @@ def run(args) -> int:
     return 0
 
 
-def _deg(x):
-    return math.degrees(x)
-
-
 def summary_lines(cfg, ds) -> list[str]:
     """Lines of the run's summary: tracking, step response, power and warnings, from the
     simulation ``ds`` of the config ``cfg`` (a :class:`~nylonflex.sim.SimConfig`), which
@@ -62,16 +58,17 @@ def summary_lines(cfg, ds) -> list[str]:
         span = a.reference.span
         what = {"sine": "amplitude", "step": "step", "schedule": "range"}[a.reference.kind]
         if a.reference.kind == "sine":
-            lines.append(f"{tag}RMS error {_deg(get('rms_error')):.2f} deg = "
-                         f"{100 * get('rms_error_fraction'):.1f} % of the {_deg(span):.0f} "
+            lines.append(f"{tag}RMS error {math.degrees(get('rms_error')):.2f} deg = "
+                         f"{100 * get('rms_error_fraction'):.1f} % of the {math.degrees(span):.0f} "
                          f"deg {what} (from t = {a.rms_from:g} s)")
         else:  # an RMS over a step's thermal rise measures the rise, not the tracking
             pick = (lambda k: ds[k].values[j]) if cfg.gripper else (lambda k: ds[k].values)
             settled = settled_errors(ds["time"].values, pick("bend_angle"),
                                      pick("bend_angle_reference"))
-            lines.append(f"{tag}settled error {_deg(float(np.max(settled))):.2f} deg at most "
-                         f"= {100 * float(np.max(settled)) / span:.1f} % of the "
-                         f"{_deg(span):.0f} deg {what} (at the end of each of the "
+            worst = float(np.max(settled))
+            lines.append(f"{tag}settled error {math.degrees(worst):.2f} deg at most "
+                         f"= {100 * worst / span:.1f} % of the "
+                         f"{math.degrees(span):.0f} deg {what} (at the end of each of the "
                          f"{len(settled)} reference level(s))")
         if a.reference.kind == "step":
             rise = get("rise_time")
@@ -83,8 +80,8 @@ def summary_lines(cfg, ds) -> list[str]:
                      f"max temperature {get('temperature_max') - 273.15:.0f} degC")
         ref_max = float(np.max(reference_signal(a.reference, ds["time"].values)))
         if ref_max > get("reach") + 1e-9:
-            lines.append(f"{tag}warning: the reference reaches {_deg(ref_max):.0f} deg, "
-                         f"beyond the {_deg(get('reach')):.0f} deg the design settles at "
+            lines.append(f"{tag}warning: the reference reaches {math.degrees(ref_max):.0f} deg, "
+                         f"beyond the {math.degrees(get('reach')):.0f} deg the design settles at "
                          f"with full heating")
         if get("time_above_t_max") > 0:
             lines.append(f"{tag}warning: the muscle spent {get('time_above_t_max'):.1f} s "

@@ -263,8 +263,8 @@ def fe_stroke(radius, wall_thickness, length, strokes, *, base_thickness=None,
         :func:`.fe_bend`'s) of the bend angle (of the tip moment when ``blocked``) against
         the next coarser mesh, whose values are ``coarser_<name>``; ``pressure_error`` [1]
         the pressure's (:func:`pressure_error`: first order, safety factor 3, as the
-        pressure is not yet in its asymptotic range). NaN where the solve could not reach the stroke. ``mesh``,
-        and ``air_heating`` [K].
+        pressure is not yet in its asymptotic range). NaN where the solve could not reach
+        the stroke. ``mesh``, and ``air_heating`` [K].
 
     Raises
     ------
