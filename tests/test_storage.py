@@ -347,7 +347,7 @@ def test_the_pressure_curves_lie_over_pressure_point_and_open_over_pressure(tmp_
 @pytest.mark.parametrize("dtype", [np.int8, np.uint8])
 @pytest.mark.parametrize("piece", [1, 7, 1 << 18])
 def test_the_flag_histogram_counts_each_byte_as_a_loop_does(dtype, piece):
-    from nylonflex.storage.reader import flag_histogram
+    from nylonflex.storage.describe import flag_histogram
 
     rng = np.random.default_rng(27)
     flags = rng.integers(0, 256, size=(13, 17, 5)).astype(np.uint8).view(dtype)

@@ -72,9 +72,13 @@ def _json(args) -> int:
 
 def _fidelity_lines(cube) -> list[str]:
     """The fidelity dataset beside the cube (``nylonflex verify``), summarised, if any."""
-    from ..fe.verify import fidelity_path, fidelity_summary, open_fidelity
+    from ..fe.paths import fidelity_path, stroke_path
 
     path = fidelity_path(cube)
+    if not path.is_file() and not stroke_path(cube).is_file():
+        return []  # none: neither the FE modules nor xarray imported
+    from ..fe.verify import fidelity_summary, open_fidelity
+
     try:
         fid = open_fidelity(cube)
     except (OSError, ValueError) as exc:
@@ -90,7 +94,8 @@ def _fidelity_lines(cube) -> list[str]:
 def _stroke_fidelity_lines(cube) -> list[str]:
     """The stroke-driven fidelity dataset beside the cube (``nylonflex verify --drive
     stroke``), summarised, if any."""
-    from ..fe.verify_stroke import open_stroke_fidelity, stroke_path, stroke_summary
+    from ..fe.paths import stroke_path
+    from ..fe.verify_stroke import open_stroke_fidelity, stroke_summary
 
     path = stroke_path(cube)
     try:

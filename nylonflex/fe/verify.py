@@ -19,6 +19,7 @@ import numpy as np
 from .. import __version__
 from ..units import InputError
 from . import MESH_NAMES, extrapolated, fe_bend, require_felupe
+from .paths import fidelity_map_path, fidelity_path
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 
 __all__ = ["ANGLE_MODELS", "MAX_DESIGNS", "PAPER_EXAMPLES", "check_arguments", "check_outputs",
@@ -42,19 +43,6 @@ FRACTIONS = (0.5, 1.0)
 AXES = ("radius", "wall_thickness", "length", "coil_index", "wrap_angle")
 #: What a verify run file holds: one number a pressure each.
 RUN_KEYS = ("bend_angle", "coarser_bend_angle", "discretisation_error")
-
-
-def fidelity_path(cube) -> Path:
-    """The fidelity dataset of a cube: ``<stem>.fidelity.nc`` beside it."""
-    cube = Path(cube)
-    return cube.with_name(cube.stem + ".fidelity.nc")
-
-
-def fidelity_map_path(cube) -> Path:
-    """The fidelity map of a cube (``nylonflex verify`` draws it): ``<stem>.fidelity_map.png``
-    beside it."""
-    cube = Path(cube)
-    return cube.with_name(cube.stem + ".fidelity_map.png")
 
 
 def check_outputs(cube, overwrite: bool = False, paths=None):

@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import __version__
 from . import fe_stroke, require_felupe
+from .paths import stroke_map_path, stroke_path
 from .runs import check_drive, journaled_runs, plan_material, plan_silicone
 from .verify import AXES, check_arguments, check_outputs, sample_designs, write_fidelity
 
@@ -46,16 +47,6 @@ FREE_KEYS = ("pressure", "bend_angle", "discretisation_error", "coarser_pressure
 BLOCKED_KEYS = ("blocked_pressure", "tip_force", "blocked_discretisation_error")
 
 
-def stroke_path(cube) -> Path:
-    """The stroke-driven fidelity dataset of a cube: ``<stem>.fidelity_stroke.nc``."""
-    cube = Path(cube)
-    return cube.with_name(cube.stem + ".fidelity_stroke.nc")
-
-
-def stroke_map_path(cube) -> Path:
-    """Its map: ``<stem>.fidelity_stroke_map.png`` beside the cube."""
-    cube = Path(cube)
-    return cube.with_name(cube.stem + ".fidelity_stroke_map.png")
 
 
 def stroke_parts(cube) -> Path:

@@ -3,7 +3,9 @@
 - :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once;
 - :mod:`.netcdf4`: the netCDF-4 layout (dimensions, coordinates, attributes) in h5py;
 - :mod:`.journal`: the journal of finished slabs and the one-writer lock;
-- :mod:`.reader`: :func:`open_cube` and friends.
+- :mod:`.reader`: :func:`open_cube` and friends;
+- :mod:`.describe`: a cube's summary (``nylonflex info``) and the check of its chunks,
+  with h5py alone.
 
 The names below are imported from their modules on first use (PEP 562), so that reading a
 cube (``nylonflex info``) does not import the engine that writes one, nor Numba.
@@ -18,8 +20,8 @@ _WHERE = {
     "CUBE_FORMAT": "..engine.provenance", "VOLATILE_ATTRS": "..engine.provenance",
     "CubeFile": ".cube",
     "Journal": ".journal", "exclusive": ".journal",
-    "check_cube": ".reader", "cube_attrs": ".reader", "cube_summary": ".reader",
-    "cube_description": ".reader",
+    "check_cube": ".describe", "cube_attrs": ".reader", "cube_summary": ".describe",
+    "cube_description": ".describe",
     "open_cube": ".reader",
 }
 

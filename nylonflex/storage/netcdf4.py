@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import __version__
 
-__all__ = ["HIDDEN_ATTRS", "NOT_A_VARIABLE", "NetCDF4File"]
+__all__ = ["HIDDEN_ATTRS", "NOT_A_VARIABLE", "NetCDF4File", "read_layout"]
 
 #: Attributes the netCDF-4 layout itself uses; a variable's own attributes may not.
 HIDDEN_ATTRS = frozenset(("REFERENCE_LIST", "CLASS", "DIMENSION_LIST", "NAME",
@@ -155,6 +155,46 @@ class NetCDF4File:
             self.close_failed = True
             _PARKED.append(self)
             raise
+
+
+def read_layout(h5) -> tuple[dict, dict]:
+    """The dimensions of a netCDF-4 file open in h5py, and each variable's, as h5netcdf
+    reads them: ``({dimension: size}, {variable: (dimension, ...)})`` in file order
+    (coordinate variables included, a dimension's own scale not).
+
+    From the ids netCDF-4 stores (``_Netcdf4Dimid`` of each scale, ``_Netcdf4Coordinates``
+    of each variable): an attribute read a dataset, where h5netcdf follows every dimension
+    scale's references (40 ms of ``info`` on a sweep's cube). A variable without the ids (a
+    file another writer made) is read through its attached scales.
+    """
+    import h5py
+
+    sizes, dimid, found = {}, {}, {}
+    for name, obj in h5.items():
+        if not isinstance(obj, h5py.Dataset):
+            continue
+        attrs = obj.attrs
+        if attrs.get("CLASS") == b"DIMENSION_SCALE":
+            sizes[name] = int(obj.shape[0])
+            if "_Netcdf4Dimid" in attrs:
+                dimid[int(np.asarray(attrs["_Netcdf4Dimid"]).reshape(-1)[0])] = name
+            if str(_text(attrs.get("NAME", b""))).startswith(NOT_A_VARIABLE):
+                continue  # a dimension, not a variable
+        ids = attrs.get("_Netcdf4Coordinates")
+        found[name] = ids if ids is not None else obj
+    dims = {}
+    for name, ids in found.items():
+        if isinstance(ids, h5py.Dataset) or any(int(i) not in dimid for i in ids):
+            scales = h5[name].dims
+            dims[name] = tuple(scales[k].values()[0].name.lstrip("/")
+                               for k in range(len(scales)))
+        else:
+            dims[name] = tuple(dimid[int(i)] for i in ids)
+    return sizes, dims
+
+
+def _text(value):
+    return value.decode() if isinstance(value, bytes) else value
 
 
 #: Files whose close failed partway (a full disk): kept, never freed (see
