@@ -12,6 +12,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from .ratios import child_env
+
 __all__ = ["cold_compiles", "command_costs", "light_commands"]
 
 #: A line of ``nylonflex warmup`` for a kernel that compiled.
@@ -34,7 +36,8 @@ def _child(args, *, env=None, cwd=None) -> dict:
             command = [_GNU_TIME, "-f", "%U %S %M", "-o", str(measured), *command]
         with open(Path(tmp) / "log.txt", "w+") as log:
             proc = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=log,
-                                    stderr=subprocess.STDOUT, env=env, cwd=cwd)
+                                    stderr=subprocess.STDOUT, env=env or child_env(),
+                                    cwd=cwd)
             _, status, usage = os.wait4(proc.pid, 0)
             proc.returncode = os.waitstatus_to_exitcode(status)
             log.seek(0)
@@ -51,7 +54,7 @@ def cold_compiles() -> dict:
     ``NUMBA_CACHE_DIR`` a new folder): ``{family: (wall s, CPU s)}`` and the whole
     process's CPU seconds under ``"process_cpu_s"``."""
     with tempfile.TemporaryDirectory(prefix="nylonflex-cold-") as cache:
-        run = _child(["warmup"], env={**os.environ, "NUMBA_CACHE_DIR": cache})
+        run = _child(["warmup"], env={**child_env(), "NUMBA_CACHE_DIR": cache})
     if run["rc"] != 0:
         raise RuntimeError(f"nylonflex warmup failed with an empty cache: {run['output'][-400:]}")
     found = {m[1]: (float(m[2]), float(m[3])) for m in _COMPILED.finditer(run["output"])}

@@ -2,7 +2,12 @@
 same run, so that it holds on any host (benchmarks/README.md, "Ratios").
 
 The whole-process figures (S1, L1) are CPU seconds (user + system) of child processes,
-medians of ``pairs`` interleaved runs: the command, then its floor, then the command again.
+medians of ``pairs`` interleaved runs: the command, then its floor, then the command again,
+after one unmeasured run of each (a warm page cache and Numba cache). The children run as a
+user's would, with their bytecode cached: without ``PYTHONDONTWRITEBYTECODE`` (set on some
+build hosts, this one included), under which nylonflex's own modules were compiled from
+source on every start (about 0.1 CPU-s of ``info``) while NumPy's and h5py's, compiled at
+install, were not: the floor and the command did not start alike.
 The in-process ones (K1, K2, P1) come from :func:`.suite.run_bench`'s result.
 """
 
@@ -29,10 +34,15 @@ TARGETS = (
 )
 
 
+def child_env() -> dict:
+    """The environment of a measured child: this one, with bytecode written and read."""
+    return {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
 def _cpu(command, cwd) -> float:
     """CPU seconds [s] (user + system) of one whole child process."""
     proc = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, cwd=cwd)
+                            stderr=subprocess.DEVNULL, cwd=cwd, env=child_env())
     _, status, usage = os.wait4(proc.pid, 0)
     if os.waitstatus_to_exitcode(status) != 0:
         raise RuntimeError(f"{' '.join(map(str, command))} failed")
@@ -45,7 +55,9 @@ def floor_cpu(modules: str, cwd) -> float:
 
 
 def _paired(command, floor, pairs, cwd) -> float:
-    """Median over ``pairs`` of command CPU / floor CPU, run in turn."""
+    """Median over ``pairs`` of command CPU / floor CPU, run in turn, after one unmeasured
+    run of each."""
+    _cpu(command, cwd), floor_cpu(floor, cwd)
     out = []
     for _ in range(pairs):
         out.append(_cpu(command, cwd) / floor_cpu(floor, cwd))
