@@ -116,15 +116,17 @@ VARIANTS = {v.name: v for v in [
             "the chamber's real pressure when the wrap squeezes the sealed air: Boyle with a "
             "compliant chamber that rounds out, (p0 + p)(v_free(s) + p/K) = p0, instead of "
             "eq. 8's rigid section; lateral_pressure's balance at that pressure plus the "
-            "wall's squeeze bend c_sq s L / h",
+            "wall's squeeze bend c_sq s L / h; held straight, the higher pressure of a "
+            "chamber that cannot lengthen by bending",
             "against the stroke-driven, sealed FE twin at full stroke (docs/fidelity.md), 48 "
             "designs, each left out of the fit: bend 1.02 (0.83-1.15), 47 of 48 within 15 % "
-            "(paper 2 of 48, fe_calibrated 0); blocked force 0.94 (0.58-1.56), 22 of 48 "
-            "within 15 % (paper 4)",
-            "the full-stroke bend, range of motion and which limit binds, as the FE twin "
-            "driven as built sees them; its blocked force is an estimate within about 0.6-1.6 "
-            "of the twin's. Fitted on tc5005 with b = t on the coarse mesh: for your own "
-            "actuator settle it on the bench (docs/bench.md, nylonflex fit chamber)",
+            "(paper 2 of 48, fe_calibrated 0); blocked force 1.01 (0.78-1.13), 45 of 48 "
+            "within 15 % (paper 4); on 24 new fig12 designs bend 23 and blocked force 22 "
+            "within 15 %",
+            "the full-stroke bend, range of motion, which limit binds and the blocked force, "
+            "as the FE twin driven as built sees them. Fitted on tc5005 with b = t on the "
+            "coarse mesh: for your own actuator settle it on the bench (docs/bench.md, "
+            "nylonflex fit chamber)",
             "s. 22"),
 ]}
 

@@ -7,8 +7,8 @@ A record is one design driven to one stroke: ``design`` (``radius``, ``wall_thic
 the same stroke), optionally ``volume_ratio`` V/V0 [-] (else p0/(p0 + p), Boyle),
 ``free_volume`` [-] (the chamber's volume with the air vented, which separates the
 compliance from the rounding) and ``blocked_pressure`` [Pa] (the chamber's pressure held
-straight; kept, not fitted: the model's blocked moment takes the free pressure and c_b
-carries the rest). :func:`fe_records` reads the sealed twin's record files into this form.
+straight, which the blocked pressure's ratio is fitted to). :func:`fe_records` reads the
+sealed twin's record files into this form.
 
 Each group is fitted by linear least squares on what a record says of it:
 
@@ -16,8 +16,11 @@ Each group is fitted by linear least squares on what a record says of it:
   v_free), only from records with ``free_volume`` (without: k0 = k1 = 0, Lame's);
 - rounding: gamma_i = ln(v_free / (1 - s)^2) / s = g0 + g1 ln(t/a), v_free = V/V0 - p/K;
 - squeeze: c_i = (theta - theta_lateral(p)) h / (s L) = c0 + c1 ln(t/a);
-- blocked: (F L - M_lateral(p)) / M_S(kappa_sq) = c_b, relative least squares, with p the
-  pressure the fitted stiffness and rounding predict (what the model adds c_b's moment to).
+- blocked pressure: ln(p_b / p) = r0 + r1 x + r2 x^2 + r3 ln s + r4 a/L (x = ln(t/a)),
+  with p the free pressure the fitted stiffness and rounding predict, from the records
+  with ``blocked_pressure``;
+- blocked moment: F L = c_a M_lateral(rho p) + c_b M_S(kappa_sq), relative least
+  squares, rho the blocked pressure's ratio just fitted (what the model itself adds).
 
 Left out one design at a time, the others' coefficients predict its pressure, bend and
 blocked force through the whole model (:func:`~nylonflex.physics.sealed_model.sealed_state`
@@ -34,8 +37,8 @@ import numpy as np
 
 from ..materials import silicone_parameters
 from ..physics import P_ATM
-from ..physics.sealed import COEFFICIENT_NAMES, GAMMA_MAX, calibration
-from ..physics.sealed_model import lateral_state, sealed_state, squeeze_moment
+from ..physics.sealed import BLOCKED_NEUTRAL, COEFFICIENT_NAMES, GAMMA_MAX, calibration
+from ..physics.sealed_model import blocked_ratio, lateral_state, sealed_state
 
 __all__ = ["TOLERANCE", "calibration_document", "fe_records", "fit_sealed_chamber",
            "record_groups"]
@@ -147,19 +150,52 @@ def _fit(records, groups, idx, silicone, p_atm=P_ATM):
     g0, g1 = _linear(g["x"], np.where(np.isfinite(gamma), np.minimum(gamma, GAMMA_MAX),
                                       np.nan))
     c0, c1 = _linear(g["x"], (theta - g["theta_p"]) * g["h"] / (s * L))
-    k_sq = (c0 + c1 * g["x"]) * s / g["h"]
     blocked = np.isfinite(force) & (force > 0)  # records whose blocked solve was reached
-    m_sq = np.array([squeeze_moment(k, *_design(r)[:3], silicone)
-                     for k, r, ok in zip(k_sq, recs, blocked) if ok])
-    # the pressure moment the model itself will add: at the pressure it predicts from the
-    # coefficients just fitted, not the record's (c_b is fitted to what it completes)
-    free = (k0, k1, g0, g1, c0, c1, 1.0)
-    moment_p = np.array([_predict(r, free, silicone, p_atm)["pressure_moment"]
-                         for r, ok in zip(recs, blocked) if ok])
-    z = m_sq / (force * L)[blocked]
-    r = ((force * L)[blocked] - moment_p) / (force * L)[blocked]
-    cb = float(z @ r / (z @ z)) if np.any(z > 0) else 1.0
-    return (k0, k1, g0, g1, c0, c1, cb)
+    # the model's own free state (c_b = c_a = 1, rho = 1): its pressure, pressure moment
+    # and squeeze moment, what the blocked groups complete (fitted to what the model adds)
+    free = (k0, k1, g0, g1, c0, c1, 1.0, *BLOCKED_NEUTRAL.values())
+    states = [_predict(r, free, silicone, p_atm) for r, ok in zip(recs, blocked) if ok]
+    held = [r for r, ok in zip(recs, blocked) if ok]
+    ratio = _blocked_pressure_fit(held, [st["pressure"] for st in states])
+    rho = np.array([blocked_ratio(float(r["stroke"]), *_design(r)[:2], _design(r)[3],
+                                  (0.0,) * 8 + ratio) for r in held])
+    moment = (force * L)[blocked]
+    ca, cb = _blocked_moment_fit(rho * np.array([st["pressure_moment"] for st in states]),
+                                 np.array([st["squeeze_moment"] for st in states]), moment)
+    return (k0, k1, g0, g1, c0, c1, cb, ca, *ratio)
+
+
+def _blocked_pressure_fit(records, pressures) -> tuple:
+    """(r0, .., r4): ln(p_b / p) = r0 + r1 x + r2 x^2 + r3 ln s + r4 a/L by least squares
+    over the ``records`` with a blocked pressure (``pressures``: the model's free ones
+    [Pa]); their mean ln(p_b / p) alone (r1 .. r4 = 0) from fewer than 8; 0 from none."""
+    rows, y = [], []
+    for rec, p in zip(records, pressures):
+        p_b = float(rec.get("blocked_pressure", math.nan))
+        if math.isfinite(p_b) and p_b > 0 and p > 0:
+            a, t, _, L = _design(rec)
+            x = math.log(t / a)
+            rows.append((1.0, x, x * x, math.log(float(rec["stroke"])), a / L))
+            y.append(math.log(p_b / p))
+    if not y:
+        return (0.0,) * 5
+    if len(y) < 8:
+        return (float(np.mean(y)),) + (0.0,) * 4
+    return tuple(float(c) for c in np.linalg.lstsq(np.array(rows), np.array(y),
+                                                    rcond=None)[0])
+
+
+def _blocked_moment_fit(pressure_moment, squeeze, moment) -> tuple:
+    """(c_a, c_b) of M = c_a M_p + c_b M_S by relative least squares over the records
+    (``pressure_moment`` c_a's term at the blocked pressure, ``squeeze`` M_S, ``moment``
+    the twin's blocked moment F L, [N m] each); (1, 1) from none."""
+    if moment.size == 0:
+        return 1.0, 1.0
+    a = np.c_[pressure_moment, squeeze] / moment[:, None]
+    if moment.size < 2:
+        return 1.0, float((1.0 - a[0, 0]) / a[0, 1])
+    ca, cb = np.linalg.lstsq(a, np.ones(moment.size), rcond=None)[0]
+    return float(ca), float(cb)
 
 
 def _predict(rec, coef, silicone, p_atm):

@@ -158,7 +158,8 @@ def settings_attrs(cfg: ResolvedConfig) -> dict:
     ``cooling_speed`` [m/s] (a float64 array, one speed a set); only with ``fidelity:
     spread``, ``model_spread`` (the variants its ``<var>_model_lo``/``_hi`` range over,
     space-separated); with ``sealed_chamber`` among the models,
-    ``sealed_chamber_coefficients`` (float64 (7,), the coefficients it ran with).
+    ``sealed_chamber_coefficients`` (float64 (13,), the coefficients it ran with; (7,) in a
+    cube written before the blocked pressure's, read with its neutral values).
     :func:`cube_settings` reads them back.
     """
     def numbers(material, names, kind):
@@ -223,8 +224,9 @@ class CubeSettings:
     cooling: Cooling | None = None
     coolings: tuple[Cooling, ...] = ()
     spread: tuple[str, ...] = ()
-    #: ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb) the cube ran with;
-    #: None: the shipped ones (a cube without that model, or from before they were stored)
+    #: ``sealed_chamber``'s coefficients (k0, k1, g0, g1, c0, c1, cb, ca, r0..r4) the cube
+    #: ran with; None: the shipped ones (a cube without that model, or from before they
+    #: were stored)
     chamber: tuple | None = None
 
     def evaluate_kwargs(self, model: str | None = None, cooling: Cooling | None = None) -> dict:

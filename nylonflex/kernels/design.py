@@ -30,7 +30,8 @@ from ..physics.bending import (NEWTON_RTOL, _curvature_rates, _curvature_solve,
                                _curvature_start, _pressure_moment, _section_nodes)
 from ..physics.chamber import _gauge_pressure, _solid_fraction
 from ..physics.limits import (CAUCHY_MOMENT, INCOMPRESSIBLE_WALL, PAPER, PAPER_EQ10,
-                              SEALED_CHAMBER, _curve_factor, _curve_squeeze, _design_state_nodes,
+                              SEALED_CHAMBER, _blocked_moment, _curve_factor, _curve_squeeze,
+                              _design_state_nodes,
                               _design_values, _dynamic_values, _length_factor, _model_moment,
                               _model_state_nodes, _nylon_force_model, _paper_force, _reach,
                               _stroke_limit_model, _stroke_state_nodes, _thermal_values,
@@ -210,9 +211,12 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
                     # fe_calibrated's curvatures depend on the length: scaled here, as
                     # the model state above is length-free
                     lf = 1.0 if _PAPER_ONLY else _length_factor(model, a, length[il])
+                    # and sealed_chamber's blocked moment, its pressure held straight
+                    m_star = st[3] if _PAPER_ONLY else _blocked_moment(
+                        model, st[0], st[2], st[3], section, length[il], chamber)
                     (usable_stroke, limit, pressure_max, torque_max, tip_force_max,
                      bend_angle_max, range_fraction, nylon_force_max,
-                     nylon_use) = _design_values(st[0], st[1], st[2], st[3], st[4] * lf,
+                     nylon_use) = _design_values(st[0], st[1], st[2], m_star, st[4] * lf,
                                                  st[5], st[6] * lf, f_lim, length[il])
                     out_design[ROW_USABLE_STROKE, ia, it, il, ic, ip] = usable_stroke
                     out_flags[ROW_LIMIT, ia, it, il, ic, ip] = limit

@@ -24,8 +24,8 @@ from .chamber import (P_ATM, _gauge_pressure, _gauge_pressure_slope, _gauge_pres
 from .nylon import _free_stroke, _stroke_shape, _temperature_for_stroke, check_stroke_shape
 from .records import (CoilRow, Cycle, Drive, NodeTable, Nodes, Ogden, Reach, Section,
                       SolvedCurve, StrokeShape)
-from .sealed import COEFFICIENTS as _SEALED, _sealed_pressure, _sealed_stroke, \
-    _squeeze_curvature, sealed_coefficients
+from .sealed import COEFFICIENTS as _SEALED, _blocked_ratio, _sealed_pressure, \
+    _sealed_stroke, _squeeze_curvature, sealed_coefficients
 from .silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from .thermal import _cooling_time, _heating_power, _heating_time, \
     _steady_temperature, check_supply_rise, coil_heat_loss_per_length, coil_resistance
@@ -354,7 +354,21 @@ def _design_state_nodes(model, drive, section, lever, coil, shape, ogden, nodes,
     ms = _model_state_nodes(model, section, lever, coil, reach, ogden, table, p_atm, chamber,
                             unsolved, 0)
     lf = _length_factor(model, section.radius, drive.length)
-    return ms[0], ms[1], ms[2], ms[3], ms[4] * lf, ms[5], ms[6] * lf, ms[7], reach.temperature
+    moment = _blocked_moment(model, ms[0], ms[2], ms[3], section, drive.length, chamber)
+    return ms[0], ms[1], ms[2], moment, ms[4] * lf, ms[5], ms[6] * lf, ms[7], reach.temperature
+
+
+@formula
+def _blocked_moment(model, stroke, pressure, moment, section, length, chamber):
+    """The blocked moment M* [N m] of a design of length L [m] from its length-free state's
+    (s*, p* [Pa], M* [N m]): ``sealed_chamber``'s pressure moment taken at the chamber's
+    pressure held straight, c_a rho M_lateral(p) (M_lateral is linear in p;
+    :func:`~.sealed._blocked_ratio`), its squeeze's moment kept; the others' M* as it is."""
+    if model != SEALED_CHAMBER:
+        return moment
+    m_p = _model_moment(model, pressure, section.radius, section.wall, section.base)
+    rho = _blocked_ratio(stroke, section.radius, section.wall, length, chamber)
+    return moment + (chamber[7] * rho - 1.0) * m_p
 
 
 @formula

@@ -55,9 +55,10 @@ SolvedCurve = namedtuple("SolvedCurve", "pressure kappa rate rate2")
 
 #: ``sealed_chamber``'s coefficients (docs/model.md s. 22, :mod:`.sealed`), dimensionless:
 #: the chamber stiffness ``k0``, ``k1``, the rounding ``g0``, ``g1``, the squeeze ``c0``,
-#: ``c1`` and the blocked moment's ``cb``. Every formula takes it (the shipped one, or a
-#: sweep's ``chamber:``); the others' variants ignore it.
-SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb")
+#: ``c1``, the blocked moment's ``cb`` (the squeeze's) and ``ca`` (the pressure's), and the
+#: blocked pressure's ``r0`` .. ``r4`` (the chamber held straight). Every formula takes it
+#: (the shipped one, or a sweep's ``chamber:``); the others' variants ignore it.
+SealedCoefficients = namedtuple("SealedCoefficients", "k0 k1 g0 g1 c0 c1 cb ca r0 r1 r2 r3 r4")
 
 #: The supply and the muscle it heats (:func:`~.limits._reach`): the supply ``voltage`` V
 #: [V] (<= 0: none), the actuator's ``length`` L [m], the wrap angle ``wrap_angle`` psi

@@ -21,6 +21,16 @@ hoop direction by s, lengthens by about s above the strain-limiting skin: c_sq =
 to the blocked moment c_b M_S(kappa_sq) (the moment that holds that curvature straight:
 c_b = 1).
 
+Held straight (the blocked force), the chamber cannot lengthen by bending, so its air is
+squeezed harder than in the free bend: the blocked pressure p_b = rho p,
+
+    rho = max(1, exp(r0 + r1 x + r2 x^2 + r3 ln s + r4 a/L)),   x = ln(t/a)
+
+(a correlation in the design's dimensionless groups, fitted to the twin's blocked
+pressures; rho = 1, r = 0, is the free chamber's pressure, the model before), and the
+blocked moment is c_a M_lateral(p_b) + c_b M_S(kappa_sq) (c_a = 1: the lateral balance's
+moment at the blocked pressure).
+
 The coefficients come from :data:`CALIBRATION_FILE` (``status`` says whether they are
 fitted: the closed-form values above are not), written by :mod:`nylonflex.fe.chamber_fit`
 from FE records; the kernels compile them in as constants and their cache is keyed on the
@@ -37,15 +47,22 @@ from ._formula import formula
 from .calibrated import _initial_shear_modulus
 from .records import SealedCoefficients
 
-__all__ = ["CALIBRATION_FILE", "COEFFICIENTS", "COEFFICIENT_NAMES", "GAMMA_MAX", "ROUNDING_BOUND",
+__all__ = ["BLOCKED_NEUTRAL", "CALIBRATION_FILE", "COEFFICIENTS", "COEFFICIENT_NAMES",
+           "GAMMA_MAX", "ROUNDING_BOUND",
            "anchored_coefficients", "calibration", "sealed_coefficients"]
 
 #: The shipped coefficients, their status and provenance.
 CALIBRATION_FILE = Path(__file__).with_name("sealed_chamber.json")
 
 #: The coefficients in the order of :data:`COEFFICIENTS`: stiffness k0, k1; rounding
-#: g0, g1; squeeze c0, c1; blocked c_b.
-COEFFICIENT_NAMES = ("k0", "k1", "g0", "g1", "c0", "c1", "cb")
+#: g0, g1; squeeze c0, c1; blocked moment c_b, c_a; blocked pressure r0 .. r4.
+COEFFICIENT_NAMES = ("k0", "k1", "g0", "g1", "c0", "c1", "cb", "ca", "r0", "r1", "r2", "r3",
+                     "r4")
+
+#: The blocked pressure's coefficients and the values that leave the blocked moment as it
+#: was before they existed (the free chamber's pressure, c_a = 1): what a cube written
+#: without them (seven stored coefficients) and a ``chamber=`` dict naming none get.
+BLOCKED_NEUTRAL = {"ca": 1.0, "r0": 0.0, "r1": 0.0, "r2": 0.0, "r3": 0.0, "r4": 0.0}
 
 #: The area a D-section of perimeter P reaches as the circle of that perimeter, over its
 #: own: (pi + 2)^2 / (2 pi^2) [-], the most that rounding alone can give v_free over
@@ -69,16 +86,22 @@ COEFFICIENTS = SealedCoefficients(*(float(calibration()["coefficients"][n])
 
 def sealed_coefficients(value=None) -> SealedCoefficients:
     """The coefficients as a :class:`~.records.SealedCoefficients`: the shipped ones for
-    None, else from a dict by name or a sequence in :data:`COEFFICIENT_NAMES` order."""
+    None, else from a dict by name or a sequence in :data:`COEFFICIENT_NAMES` order (a
+    dict with none of the blocked pressure's names, or a sequence of the first seven, as a
+    cube or chamber file written before them holds, takes :data:`BLOCKED_NEUTRAL`)."""
     if value is None:
         return COEFFICIENTS
     if isinstance(value, dict):
+        value = {**BLOCKED_NEUTRAL, **value} if not any(n in value for n in BLOCKED_NEUTRAL) \
+            else value
         missing = [n for n in COEFFICIENT_NAMES if n not in value]
         if missing:
             raise ValueError(f"chamber: needs {', '.join(COEFFICIENT_NAMES)}; missing "
                              f"{', '.join(missing)}")
         value = [value[n] for n in COEFFICIENT_NAMES]
     coef = tuple(float(c) for c in value)
+    if len(coef) == len(COEFFICIENT_NAMES) - len(BLOCKED_NEUTRAL):  # a cube's before them
+        coef += tuple(BLOCKED_NEUTRAL.values())
     if len(coef) != len(COEFFICIENT_NAMES) or not all(math.isfinite(c) for c in coef):
         raise ValueError(f"chamber: needs {len(COEFFICIENT_NAMES)} finite numbers "
                          f"({', '.join(COEFFICIENT_NAMES)}), got {value!r}")
@@ -196,3 +219,16 @@ def _squeeze_curvature(stroke, radius, wall_thickness, base_thickness, coef):
     the wall's lengthening above the skin gives."""
     c_sq = coef[4] + coef[5] * math.log(wall_thickness / radius)
     return c_sq * stroke / (base_thickness + radius + 0.5 * wall_thickness)
+
+
+@formula
+def _blocked_ratio(stroke, radius, wall_thickness, length, coef):
+    """rho = p_b / p [-]: the chamber's pressure held straight over its free bend's, at
+    stroke s [-] of a design a, t, L [m]; max(1, exp(r0 + r1 x + r2 x^2 + r3 ln s + r4 a/L)),
+    x = ln(t/a) (1 at s = 0)."""
+    if stroke <= 0.0:
+        return 1.0
+    x = math.log(wall_thickness / radius)
+    rho = math.exp(coef[8] + coef[9] * x + coef[10] * x * x + coef[11] * math.log(stroke)
+                   + coef[12] * radius / length)
+    return rho if rho > 1.0 else 1.0

@@ -16,10 +16,11 @@ from .bending import _curvature_nodes, _node_table, _section_moment, NEWTON_RTOL
     quadrature_nodes
 from .chamber import P_ATM
 from .limits import LATERAL_PRESSURE, _model_moment
-from .sealed import (_boyle_pressure, _chamber_stiffness, _free_volume, _rounding,
-                     _sealed_pressure, _sealed_stroke, _squeeze_curvature, sealed_coefficients)
+from .sealed import (_blocked_ratio, _boyle_pressure, _chamber_stiffness, _free_volume,
+                     _rounding, _sealed_pressure, _sealed_stroke, _squeeze_curvature,
+                     sealed_coefficients)
 
-__all__ = ["boyle_pressure", "chamber_stiffness", "free_volume", "lateral_state",
+__all__ = ["blocked_ratio", "boyle_pressure", "chamber_stiffness", "free_volume", "lateral_state",
            "sealed_pressure", "sealed_state", "sealed_stroke", "squeeze_moment"]
 
 
@@ -46,6 +47,18 @@ def boyle_pressure(volume, stiffness=math.inf, tau=1.0, p_atm=P_ATM):
     f = np.vectorize(lambda v_, k_, t_: _boyle_pressure(v_, p_atm / k_, t_, p_atm)[0],
                      otypes=[float])
     return scalar_or_array(f(v, k, tau))
+
+
+def blocked_ratio(stroke, radius, wall_thickness, length, coefficients=None):
+    """rho = p_b / p [-]: the chamber's pressure held straight over its free bend's at
+    stroke s [-], max(1, exp(r0 + r1 x + r2 x^2 + r3 ln s + r4 a/L)), x = ln(t/a), for a,
+    t, L [m] (docs/model.md s. 22)."""
+    s = check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-")
+    a, t, _ = check_section(radius, wall_thickness, None)
+    L = check("length", length, 0.0, lo_open=True, unit="m")
+    coef = sealed_coefficients(coefficients)
+    f = np.vectorize(lambda s_, a_, t_, L_: _blocked_ratio(s_, a_, t_, L_, coef), otypes=[float])
+    return scalar_or_array(f(s, a, t, L))
 
 
 def chamber_stiffness(radius, wall_thickness, silicone="tc5005", coefficients=None):
@@ -118,8 +131,9 @@ def sealed_state(stroke, radius, wall_thickness, length, base_thickness=None, si
     Returns ``pressure`` [Pa], ``volume_ratio`` V/V0 and ``free_volume`` [-], ``stiffness``
     K [Pa], ``squeeze_curvature`` [1/m], ``bend_angle`` [rad] (``lateral_pressure``'s
     balance at p plus the squeeze), ``pressure_angle`` [rad] (the balance alone),
-    ``pressure_moment`` M_lateral(p) [N m], ``torque`` [N m] and ``tip_force`` [N]
-    (blocked: M_lateral(p) + c_b M_S(kappa_sq), over L) (docs/model.md s. 22).
+    ``pressure_moment`` M_lateral(p) [N m], ``blocked_pressure`` p_b = rho p [Pa] (held
+    straight), ``torque`` [N m] and ``tip_force`` [N] (blocked: c_a M_lateral(p_b) +
+    c_b M_S(kappa_sq), over L) (docs/model.md s. 22).
     """
     s = float(check("stroke", stroke, 0.0, 1.0, hi_open=True, unit="-"))
     a, t, b = (float(x) for x in check_section(radius, wall_thickness, base_thickness))
@@ -132,7 +146,10 @@ def sealed_state(stroke, radius, wall_thickness, length, base_thickness=None, si
     kappa_p, moment = lateral_state(p, a, t, b, silicone)
     k_sq = _squeeze_curvature(s, a, t, b, coef)
     m_sq = coef[6] * squeeze_moment(k_sq, a, t, b, silicone)
+    rho = _blocked_ratio(s, a, t, L, coef)
+    torque = coef[7] * rho * moment + m_sq  # M_lateral is linear in p
     return {"pressure": p, "volume_ratio": v + p / k, "free_volume": v, "stiffness": k,
             "squeeze_curvature": k_sq, "bend_angle": (kappa_p + k_sq) * L,
             "pressure_angle": kappa_p * L, "pressure_moment": moment,
-            "torque": moment + m_sq, "tip_force": (moment + m_sq) / L}
+            "blocked_pressure": rho * p, "squeeze_moment": m_sq, "torque": torque,
+            "tip_force": torque / L}
