@@ -24,7 +24,6 @@ from .where import where_rows
 _SLAB_VALUES = 2**20
 
 
-# ---------------------------------------------------------------------------- the scan
 def slab_rows(ds, at_loc, r0, r1):
     """Rows (SI arrays by column) of radius indices [r0, r1) after ``--at`` selection."""
     # read each given axis's bracketing pair (one index on a grid point), then collapse it
@@ -183,9 +182,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     Parameters
     ----------
     ds : xarray.Dataset
-        A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab); where
-        :func:`~nylonflex.query.where.by_variable` holds, also a cube read through h5py
-        alone (:func:`nylonflex.storage.light.open_light`).
+        A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab), or, where
+        :func:`~nylonflex.query.where.by_variable` holds, from ``storage.open_light``.
     at : dict or str or list of str, optional
         ``{axis: SI value}`` or the ``--at`` text(s).
     where : sequence of str or Condition
