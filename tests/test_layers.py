@@ -268,7 +268,8 @@ def test_the_contract_fails_when_an_arrow_runs_back(tmp_path, monkeypatch):
 #: completion's shtab (70 ms here), which only ``nylonflex completion`` needs.
 _HEAVY = {
     "info": ("numba", "dask", "xarray", "pandas", "nylonflex.engine", "shtab"),
-    "query": ("numba", "dask", "nylonflex.kernels", "shtab"),
+    # issue 49: a --where scan on the grid reads the cube through h5py alone
+    "query": ("numba", "dask", "nylonflex.kernels", "shtab", "xarray", "pandas", "h5netcdf"),
     "chart": ("numba", "dask", "xarray", "matplotlib", "h5py", "shtab"),
     "list": ("numba", "dask", "xarray", "h5py", "shtab"),
     "init": ("numba", "dask", "xarray", "h5py", "shtab"),

@@ -4,6 +4,7 @@ Expected numbers come from docs/model.md section 8 (the paper's worked examples,
 0.150 N) and from :func:`nylonflex.design_limits` (the exact value at any design).
 """
 
+import contextlib
 import csv
 import io
 import json
@@ -553,3 +554,250 @@ def test_interpolated_flags_without_the_exact_model_are_unknown_where_corners_di
     at_loc = {n: query.locate(ds, n, v) for n, v in dict(at, radius=6e-3).items()}
     rows = query.slab_rows(ds, at_loc, at_loc["radius"][0], at_loc["radius"][1] + 1)
     assert rows["validity"][0] == 0  # both corners clean
+
+
+# ---------------------------------------------------------------------------- issue 49
+# A --where query on the grid of a one-model cube reads it through h5py alone
+# (nylonflex.storage.light): the same rows, bit for bit, as through xarray.
+SPREAD_GRID = {
+    "name": "spread",
+    "fidelity": {"spread": ["paper", "lateral_pressure"]},
+    "grid": {
+        "radius": {"values": [5, 10, 15, 20], "units": "mm"},
+        "wall_thickness": {"values": [1, 2, 6], "units": "mm"},
+        "length": {"values": [70, 90], "units": "mm"},
+        "coil_index": {"values": [1.1, 1.7]},
+        "wrap_angle": {"values": [5, 8], "units": "deg"},
+    },
+    "curves": {"stroke": {"start": 0, "stop": 0.1, "num": 6},
+               "pressure": {"start": 0, "stop": 40, "num": 5, "units": "kPa"}},
+}
+
+
+def _incomplete(cube, folder):
+    """A copy of ``cube`` as a sweep stopped after its first 3 radii leaves it."""
+    part = folder / "part.h5"
+    part.write_bytes(cube.read_bytes())
+    with h5py.File(part, "r+") as f:
+        f.attrs["complete"] = "false"
+        f["slab_done"][3:] = 0
+    return part
+
+
+@pytest.fixture(scope="module")
+def cubes(cube, tmp_path_factory):
+    """The complete cube, an incomplete copy, and a cube with a model spread (OPTIONAL
+    columns)."""
+    folder = tmp_path_factory.mktemp("light")
+    spread = folder / "spread.h5"
+    run_sweep(parse_config(SPREAD_GRID), out=spread).close()
+    return {"complete": cube, "incomplete": _incomplete(cube, folder), "spread": spread}
+
+
+@contextlib.contextmanager
+def _views(cubes, which):
+    """The cube ``which`` of :func:`cubes` through h5py alone and through xarray (each
+    with the incomplete cube's warning)."""
+    from nylonflex.storage import open_light
+
+    views = []
+    try:
+        for opener in (open_light, open_cube):
+            with pytest.warns(UserWarning, match="is incomplete") if which == "incomplete" \
+                    else contextlib.nullcontext():
+                views.append(opener(cubes[which]))
+        yield views
+    finally:
+        for view in views:
+            view.close()
+
+
+@pytest.mark.parametrize("which", ["complete", "incomplete", "spread"])
+def test_the_h5py_view_reads_what_xarray_reads(cubes, which):
+    with _views(cubes, which) as (light, ds):
+        assert type(light).__name__ == "LightCube" and light.sizes == dict(ds.sizes)
+        assert set(light.dims) == set(ds.dims) and set(light.variables) == set(ds.variables)
+        assert set(light.attrs) == set(ds.attrs)
+        for key, value in ds.attrs.items():  # a one-element array: its number here
+            assert np.array_equal(np.ravel(light.attrs[key]), np.ravel(value)), key
+        for name, var in ds.variables.items():
+            mine = light[name]
+            assert mine.dims == var.dims and mine.dtype.kind == var.dtype.kind, name
+            want = np.asarray(var.values, dtype=float)
+            assert np.array_equal(mine.values, want, equal_nan=True), name
+            index = {"radius": slice(1, 4)} if "radius" in var.dims else {}
+            box = np.asarray(var.isel(index).values, dtype=float)
+            assert np.array_equal(light.read(name, index), box, equal_nan=True), name
+        assert np.isnan(light.read("tip_force_max")).any() == (which == "incomplete")
+
+
+def _same(a, b):
+    assert a.matched == b.matched and a.columns == b.columns and a.point == b.point
+    for name in a.columns:
+        x, y = a.data[name], b.data[name]
+        assert x.dtype == y.dtype and x.shape == y.shape, name
+        assert x.tobytes() == y.tobytes(), name  # bit for bit, NaN included
+
+
+@pytest.mark.parametrize("which", ["complete", "incomplete", "spread"])
+@pytest.mark.parametrize("at, where, sort, limit", [
+    (None, ["tip_force_max >= 0.3 N"], None, None),
+    (None, ["tip_force_max >= 0.3 N"], None, 0),
+    (None, ["tip_force_max >= 0.3 N"], None, 3),
+    (None, ["wall_thickness <= 3 mm", "nylon_use > 0.5", "bend_angle_max < 200 deg"],
+     "-tip_force_max", 5),
+    (None, ["limit == strength", "radius >= 10 mm"], "nylon_use", None),
+    ("coil_index=1.7", ["range_fraction < 1"], None, None),
+    (AT_2.replace("7.5mm", "10mm"), ["tip_force_max >= 0 N"], None, None),
+    (None, ["tip_force_max > 1e9 N"], None, None),
+    (None, ["model == paper", "validity == 0"], "-bend_angle_max", 4),
+])
+def test_the_h5py_view_answers_as_xarray_does(cubes, which, at, where, sort, limit):
+    with _views(cubes, which) as (light, ds):
+        assert query.by_variable(light, at, where, False)
+        _same(query.query_cube(light, at=at, where=where, sort=sort, limit=limit),
+              query.query_cube(ds, at=at, where=where, sort=sort, limit=limit))
+
+
+def test_spread_columns_are_tested_and_kept_through_the_h5py_view(cubes):
+    with _views(cubes, "spread") as (light, ds):
+        where = ["tip_force_max_model_hi >= 0.3 N", "validity_model_any == 0"]
+        res = query.query_cube(light, where=where, sort="-tip_force_max_model_lo")
+        _same(res, query.query_cube(ds, where=where, sort="-tip_force_max_model_lo"))
+        assert res.matched > 0 and "validity_model_any" in res.columns
+        assert np.all(res.data["tip_force_max_model_hi"] >= 0.3)
+
+
+def _both(monkeypatch, capsys, *argv):
+    """``nylonflex query ARGV`` as it runs (the view it opens, its rc, stdout, stderr), and
+    again with the h5py view turned off (xarray's reader)."""
+    import nylonflex.storage
+    from nylonflex.cli import query as cli_query
+
+    opened = []
+    real = cli_query.open_cube_for
+
+    def spy(*args, **kwargs):
+        opened.append(real(*args, **kwargs))
+        return opened[-1]
+
+    monkeypatch.setattr(cli_query, "open_cube_for", spy)
+    first = run(capsys, *argv)
+    nylonflex.storage.open_light  # loaded, so that it can be replaced
+    monkeypatch.setattr(nylonflex.storage, "open_light", lambda path, **kw: None)
+    second = run(capsys, *argv)
+    monkeypatch.undo()
+    return [type(ds).__name__ for ds in opened], first, second
+
+
+#: Options of ``nylonflex query`` answered through the h5py view.
+LIGHT_QUERIES = [
+    ["--where", "tip_force_max >= 0.5 N"],
+    ["--where", "tip_force_max >= 0.3 N", "--limit", "0"],
+    ["--where", "tip_force_max >= 0.3 N", "--limit", "all", "--format", "csv"],
+    ["--where", "tip_force_max >= 0.3 N", "--limit", "3", "--format", "csv"],
+    ["--where", "bend_angle_max >= 90 deg", "--sort", "-tip_force_max", "--format", "json",
+     "--limit", "4"],
+    ["--where", "radius <= 10 mm", "--where", "limit == stroke", "--columns", "all"],
+    ["--where", "bend_angle_max >= 100000"],  # nothing: a note on the bare number's unit
+    ["--where", "radius <= 0.01"],
+    ["--at", "wrap_angle=8deg", "--where", "tip_force_max >= 0.3 N", "--format", "json"],
+]
+
+
+@pytest.mark.parametrize("which, extra", [
+    *(("complete", extra) for extra in LIGHT_QUERIES),
+    *((which, LIGHT_QUERIES[k]) for which in ("incomplete", "spread") for k in (2, 4, 6, 8)),
+])
+def test_the_command_prints_the_same_through_h5py_and_xarray(cubes, monkeypatch, capsys,
+                                                             which, extra):
+    opened, light, full = _both(monkeypatch, capsys, cubes[which], *extra)
+    assert opened == ["LightCube", "Dataset"]
+    assert light == full and light[0] == 0
+    assert ("incomplete" in light[2]) == (which == "incomplete")
+    assert light[2].count("warning") == (which == "incomplete")
+
+
+@pytest.mark.parametrize("extra", [
+    ["--limit", "3"],  # no --where: the slab reader
+    ["--at", "radius=7.3mm", "--where", "tip_force_max >= 0.1 N"],  # off the grid
+    ["--at", "radius=7.5mm", "--where", "tip_force_max >= 0.1 N", "--interpolate"],
+    ["--where", "model == paper"],
+    ["--at", "radius=99mm", "--where", "tip_force_max >= 0.1 N"],  # refused, as before
+])
+def test_other_queries_keep_xarray(cube, monkeypatch, capsys, extra):
+    opened, light, full = _both(monkeypatch, capsys, cube, *extra)
+    assert light == full and opened == ["Dataset", "Dataset"]
+
+
+def test_a_cube_of_several_models_and_cooling_sets_keeps_xarray(tmp_path, monkeypatch,
+                                                                capsys):
+    from nylonflex.storage import open_light
+
+    raw = dict(SMALL, model=["paper", "lateral_pressure"], supply={"voltage": 12},
+               cooling=["still_air", "still_water"])
+    path = write_cube(tmp_path, raw)
+    assert open_light(path) is None  # string dimensions: xarray's reader
+    opened, light, full = _both(monkeypatch, capsys, path, "--where",
+                                "tip_force_max >= 0.5 N", "--format", "json")
+    assert opened == ["Dataset", "Dataset"] and light == full and light[0] == 0
+    doc = json.loads(light[1])
+    with open_cube(path) as ds:
+        want = int((ds["tip_force_max"] >= 0.5).sum())
+        assert doc["matching"] == want > 0
+        assert {row["model"] for row in doc["designs"]} <= {"paper", "lateral_pressure"}
+        opened, light, _ = _both(monkeypatch, capsys, path, "--where", "model == paper",
+                                 "--where", "cooling == still_air", "--where",
+                                 "tip_force_max >= 0.5 N", "--format", "json", "--limit",
+                                 "all")
+        doc = json.loads(light[1])
+        sub = ds["tip_force_max"].sel(model="paper", cooling="still_air") \
+            if "cooling" in ds["tip_force_max"].dims else ds["tip_force_max"].sel(model="paper")
+        assert doc["matching"] == int((sub >= 0.5).sum()) > 0
+
+
+def test_the_h5py_view_refuses_in_open_cubes_words(tmp_path, cube):
+    from nylonflex.storage import open_light
+
+    bad = tmp_path / "bad.h5"
+    bad.write_text("not hdf5")
+    for path in (bad, tmp_path / "none.h5"):
+        with pytest.raises(InputError) as light:
+            open_light(path)
+        with pytest.raises(InputError) as full:
+            open_cube(path)
+        assert str(light.value) == str(full.value)
+    odd = tmp_path / "odd.h5"
+    odd.write_bytes(cube.read_bytes())
+    with h5py.File(odd, "r+") as f:
+        f["tip_force_max"].attrs["units"] = "kN"
+    with pytest.raises(InputError) as light:
+        open_light(odd)
+    with pytest.raises(InputError) as full:
+        open_cube(odd)
+    assert str(light.value) == str(full.value) and "registry" in str(light.value)
+    packed = tmp_path / "packed.h5"  # a packed variable: for xarray to decode
+    packed.write_bytes(cube.read_bytes())
+    with h5py.File(packed, "r+") as f:
+        f["tip_force_max"].attrs["scale_factor"] = 2.0
+    assert open_light(packed) is None
+
+
+def test_a_where_query_imports_neither_xarray_nor_pandas(cube):
+    # issue 49: python -m nylonflex query CUBE --where ..., in its own process, from this
+    # checkout
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    probe = ("import atexit, runpy, sys\n"
+             "atexit.register(lambda: print('LOADED', [m for m in ('xarray', 'pandas', "
+             "'h5netcdf', 'h5py') if m in sys.modules]))\n"
+             f"sys.argv = ['nylonflex', 'query', {str(cube)!r}, '--where', "
+             "'tip_force_max >= 0.5 N']\n"
+             "runpy.run_module('nylonflex', run_name='__main__')\n")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          cwd=Path(__file__).resolve().parents[1], timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "designs shown of" in done.stdout
+    assert done.stdout.splitlines()[-1] == "LOADED ['h5py']"

@@ -9,13 +9,24 @@ import time
 import warnings
 
 
-def open_cube_for(command: str, path):
-    """:func:`nylonflex.open_cube` for a command: an incomplete cube's warning as one line."""
-    from ..storage import open_cube
+def open_cube_for(command: str, path, light=None):
+    """:func:`nylonflex.open_cube` for a command: an incomplete cube's warning as one line.
+
+    ``light``: a test of a :class:`~nylonflex.storage.light.LightCube` (the cube read
+    through h5py alone, no xarray); where the cube opens as one and passes it, that view is
+    returned instead of the Dataset (with the same checks and warning).
+    """
+    from ..storage import open_cube, open_light
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        ds = open_cube(path)
+        ds = open_light(path) if light is not None else None
+        if ds is not None and not light(ds):
+            ds.close()
+            ds = None
+        if ds is None:
+            del caught[:]  # open_cube warns again
+            ds = open_cube(path)
     for w in caught:
         say(f"nylonflex {command}: warning: {w.message}")
     return ds

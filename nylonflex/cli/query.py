@@ -62,12 +62,15 @@ def add_arguments(q):
 def run(args) -> int:
     import numpy as np
 
-    from ..query import (format_csv, format_json, format_table, held_back, parse_at,
-                         parse_where, query_cube)
-
+    from ..query import (by_variable, format_csv, format_json, format_table, held_back,
+                         parse_at, parse_where, query_cube)
     from ..query.notes import unit_notes
 
-    ds = open_cube_for("query", args.cube)  # an incomplete cube: queried where it is done
+    # a --where scan on the grid reads the cube through h5py alone (no xarray nor pandas)
+    light = (lambda c: by_variable(c, args.at, args.where, args.interpolate)) \
+        if args.where and not args.interpolate else None
+    # an incomplete cube: queried where it is done
+    ds = open_cube_for("query", args.cube, light=light)
     try:
         where = parse_where(args.where)
         with progress_bar("query", unit="slab", quiet=args.quiet) as bar:

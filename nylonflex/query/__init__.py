@@ -33,10 +33,13 @@ from .format import (cell_text, flag_names, format_csv, format_json, format_tabl
 from ..conditions import (COLUMNS, EXACT, GRID, HEADLINE, INTERPOLATED, OPS, OPTIONAL,
                     Condition, default_columns, parse_at, parse_columns, parse_condition,
                     parse_constraint, parse_requirements, parse_where)
-from .scan import QueryResult, at_value, locate, query_cube, slab_rows
+from .grid import at_value, locate
+from .result import QueryResult
+from .scan import query_cube, slab_rows
+from .where import by_variable
 
 __all__ = ["COLUMNS", "EXACT", "GRID", "HEADLINE", "INTERPOLATED", "OPS", "OPTIONAL",
-           "Condition", "QueryResult", "at_value",
+           "Condition", "QueryResult", "at_value", "by_variable",
            "cell_text", "default_columns", "flag_names", "format_csv", "format_json",
            "format_table", "held_back", "locate", "parse_at", "parse_columns",
            "parse_condition", "parse_constraint", "parse_requirements", "parse_where",

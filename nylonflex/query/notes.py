@@ -15,6 +15,7 @@ import numpy as np
 from ..units import bare_number, from_si
 from ..variables import AXES, VARIABLES
 from ..conditions import CONDITION_PATTERN, Condition
+from .where import read_values
 
 __all__ = ["unit_notes", "variable_range"]
 
@@ -25,12 +26,11 @@ def variable_range(ds, name, slab_values: int = 2**20):
     if name in AXES:
         grid = ds[name].values.astype(float)
         return float(grid.min()), float(grid.max())
-    da = ds[name]
-    per_radius = max(1, int(np.prod([n for d, n in da.sizes.items() if d != "radius"])))
+    per_radius = max(1, int(np.prod([ds.sizes[d] for d in ds[name].dims if d != "radius"])))
     step = max(1, slab_values // per_radius)
     lo, hi = np.inf, -np.inf
     for r0 in range(0, ds.sizes["radius"], step):
-        x = np.asarray(da.isel(radius=slice(r0, r0 + step)).values, dtype=float)
+        x = read_values(ds, name, {"radius": slice(r0, r0 + step)})
         x = x[np.isfinite(x)]
         if x.size:
             lo, hi = min(lo, float(x.min())), max(hi, float(x.max()))
@@ -43,7 +43,8 @@ def unit_notes(ds, conditions, matched) -> list[str]:
     Parameters
     ----------
     ds : xarray.Dataset
-        The cube queried.
+        The cube queried (or a cube read through h5py alone:
+        :func:`~nylonflex.query.where.read_values`).
     conditions : sequence of Condition or str
         The ``--where`` conditions (strings that are not a Condition are skipped).
     matched : int

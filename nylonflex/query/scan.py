@@ -3,7 +3,7 @@
 ``--where`` is tested one variable at a time (a slab none of whose designs passes is left
 after the first variable that rules it out) and the other columns are read only over the
 box of a slab's matching rows, so a selective query reads little more than the variables
-it tests.
+it tests (:mod:`.where`).
 """
 
 from __future__ import annotations
@@ -11,98 +11,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics import design_limits
-from ..units import InputError, from_si
-from ..variables import CATEGORIES, AXES, DESIGN, SPREAD, VARIABLES
-from .format import rows_note, shown_columns
-from .frames import html_table, rows_frame
+from ..units import InputError
+from ..variables import CATEGORIES, AXES, DESIGN, SPREAD
 from ..conditions import (CATEGORY_WHERE, COLUMNS, EXACT, GRID, INTERPOLATED, OPTIONAL, Condition,
                     parse_sort, missing_hint, parse_at, parse_columns, parse_condition)
+from .grid import at_value, locate
+from .result import QueryResult
 from .spread import PER_LENGTH, TIMES_LENGTH, exact_spread, spread_variants
+from .where import where_rows
 
-# Values this close (relative to the axis span) to a grid value are that grid value.
-_GRID_RTOL = 1e-6
 # Slab size when scanning a cube: about this many float64 values per variable.
 _SLAB_VALUES = 2**20
-
-
-def locate(ds, name, value):
-    """Where ``value`` [SI] sits on axis ``name``: ``(i0, i1, weight of i1, on_grid)``.
-
-    Raises
-    ------
-    InputError
-        The value lies outside the axis's range (the message gives it in display units).
-    """
-    grid = ds[name].values.astype(float)
-    lo, hi = float(grid.min()), float(grid.max())
-    tol = _GRID_RTOL * max(hi - lo, abs(hi), abs(lo), 1e-300)
-    near = int(np.argmin(np.abs(grid - value)))
-    if abs(grid[near] - value) <= tol:
-        return near, near, 0.0, True
-    if not lo - tol <= value <= hi + tol:
-        v = VARIABLES[name]
-        unit = "" if v.display == "1" else f" {v.display}"
-        shown = ", ".join(f"{x:g}" for x in from_si(grid, v.display)) if grid.size <= 8 \
-            else f"{from_si(lo, v.display):g} .. {from_si(hi, v.display):g}"
-        bare = f" (a bare number is read in {v.display})" if unit else ""
-        raise InputError(f"--at: {name}={from_si(value, v.display):g}{unit} is outside the "
-                         f"cube's grid; {name} takes {shown}{unit}{bare}")
-    if np.any(np.diff(grid) <= 0):  # a grid the sweep wrote is increasing; be safe
-        raise InputError(f"--at: the cube's {name} axis is not increasing; cannot interpolate")
-    i1 = int(np.searchsorted(grid, value))
-    i0 = i1 - 1
-    return i0, i1, float((value - grid[i0]) / (grid[i1] - grid[i0])), False
-
-
-# ---------------------------------------------------------------------------- the scan
-class QueryResult:
-    """Rows of a query: ``data`` maps each column to an SI array.
-
-    Attributes
-    ----------
-    data : dict of str to numpy.ndarray
-        One array per column of :data:`COLUMNS`, SI; ``limit`` and ``validity`` hold
-        whole numbers (NaN: unknown).
-    point : str or None
-        ``"grid point"``, ``"exact model"`` or ``"interpolated"`` for an ``--at`` query,
-        else None.
-    interpolated : list of str
-        The ``--at`` axes that lie between grid points (evaluated exactly, or interpolated
-        when ``point`` is ``"interpolated"``).
-    matched : int or None
-        Designs that met the conditions (every one is counted, shown or not).
-    single : bool
-        The query named one design (all five axes in ``--at``).
-    """
-
-    def __init__(self, data, point, interpolated, matched, single, at, columns=COLUMNS,
-                 chosen=None, asked=(), flags=None, every=False):
-        self.data, self.point, self.interpolated = data, point, interpolated
-        self.matched, self.single, self.at = matched, single, at
-        self.columns = tuple(columns)  # COLUMNS and the cube's OPTIONAL ones
-        #: the columns ``--columns`` named (None: the format's default)
-        self.chosen = None if chosen is None else tuple(chosen)
-        #: ``--columns all``: every column (a table still leaves out the all-NaN ones)
-        self.every = every
-        #: the names ``--where`` tests and ``--sort`` orders by (a table shows them)
-        self.asked = tuple(asked)
-        #: with ``--interpolate``: where ``limit`` and ``validity`` came from, "exact
-        #: model" or "unknown where the grid points disagree"; None otherwise
-        self.flags = flags
-
-    def __len__(self):
-        return len(self.data[COLUMNS[0]])
-
-    def to_dataframe(self):
-        """The rows as a pandas DataFrame, every column in SI (``df.attrs["units"]``),
-        ``limit`` and ``validity`` as numbers (NaN: unknown), as ``--format csv``."""
-        extra = {"point": [self.point] * len(self)} if self.point else None
-        return rows_frame(self.data, shown_columns(self, "csv"), extra)
-
-    def _repr_html_(self) -> str:
-        """The table ``nylonflex query`` prints, as HTML (display units, flags by name)."""
-        caption = rows_note(self) if self.matched is not None else (self.point or "")
-        return html_table(self.data, shown_columns(self), len(self), caption)
 
 
 def slab_rows(ds, at_loc, r0, r1):
@@ -169,89 +88,6 @@ def slab_rows(ds, at_loc, r0, r1):
     for name in (n for n in OPTIONAL if n in sub):
         rows[name] = sub[name].transpose(*dims).values.reshape(-1)
     return rows
-
-
-def _where_rows(ds, at_loc, r0, r1, conditions, room=None):
-    """The rows of radius indices [r0, r1) that meet every condition (``--at`` on the grid),
-    at most ``room`` of them (the first in grid order; None: all), and how many matched.
-
-    The conditions are tested one variable at a time (axes first: they cost no read), each
-    variable read only over the box (an index range per axis) that still holds matching
-    designs after the ones before; the slab is left as soon as nothing matches. The other
-    columns are then read over the final box of the rows kept only (none once ``--limit``
-    rows are kept: the scan then reads the tested variables alone), and the matching rows
-    picked from it, in grid order, as :func:`slab_rows` gives them.
-    """
-    fixed = {name: loc[0] for name, loc in at_loc.items() if name != "radius"}
-    dims = [d for d in AXES if d not in fixed]
-    start = {d: (r0 if d == "radius" else 0) for d in dims}
-    box = {d: (0, (r1 - r0) if d == "radius" else ds.sizes[d]) for d in dims}
-    coords = {d: ds[d].values.astype(float)[start[d]:start[d] + box[d][1]] for d in dims}
-
-    def sel(b):
-        index = dict(fixed)
-        index.update({d: slice(start[d] + b[d][0], start[d] + b[d][1]) for d in dims})
-        return index
-
-    def axis_values(name, b):
-        if name in fixed:
-            return np.full([b[d][1] - b[d][0] for d in dims], at_value(at_loc, name, ds))
-        shape = [-1 if d == name else 1 for d in dims]
-        values = coords[name][b[name][0]:b[name][1]].reshape(shape)
-        return np.broadcast_to(values, [b[d][1] - b[d][0] for d in dims])
-
-    def read(name, b):
-        if name not in ds:  # heating_time: only with a supply
-            return np.full([b[d][1] - b[d][0] for d in dims], np.nan)
-        return np.asarray(ds[name].isel(sel(b)).transpose(*dims).values, dtype=float)
-
-    def shrink(mask, box):
-        """The matches' bounding box, and the mask cut to it."""
-        cut = {}
-        for j, d in enumerate(dims):
-            hit = np.flatnonzero(mask.any(axis=tuple(k for k in range(len(dims)) if k != j)))
-            cut[d] = (int(hit[0]), int(hit[-1]) + 1)
-        return (mask[tuple(slice(*cut[d]) for d in dims)],
-                {d: (box[d][0] + cut[d][0], box[d][0] + cut[d][1]) for d in dims})
-
-    empty = {name: np.empty(0) for name in COLUMNS + tuple(n for n in OPTIONAL if n in ds)}
-    read_at = {}  # name: (values, the box they were read over)
-    mask = None
-    for c in sorted(conditions, key=lambda c: c.name not in AXES):
-        if c.name in AXES:
-            x = axis_values(c.name, box)
-        else:
-            x = read(c.name, box)
-            read_at[c.name] = (x, dict(box))
-        m = c.mask(x)
-        mask = m if mask is None else mask & m
-        if not mask.any():
-            return empty, 0
-        mask, box = shrink(mask, box)  # before the next read
-    matched = int(mask.sum())
-    if room is not None:
-        if room <= 0:
-            return empty, matched
-        first = np.flatnonzero(mask.ravel())[:room]
-        mask = np.zeros(mask.shape, dtype=bool)
-        mask.ravel()[first] = True
-        mask, box = shrink(mask, box)
-    rows = {name: axis_values(name, box)[mask] for name in AXES}
-    for name in (*DESIGN, *(n for n in OPTIONAL if n in ds)):
-        if name in read_at:
-            x, b = read_at[name]
-            x = x[tuple(slice(box[d][0] - b[d][0], box[d][1] - b[d][0]) for d in dims)]
-        else:
-            x = read(name, box)
-        rows[name] = x[mask]
-    return rows, matched
-
-
-def at_value(at_loc, name, ds):
-    """SI value of an ``--at`` axis after location (the grid value on a grid point)."""
-    i0, i1, w, on_grid = at_loc[name]
-    grid = ds[name].values.astype(float)
-    return float(grid[i0]) if on_grid else float(grid[i0] * (1 - w) + grid[i1] * w)
 
 
 #: Designs up to which the exact model of an off-grid ``--at`` runs the physics layer's
@@ -346,7 +182,8 @@ def query_cube(ds, at=None, where=(), sort=None, limit=None, *, interpolate=Fals
     Parameters
     ----------
     ds : xarray.Dataset
-        A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab).
+        A cube from :func:`nylonflex.open_cube` (lazy; read slab by slab), or, where
+        :func:`~nylonflex.query.where.by_variable` holds, from ``storage.open_light``.
     at : dict or str or list of str, optional
         ``{axis: SI value}`` or the ``--at`` text(s).
     where : sequence of str or Condition
@@ -497,7 +334,7 @@ def _rows_of_slab(ds, at, at_loc, bounds, conditions, room, *, model, exact, fla
     elif conditions and not off_grid and not any(c in ds.dims for c in CATEGORIES):
         # variable by variable (a cube of several models or cooling sets is read whole,
         # per slab)
-        rows, n_where = _where_rows(ds, at_loc, r0, r1, conditions, room)
+        rows, n_where = where_rows(ds, at_loc, r0, r1, conditions, room)
     else:
         rows = slab_rows(ds, at_loc, r0, r1)
     if flags == EXACT:

@@ -5,7 +5,9 @@
 - :mod:`.journal`: the journal of finished slabs and the one-writer lock;
 - :mod:`.reader`: :func:`open_cube` and friends;
 - :mod:`.describe`: a cube's summary (``nylonflex info``) and the check of its chunks,
-  with h5py alone.
+  with h5py alone;
+- :mod:`.light`: :func:`open_light`, a cube read through h5py alone (no xarray), for the
+  variable-by-variable scan of ``nylonflex query --where``.
 
 The names below are imported from their modules on first use (PEP 562), so that reading a
 cube (``nylonflex info``) does not import the engine that writes one, nor Numba.
@@ -23,6 +25,7 @@ _WHERE = {
     "check_cube": ".describe", "cube_attrs": ".reader", "cube_summary": ".describe",
     "cube_description": ".describe",
     "open_cube": ".reader",
+    "LightCube": ".light", "open_light": ".light",
 }
 
 __all__ = sorted(_WHERE)

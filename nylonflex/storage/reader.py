@@ -13,8 +13,9 @@ from ..variables import AXES, CURVES, DESIGN, SPREAD, UNCERTAIN, is_complete, va
 from .cube import STORED_DIMS, require_filters
 from .journal import Journal
 
-__all__ = ["MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_chunk_sizes", "cube_attrs",
-           "logical_dims", "open_cube", "portable_encoding"]
+__all__ = ["MASKED", "MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_chunk_sizes",
+           "checked_attrs", "cube_attrs", "incomplete_warning", "logical_dims", "open_cube",
+           "portable_encoding"]
 
 #: The largest chunk of a cube read [bytes]: a chunk is decoded whole, and nylonflex writes
 #: chunks of about 2 MB (a crafted 2^29-element chunk made ``info`` allocate 4 GiB).
@@ -69,6 +70,48 @@ def _attr(v):
     return v
 
 
+def checked_attrs(path) -> dict:
+    """The global attributes of the cube at ``path`` (:func:`cube_attrs`), after the checks
+    every reader of it makes before anything is decoded: the file is a nylonflex cube, no
+    chunk or axis is too large to read (:func:`check_chunk_sizes`), and HDF5 can decompress
+    its codec (:func:`~nylonflex.storage.cube.require_filters`). :func:`open_cube` and
+    :func:`~nylonflex.storage.light.open_light` share it, so both refuse in the same words.
+
+    Raises
+    ------
+    InputError
+        The path is missing (naming an interrupted run's slabs where there are some), not
+        HDF5, not a nylonflex cube, or holds a chunk or axis too large.
+    MissingPlugin
+        Its codec (zstd, lz4) needs a filter plugin that is not installed.
+    """
+    path = Path(path)
+    if not path.exists():
+        parts = Journal(path)
+        extra = (f"; an interrupted run's slabs are in {parts.dir} (finish it with "
+                 "'nylonflex sweep CONFIG --resume')") if parts.exists() else ""
+        raise InputError(f"{path}: no such cube{extra}")
+    attrs = cube_attrs(path)
+    if attrs is None:
+        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
+                         "written by 'nylonflex sweep')")
+    check_chunk_sizes(path)
+    require_filters(attrs.get("compression"))  # zstd and lz4 need a filter plugin
+    return attrs
+
+
+#: The variables an incomplete cube reads as NaN at the radii not computed (those over
+#: ``radius``): every design, curve, sampled and spread variable; a tracking one is not.
+MASKED = frozenset({**DESIGN, **CURVES, **UNCERTAIN, **SPREAD})
+
+
+def incomplete_warning(path, done) -> str:
+    """The one line an incomplete cube opens with: how many of its radii are computed
+    (``done``, bool over ``radius``)."""
+    return (f"{path} is incomplete: {int(done.sum())} of {done.size} radii computed; the "
+            "rest is masked")
+
+
 def open_cube(path, *, quiet: bool = False):
     """Open a cube written by ``nylonflex sweep`` as an :class:`xarray.Dataset` (lazy).
 
@@ -84,18 +127,8 @@ def open_cube(path, *, quiet: bool = False):
 
     from .accessor import CubeAccessor  # noqa: F401 - registers ds.nf
 
+    attrs = checked_attrs(path)
     path = Path(path)
-    if not path.exists():
-        parts = Journal(path)
-        extra = (f"; an interrupted run's slabs are in {parts.dir} (finish it with "
-                 "'nylonflex sweep CONFIG --resume')") if parts.exists() else ""
-        raise InputError(f"{path}: no such cube{extra}")
-    attrs = cube_attrs(path)
-    if attrs is None:
-        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
-                         "written by 'nylonflex sweep')")
-    check_chunk_sizes(path)
-    require_filters(attrs.get("compression"))  # zstd and lz4 need a filter plugin
     ds = logical_dims(xr.open_dataset(path, engine="h5netcdf"))
     for var in ds.variables.values():
         var.encoding = portable_encoding(var.encoding)
@@ -107,10 +140,8 @@ def open_cube(path, *, quiet: bool = False):
     if not is_complete(attrs):
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
-            warnings.warn(f"{path} is incomplete: {int(done.sum())} of {done.size} radii "
-                          "computed; the rest is masked", stacklevel=2)
-        for name in [n for n in ds.data_vars
-                     if n in {**DESIGN, **CURVES, **UNCERTAIN, **SPREAD}]:
+            warnings.warn(incomplete_warning(path, done), stacklevel=2)
+        for name in [n for n in ds.data_vars if n in MASKED]:
             if "radius" in ds[name].dims:
                 ds[name] = _masked(ds[name].variable, done)
     return ds
