@@ -1,5 +1,6 @@
 import math
 import os
+import signal
 
 import pytest
 from hypothesis import settings
@@ -10,6 +11,16 @@ from hypothesis import settings
 settings.register_profile("local", deadline=None)
 settings.register_profile("ci", deadline=None, derandomize=True)
 settings.load_profile("ci" if os.environ.get("CI") else "local")
+
+
+# A job a shell starts in the background (a CI runner's, `./.ci/run &`) begins with SIGINT
+# ignored (POSIX: asynchronous commands ignore SIGINT and SIGQUIT), and every process it
+# starts inherits that: the tests that stop a command with Ctrl-C (SIGINT) then saw it go
+# on to the end (CI, 2026-12-07: test_a_signal_before_the_sweeps_own_handler_is_a_stop
+# [INT-*] exit 0 and 1, where a terminal's run gives 130). The tests run as from a
+# terminal: Python's own SIGINT handler here, which the commands they start set up again.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 DEG = math.pi / 180.0
