@@ -158,7 +158,7 @@ def _fit(records, groups, idx, silicone, p_atm=P_ATM):
     held = [r for r, ok in zip(recs, blocked) if ok]
     ratio = _blocked_pressure_fit(held, [st["pressure"] for st in states])
     rho = np.array([blocked_ratio(float(r["stroke"]), *_design(r)[:2], _design(r)[3],
-                                  (0.0,) * 8 + ratio) for r in held])
+                                  free[:8] + ratio) for r in held])
     moment = (force * L)[blocked]
     ca, cb = _blocked_moment_fit(rho * np.array([st["pressure_moment"] for st in states]),
                                  np.array([st["squeeze_moment"] for st in states]), moment)

@@ -88,7 +88,7 @@ def sealed_coefficients(value=None) -> SealedCoefficients:
     """The coefficients as a :class:`~.records.SealedCoefficients`: the shipped ones for
     None, else from a dict by name or a sequence in :data:`COEFFICIENT_NAMES` order (a
     dict with none of the blocked pressure's names, or a sequence of the first seven, as a
-    cube or chamber file written before them holds, takes :data:`BLOCKED_NEUTRAL`)."""
+    cube written before them holds, takes :data:`BLOCKED_NEUTRAL`)."""
     if value is None:
         return COEFFICIENTS
     if isinstance(value, dict):
