@@ -345,7 +345,8 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     walls : sequence of float, optional
         Wall thicknesses, one panel each [m]; default nearest 2 and 6 mm.
     length : float, optional
-        Length at which M* is read [m] (M* does not depend on it); default nearest 90 mm.
+        Length at which M* is read [m] (M* does not depend on it, but for
+        ``sealed_chamber``'s, whose blocked pressure does); default nearest 90 mm.
     wrap_angle : float or sequence of float, optional
         Wrap angles whose thresholds are drawn [rad]; default every one of the cube (up to
         six labelled, the rest faint).
@@ -393,8 +394,11 @@ def fig12b(ds, *, walls=None, length=None, wrap_angle=None, coil_index=None):
     _legend_12bc(fig, [(c, _coil_colour(ds, c)) for c in coils], psis,
                  psi_ref if load else None, _flag_text(ds, bits),
                  load)
-    _suptitle(fig, "Figure 12(b): maximum torque against actuator radius",
-              "any length (M* does not depend on L; tip force = M*/L)" +
+    # sealed_chamber's blocked pressure, and so its M*, depends on a/L (docs/model.md s. 22)
+    where = f"at {_eq('length', length)} (sealed_chamber's M* depends on L; tip force = " \
+        "M*/L)" if "sealed_chamber" in models else \
+        "any length (M* does not depend on L; tip force = M*/L)"
+    _suptitle(fig, "Figure 12(b): maximum torque against actuator radius", where +
               (f"\none column per model ({len(models)}), one scale along each row"
                if many else "") + legend_text(ds, psi_ref))
     _footer(fig, ds)
