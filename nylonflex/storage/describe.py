@@ -13,11 +13,10 @@ try:
 except ImportError:  # pragma: no cover - isal is a dependency
     isal_zlib = None
 
-from ..units import InputError
 from ..variables import AXES, SPREAD_OF, VARIABLES, is_complete, to_display
 from .cube import STORED_DIMS, require_filters
 from .netcdf4 import read_layout
-from .reader import _attr, check_chunk_sizes, cube_attrs, open_cube
+from .reader import _attr, check_chunk_sizes, checked_attrs, cube_attrs
 
 __all__ = ["check_cube", "cube_description", "cube_summary", "flag_histogram",
            "summary_lines"]
@@ -118,15 +117,22 @@ def check_cube(path, *, full: bool = True, progress=None) -> list[str]:
 
     check_chunk_sizes(path)
     require_filters((cube_attrs(path) or {}).get("compression"))
-    problems = []
     with h5py.File(path, "r") as f:
-        names = [n for n, obj in f.items() if isinstance(obj, h5py.Dataset)]
-        for k, name in enumerate(names, 1):
-            dset = f[name]
-            if dset.shape and dset.size:
-                problems.extend(_check_dataset(path, name, dset, full))
-            if progress is not None:
-                progress(k, len(names))
+        return _unreadable(f, path, full, progress)
+
+
+def _unreadable(f, path, full, progress=None) -> list[str]:
+    """:func:`check_cube`'s lines for the cube open in h5py as ``f`` (checked already)."""
+    import h5py
+
+    problems = []
+    names = [n for n, obj in f.items() if isinstance(obj, h5py.Dataset)]
+    for k, name in enumerate(names, 1):
+        dset = f[name]
+        if dset.shape and dset.size:
+            problems.extend(_check_dataset(path, name, dset, full))
+        if progress is not None:
+            progress(k, len(names))
     return problems
 
 
@@ -218,15 +224,8 @@ def cube_description(path) -> dict:
     """
     import h5py
 
+    a = checked_attrs(path)  # open_cube's refusals, in its words
     path = Path(path)
-    a = cube_attrs(path)
-    if a is None:
-        if not path.exists():
-            open_cube(path)  # the missing-cube message, with a journal's hint
-        raise InputError(f"{path}: not a nylonflex cube (expected a NetCDF4/HDF5 file "
-                         "written by 'nylonflex sweep')")
-    check_chunk_sizes(path)
-    require_filters(a.get("compression"))
     d = {"cube": str(path), "name": str(a.get("name"))[:80],
          "config_sha256": str(a.get("config_sha256", ""))}
     complete = is_complete(a)
@@ -234,7 +233,7 @@ def cube_description(path) -> dict:
         sizes, dims = read_layout(h5)
         done_flags = np.asarray(h5["slab_done"][...]).astype(bool)
         # a spot check: the first chunk of each variable read ('info --check' reads all)
-        d["damaged"] = check_cube(path, full=False)
+        d["damaged"] = _unreadable(h5, path, full=False)
         d["status"] = "DAMAGED" if d["damaged"] else "complete" if complete else "INCOMPLETE"
         d["radii_done"], d["radii"] = int(np.sum(done_flags, dtype=np.int64)), sizes["radius"]
         d["shape"] = {ax: sizes[ax] for ax in AXES}

@@ -22,11 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..units import InputError
-from ..variables import CATEGORIES, is_complete, validate
+from ..variables import CATEGORIES, is_complete
 from .cube import STORED_DIMS
 from .netcdf4 import HIDDEN_ATTRS, read_layout
-from .reader import MASKED, _attr, checked_attrs, incomplete_warning
+from .reader import MASKED, _attr, checked_attrs, incomplete_warning, validated
 
 __all__ = ["LightCube", "LightVariable", "open_light"]
 
@@ -188,11 +187,7 @@ def open_light(path, *, quiet: bool = False) -> LightCube | None:
     if not cube.plain:
         cube.close()
         return None
-    try:
-        validate(cube)  # the registry's dimensions, units and dtypes (metadata only)
-    except ValueError as err:
-        cube.close()
-        raise InputError(f"{path}: {err}") from None
+    validated(cube, path)
     if not is_complete(attrs):
         cube.mask(cube["slab_done"].values.astype(bool))
         if not quiet:

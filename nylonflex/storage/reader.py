@@ -15,7 +15,7 @@ from .journal import Journal
 
 __all__ = ["MASKED", "MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_chunk_sizes",
            "checked_attrs", "cube_attrs", "incomplete_warning", "logical_dims", "open_cube",
-           "portable_encoding"]
+           "portable_encoding", "validated"]
 
 #: The largest chunk of a cube read [bytes]: a chunk is decoded whole, and nylonflex writes
 #: chunks of about 2 MB (a crafted 2^29-element chunk made ``info`` allocate 4 GiB).
@@ -112,6 +112,18 @@ def incomplete_warning(path, done) -> str:
             "rest is masked")
 
 
+def validated(cube, path):
+    """``cube`` (an open Dataset, or :class:`~nylonflex.storage.light.LightCube`) after the
+    registry's check of its dimensions, units and dtypes (metadata only); closed, and an
+    InputError naming ``path``, where it disagrees."""
+    try:
+        validate(cube)
+    except ValueError as err:
+        cube.close()
+        raise InputError(f"{path}: {err}") from None
+    return cube
+
+
 def open_cube(path, *, quiet: bool = False):
     """Open a cube written by ``nylonflex sweep`` as an :class:`xarray.Dataset` (lazy).
 
@@ -132,11 +144,7 @@ def open_cube(path, *, quiet: bool = False):
     ds = logical_dims(xr.open_dataset(path, engine="h5netcdf"))
     for var in ds.variables.values():
         var.encoding = portable_encoding(var.encoding)
-    try:
-        validate(ds)  # the registry's dimensions, units and dtypes (metadata only)
-    except ValueError as err:
-        ds.close()
-        raise InputError(f"{path}: {err}") from None
+    validated(ds, path)
     if not is_complete(attrs):
         done = ds["slab_done"].values.astype(bool)
         if not quiet:
