@@ -34,7 +34,7 @@ from nylonflex.sweep.conductor import run_sweep, sweep_file
 
 from .first_use import cold_compiles, command_costs
 from .flops import kernel_flops_per_design
-from .kernel_cpu import kernel_seconds
+from .kernel_cpu import kernel_encode_seconds, kernel_seconds
 from .ratios import kernel_ratios, process_ratios, ratio_lines
 from .yardstick import grid_numpy
 
@@ -62,7 +62,12 @@ QUICK = {"radius": 12, "wall_thickness": 6, "length": 4, "coil_index": 3, "wrap_
 
 def bench_config(sizes: dict):
     """The benchmark's design space (the fig12 ranges, sizes from ``sizes``)."""
-    return parse_config({
+    return parse_config(bench_dict(sizes))
+
+
+def bench_dict(sizes: dict) -> dict:
+    """:func:`bench_config`'s config as the dict a YAML file would hold."""
+    return {
         "name": "bench",
         "grid": {
             "radius": {"start": 5, "stop": 25, "num": sizes["radius"], "units": "mm"},
@@ -75,7 +80,7 @@ def bench_config(sizes: dict):
         "curves": {"stroke": {"start": 0, "stop": 0.1, "num": sizes["stroke"]},
                    "pressure": {"start": 0, "stop": 40, "num": sizes["pressure"],
                                 "units": "kPa"}},
-    })
+    }
 
 
 #: The sampled sweep of issue 12: the fig12 grid (41 x 6 x 3 x 4 x 4 = 11,808 designs) x
@@ -241,7 +246,12 @@ def run_bench(quick: bool = False, log=None) -> dict:
         size_mb = (Path(tmp) / "cube.h5").stat().st_size / 2**20
         ds.close()
         light = command_costs(Path(tmp) / "cube.h5")
-        whole = process_ratios(Path(tmp) / "cube.h5", pairs=1 if quick else 3)
+        # S2 (the sweep beyond its start-up over its kernel and encoding): not in --quick,
+        # whose 3,456 designs cost less than the noise of two process start-ups
+        encode_cpu, _ = kernel_encode_seconds(cfg, tmp)
+        whole = process_ratios(Path(tmp) / "cube.h5", pairs=1 if quick else 3,
+                               sweep=None if quick else bench_dict(sizes),
+                               encode_cpu=encode_cpu)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t_numpy, t_kernel_whole = _numpy_yardstick(cfg)
 
@@ -294,6 +304,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         "matmul_gflops": gflops,
         "matmul_gflops_per_cpu_s": gflops_cpu,
         "kernel_cpu_s": cpu_kernel,
+        "kernel_encode_cpu_s": encode_cpu,
         "kernel_flops_per_design": flops,
         "kernel_gflops_per_cpu_s": kernel_gflops,
         "kernel_peak_fraction": kernel_gflops / gflops_cpu,
@@ -331,6 +342,8 @@ def run_bench(quick: bool = False, log=None) -> dict:
         f"source, benchmarks/flops.py), {kernel_gflops:.2f} GFlop per CPU-s: "
         f"{100 * result['kernel_peak_fraction']:.1f} % of the matmul's (same run; "
         f"{cpu_kernel:.2f} CPU-s for the kernels)")
+    say(f"  kernel + encoding          {encode_cpu:8.2f} CPU-s over the grid (pooled output "
+        f"arrays, the cube's codec, nothing written: kernel {cpu_kernel:.2f} CPU-s of it)")
     say(f"  closed loop {sim_duration / 60:g} min @ 10 ms  {t_loop * 1e3:8.1f} ms loop, "
         f"{t_sim * 1e3:.0f} ms with tables and output")
     say(f"  sampled sweep (uncertainty) {t_sampled:7.2f} s  "
