@@ -99,7 +99,41 @@ def test_cluster_cube_identical_to_local(cluster, config_path, local_cube, tmp_p
         assert not any(client.run(_numba_threads_started).values())
 
 @pytest.mark.slow
+def test_the_workers_encode_the_slabs_and_the_client_prepares_none(cluster, config_path,
+                                                                   tmp_path):
+    # with the sink's encoder, a worker sends the compressed chunks (an EncodedSlab, the
+    # bytes the cube file would make of the arrays), and the client's own first step
+    # (prepare: compression in its threads) is not run
+    from nylonflex.engine.grid import compute_slab, coords, cube_variables
+    from nylonflex.engine.provenance import provenance
+    from nylonflex.storage.codec import EncodedSlab
+    from nylonflex.storage.cube import CubeFile
 
+    cfg = nf.load_config(config_path)
+    slabs, chunk = plan_slabs(cfg)
+    cube = CubeFile(tmp_path / "c.h5", coords(cfg), provenance(cfg), chunk, cfg.compression,
+                    cube_variables(cfg), cfg.models, cfg.cooling_names)
+
+    def prepare(i0, arrays):
+        raise AssertionError("the client compressed a slab a worker had encoded")
+
+    executor = DaskExecutor(cluster.scheduler_address)
+    try:
+        got = dict(executor.map_slabs(cfg, slabs, [0, 3], prepare=prepare,
+                                      remote=cube.remote_encoder()))
+        assert got.keys() == {0, 3}
+        for k, slab in got.items():
+            assert isinstance(slab, EncodedSlab)
+            want = cube.encode(slabs[k][0], compute_slab(cfg, *slabs[k], parallel=False))
+            assert slab.arrays.keys() == want.keys()
+            for key, value in want.items():
+                np.testing.assert_array_equal(slab.arrays[key], value, err_msg=key)
+    finally:
+        executor.close()
+        cube.close()
+
+
+@pytest.mark.slow
 def test_killed_cluster_run_resumes(cluster, config_path, local_cube, tmp_path):
     out = tmp_path / "cube.h5"
     argv = ["sweep", str(config_path), "--out", str(out), "--scheduler",

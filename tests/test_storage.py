@@ -1,10 +1,12 @@
 """The cube writer's own chunk filters against HDF5's (storage by round trip)."""
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
 
-from nylonflex.storage.cube import _shuffle_deflate
+from nylonflex.storage.codec import _shuffle_deflate
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.int8])
@@ -50,6 +52,46 @@ def test_every_codec_stores_the_same_cube(tmp_path, codec):
         np.testing.assert_array_equal(f["tip_force_max"][...], ref["tip_force_max"].values)
 
 
+@pytest.mark.parametrize("codec", ["gzip", "zstd", "none", "lz4"])
+def test_a_slab_encoded_away_from_the_file_is_what_the_file_encodes(tmp_path, codec):
+    # a Dask worker encodes the slab it computed with the cube's encoder, pickled and sent
+    # to it (engine/cluster.py): the same keys and the same bytes as the cube file's own
+    # encoding with its thread pool, for slabs of whole chunks (the last one short) and
+    # one that is not (its arrays stay plain); lz4 (HDF5 compresses) sends none
+    import pickle
+
+    import yaml
+
+    from nylonflex.config import parse_config
+    from nylonflex.engine.grid import compute_slab, coords, cube_variables
+    from nylonflex.engine.provenance import provenance
+    from nylonflex.storage.codec import EncodedSlab
+    from nylonflex.storage.cube import CubeFile
+
+    raw = yaml.safe_load((Path(__file__).parent / "data" / "reference_cube.yaml").read_text())
+    cfg = parse_config({**raw, "compression": codec})
+    n = cfg.shape[0]
+    slabs = [(i, min(i + 2, n)) for i in range(0, n, 2)] + [(1, 2)]
+    assert n % 2 and len(slabs) >= 3  # a last chunk shorter than the rest
+    cube = CubeFile(tmp_path / "c.h5", coords(cfg), provenance(cfg), 2, codec,
+                    cube_variables(cfg), cfg.models, cfg.cooling_names)
+    try:
+        if codec == "lz4":
+            assert cube.remote_encoder() is None
+            return
+        encoder = pickle.loads(pickle.dumps(cube.remote_encoder()))
+        for i0, i1 in slabs:
+            arrays = compute_slab(cfg, i0, i1, parallel=False)
+            here, there = cube.encode(i0, arrays), encoder(i0, arrays)
+            assert isinstance(there, EncodedSlab) and there.arrays.keys() == here.keys()
+            assert any(key.endswith(":bytes") for key in here) == (i0 % 2 == 0)
+            for key, value in here.items():
+                assert there.arrays[key].dtype == value.dtype, key
+                np.testing.assert_array_equal(there.arrays[key], value, err_msg=key)
+    finally:
+        cube.close()
+
+
 # ------------------------------------------------------------------ the netCDF-4 layout
 def _h5netcdf_cube(path, cfg, codec):
     """The cube's skeleton as h5netcdf writes it (what CubeFile did before issue 17's
@@ -57,7 +99,7 @@ def _h5netcdf_cube(path, cfg, codec):
     import h5netcdf
 
     from nylonflex.engine.grid import coords, cube_variables, plan_slabs
-    from nylonflex.storage.cube import CODECS, chunk_shape
+    from nylonflex.storage.codec import CODECS, chunk_shape
     from nylonflex.variables import COORDS, MODEL, slab_done_attrs
 
     _, chunk = plan_slabs(cfg)
@@ -186,7 +228,7 @@ def test_shuffle_is_hdf5s_byte_transpose(itemsize, n):
 def test_numpy_and_compiled_shuffles_store_the_same_bytes(codec, dtype):
     # a small cube's chunks are shuffled by NumPy (nothing to compile), a large one's by the
     # compiled loops: the stored chunk must be the same either way, padded chunks included
-    from nylonflex.storage.cube import CODECS, encode_chunk
+    from nylonflex.storage.codec import CODECS, encode_chunk
 
     if CODECS[codec].plugin:
         pytest.importorskip("zstandard")
@@ -200,20 +242,21 @@ def test_numpy_and_compiled_shuffles_store_the_same_bytes(codec, dtype):
 def test_a_small_cube_compiles_no_shuffle(tmp_path):
     # the README's main job is far below COMPILED_SHUFFLE_BYTES: its writer must not ask
     # for the compiled shuffle (a first compile of 0.4-0.6 s), a large cube's must
-    from nylonflex.storage.cube import COMPILED_SHUFFLE_BYTES, CubeFile
+    from nylonflex.storage.codec import COMPILED_SHUFFLE_BYTES
+    from nylonflex.storage.cube import CubeFile
 
     coords = {"radius": np.linspace(5e-3, 10e-3, 4), "wall_thickness": [2e-3],
               "length": [0.09], "coil_index": [1.3], "wrap_angle": [0.1],
               "stroke": [0.0, 0.1], "pressure": [0.0, 2e4]}
     cube = CubeFile(tmp_path / "c.h5", coords, {}, radius_chunk=2)
     try:
-        assert not cube._compiled_shuffle
+        assert not cube.encoder.compiled
     finally:
         cube.close()
     big = dict(coords, radius=np.linspace(5e-3, 10e-3, COMPILED_SHUFFLE_BYTES // 8 // 20))
     cube = CubeFile(tmp_path / "big.h5", big, {}, radius_chunk=1024)
     try:
-        assert cube._compiled_shuffle
+        assert cube.encoder.compiled
     finally:
         cube.close()
 
@@ -255,13 +298,13 @@ def test_the_default_codec_is_plain_deflate_with_shuffle(tmp_path):
 def test_a_zstd_cube_without_the_plugin_says_what_to_install(tmp_path, monkeypatch):
     import nylonflex as nf
     from nylonflex.config import parse_config
-    from nylonflex.storage import cube as cube_module
-    from nylonflex.storage.cube import MissingPlugin
+    from nylonflex.storage import codec as codec_module
+    from nylonflex.storage.codec import MissingPlugin
 
     path = tmp_path / "zstd.h5"
     nf.run_sweep(parse_config({**_reference_raw(), "compression": "zstd"}), path).close()
     # as in an install without the zstd extra and without HDF5_PLUGIN_PATH
-    monkeypatch.setattr(cube_module, "load_filter_plugins", lambda: False)
+    monkeypatch.setattr(codec_module, "load_filter_plugins", lambda: False)
     monkeypatch.setattr(h5py.h5z, "filter_avail", lambda filter_id: False)
     with pytest.raises(MissingPlugin, match=r"pip install 'nylonflex\[zstd\]'.*HDF5_PLUGIN_PATH"):
         nf.open_cube(path)

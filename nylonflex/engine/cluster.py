@@ -7,7 +7,9 @@ one slab of radii with the design kernel in the worker's own thread
 cluster's worker processes and threads are the only level of parallelism, so the
 kernels are never split over threads inside Dask's threads and never oversubscribe a
 worker's cores.
-Results come back to the client as they finish; the client journals and writes each one, as
+Each worker encodes the slab it computed as the cube stores it (the sink's picklable
+encoder, ``remote``: shuffled and compressed chunks, a fifth of the arrays' bytes), and the
+results come back to the client as they finish; the client journals and writes each one, as
 a local run does, so resume and the cube's format are the same.
 
 Memory stays bounded by the slab size whatever the grid: at most :data:`IN_FLIGHT_PER_THREAD`
@@ -197,14 +199,17 @@ def _stall_seconds() -> float:
     return value
 
 
-def _slab_task(cfg, i0: int, i1: int, expected: dict) -> dict:
-    """Runs on a worker: one slab with the serial kernel (one level of parallelism)."""
+def _slab_task(cfg, i0: int, i1: int, expected: dict, remote=None):
+    """Runs on a worker: one slab with the serial kernel (one level of parallelism), then
+    ``remote(i0, arrays)`` when given (the sink's encoding: the client receives the
+    compressed chunks, not the arrays)."""
     bad = _mismatch(expected, _versions())
     if bad:
         raise RuntimeError(f"this Dask worker runs {bad}; install the client's versions so "
                            "that the cube is reproducible")
 
-    return compute_slab(cfg, i0, i1, parallel=False)
+    arrays = compute_slab(cfg, i0, i1, parallel=False)
+    return arrays if remote is None else remote(i0, arrays)
 
 
 class DaskExecutor:
@@ -281,12 +286,14 @@ class DaskExecutor:
         return IN_FLIGHT_PER_THREAD * max(1, sum(self._threads.values()))
 
     def map_slabs(self, cfg, slabs: list[tuple[int, int]], todo: Iterable[int],
-                  prepare=None) -> Iterator[tuple[int, dict]]:
+                  prepare=None, remote=None) -> Iterator[tuple[int, dict]]:
         """Yield ``(k, arrays)`` for each slab index in ``todo``, as they finish.
 
         ``arrays`` is what ``compute_slab(cfg, *slabs[k], parallel=False)`` returns,
-        computed on a worker (``prepare(i0, arrays)`` when given: a sink's first step, run
-        here once the slab is fetched). At most :data:`IN_FLIGHT_PER_THREAD` slabs per
+        computed on a worker; with ``remote`` (a picklable step, the sink's encoder), what
+        ``remote(i0, arrays)`` returns on the worker, so that only its result travels;
+        else ``prepare(i0, arrays)`` when given (a sink's first step, run here once the
+        slab is fetched). At most :data:`IN_FLIGHT_PER_THREAD` slabs per
         worker thread are submitted at once; a slab is released from the cluster once
         yielded.
         """
@@ -302,7 +309,7 @@ class DaskExecutor:
             if k is None:
                 return False
             i0, i1 = slabs[k]
-            fut = self.client.submit(_slab_task, cfg, i0, i1, expected, pure=False,
+            fut = self.client.submit(_slab_task, cfg, i0, i1, expected, remote, pure=False,
                                      key=f"nylonflex-slab-{token}-{k:06d}")
             fut.slab = k
             self._pending.add(fut)
@@ -326,7 +333,7 @@ class DaskExecutor:
             self._pending.discard(fut)
             fut.release()
             top_up()
-            if prepare is not None:
+            if prepare is not None and remote is None:
                 arrays = prepare(slabs[fut.slab][0], arrays)
             return fut.slab, arrays
 

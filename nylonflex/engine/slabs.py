@@ -130,9 +130,11 @@ class LocalExecutor:
     def info(self) -> dict:
         return {"scheduler": "local (threads)", "workers": str(self.workers)}
 
-    def map_slabs(self, cfg, slabs, todo, prepare=None):
+    def map_slabs(self, cfg, slabs, todo, prepare=None, remote=None):
         """Yield ``(k, arrays)`` as slabs finish; with ``prepare``, ``(k, prepare(i0,
         arrays))``, called in the computing thread (a sink's compression starts there).
+        ``remote`` (a step for executors that compute elsewhere) is not used: ``prepare``
+        runs in this process already.
 
         A slab's arrays are reused for a later slab once the caller asks for the next one
         (they come from an :class:`~nylonflex.engine.grid.ArrayPool`): store or copy them
@@ -171,7 +173,7 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
         Indices into ``slabs`` to compute.
     executor : LocalExecutor or DaskExecutor
         Yields ``(k, arrays)`` from ``map_slabs(cfg, slabs, todo)`` (with
-        ``prepare=sink.prepare`` when the sink has one).
+        ``prepare=sink.prepare`` and ``remote=sink.remote`` when the sink has them).
     sink : object with ``put(k, i0, i1, arrays)``
         Stores a finished slab.
     progress : callable, optional
@@ -196,6 +198,8 @@ def run_slabs(cfg: ResolvedConfig, slabs, todo, executor, sink, progress=None) -
             # a sink with a first step (CubeSink starts compressing) has the executor run it
             # as soon as a slab is computed
             first = {"prepare": sink.prepare} if hasattr(sink, "prepare") else {}
+            if getattr(sink, "remote", None) is not None:  # a step a Dask worker can run
+                first["remote"] = sink.remote
             finished = executor.map_slabs(cfg, slabs, todo, **first)
             try:
                 for k, arrays in finished:

@@ -5,7 +5,7 @@ about 2 GB/s, about deflate's own speed. These loops release the GIL, so the com
 threads shuffle in parallel: the byte-by-byte loop runs at 2.5-3.3 GB/s; for 8-byte
 elements (every float variable of the cube) the word loop transposes 8 x 8-byte blocks in
 registers at 9-14 GB/s on a chunk in cache. They are compiled the first time a large cube
-is written (:data:`nylonflex.storage.cube.COMPILED_SHUFFLE_BYTES`); a small one is
+is written (:data:`nylonflex.storage.codec.COMPILED_SHUFFLE_BYTES`); a small one is
 shuffled by NumPy, with the same bytes.
 """
 

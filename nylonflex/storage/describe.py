@@ -14,7 +14,8 @@ except ImportError:  # pragma: no cover - isal is a dependency
     isal_zlib = None
 
 from ..variables import AXES, SPREAD_OF, VARIABLES, is_complete, to_display
-from .cube import STORED_DIMS, require_filters
+from .codec import require_filters
+from .cube import STORED_DIMS
 from .netcdf4 import read_layout
 from .reader import _attr, check_chunk_sizes, checked_attrs, cube_attrs
 

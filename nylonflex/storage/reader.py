@@ -10,7 +10,8 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN, SPREAD, UNCERTAIN, is_complete, validate
-from .cube import STORED_DIMS, require_filters
+from .codec import require_filters
+from .cube import STORED_DIMS
 from .journal import Journal
 
 __all__ = ["MASKED", "MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_chunk_sizes",
@@ -74,7 +75,7 @@ def checked_attrs(path) -> dict:
     """The global attributes of the cube at ``path`` (:func:`cube_attrs`), after the checks
     every reader of it makes before anything is decoded: the file is a nylonflex cube, no
     chunk or axis is too large to read (:func:`check_chunk_sizes`), and HDF5 can decompress
-    its codec (:func:`~nylonflex.storage.cube.require_filters`). :func:`open_cube` and
+    its codec (:func:`~nylonflex.storage.codec.require_filters`). :func:`open_cube` and
     :func:`~nylonflex.storage.light.open_light` share it, so both refuse in the same words.
 
     Raises

@@ -19,7 +19,7 @@ from ..engine.grid import (bytes_per_radius, check_physics, compute_slab, coords
 from ..engine.provenance import provenance, typed_info
 from ..engine.slabs import LocalExecutor, MemorySink, deferred_signals, run_slabs, set_workers
 from ..engine.warmup import grid_families, warm_up_aside, warm_up_codec, warm_up_grid
-from ..storage.cube import CODECS, chunk_shape, encode_chunk, compiled_shuffle
+from ..storage.codec import CODECS, chunk_shape, encode_chunk, compiled_shuffle
 from ..storage.reader import open_cube
 from .run import sweep_to_file
 

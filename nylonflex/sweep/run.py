@@ -26,7 +26,8 @@ from ..engine.provenance import is_complete, provenance, run_attrs
 from ..engine.slabs import LocalExecutor, deferred_signals, run_slabs
 from ..kernels import source_digest
 from ..units import InputError
-from ..storage.cube import CODECS, CubeFile
+from ..storage.codec import CODECS, EncodedSlab
+from ..storage.cube import CubeFile
 from ..storage.journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
     manifest_digest, publish, refuse_special, share_building
 from ..storage.reader import cube_attrs
@@ -46,7 +47,8 @@ class CubeSink:
     """Journals each slab and writes it into the building cube file.
 
     :meth:`prepare` starts a slab's compression as soon as it is computed (the executor
-    calls it from the computing thread); :meth:`put` journals it (in a second thread) while
+    calls it from the computing thread; a Dask worker encodes it instead, with
+    :attr:`remote`); :meth:`put` journals it (in a second thread) while
     it writes it into the cube. ``put`` returns once the slab is in the cube and the
     *previous* slab's journal file is on disk; :meth:`close` waits for the last one (and
     raises its error, a full disk). The journal's write and fsync so overlap the next slab
@@ -66,9 +68,20 @@ class CubeSink:
         """Start compressing the slab of radii from ``i0`` (returns what :meth:`put` takes)."""
         return _Started(self.cube.encode_start(i0, arrays))
 
+    @property
+    def remote(self):
+        """What an executor that computes slabs elsewhere (Dask) runs there on each slab
+        instead of :meth:`prepare` here: the cube's encoder (its result is an
+        :class:`~nylonflex.storage.codec.EncodedSlab`), or None (HDF5 compresses: lz4)."""
+        return self.cube.remote_encoder()
+
     def put(self, k, i0, i1, arrays):
-        encoded = self.cube.encode_finish(arrays.started) if isinstance(arrays, _Started) \
-            else self.cube.encode(i0, arrays)
+        if isinstance(arrays, EncodedSlab):  # encoded where it was computed
+            encoded = arrays.arrays
+        elif isinstance(arrays, _Started):
+            encoded = self.cube.encode_finish(arrays.started)
+        else:
+            encoded = self.cube.encode(i0, arrays)
         saving = self._journaling.submit(self.journal.save, k, encoded, slab=(i0, i1),
                                          config_sha=self.config_sha,
                                          decoding=self.decoding)
