@@ -41,7 +41,7 @@ import numpy
 from .. import __version__
 from ..kernels import source_digest
 from ..units import InputError
-from .grid import compute_slab
+from .grid import ArrayPool, compute_slab
 
 __all__ = ["CONNECT_TIMEOUT", "IN_FLIGHT_PER_THREAD", "STALL_TIMEOUT", "WORKER_WAIT",
            "DaskExecutor", "connect_client"]
@@ -208,8 +208,20 @@ def _slab_task(cfg, i0: int, i1: int, expected: dict, remote=None):
         raise RuntimeError(f"this Dask worker runs {bad}; install the client's versions so "
                            "that the cube is reproducible")
 
-    arrays = compute_slab(cfg, i0, i1, parallel=False)
-    return arrays if remote is None else remote(i0, arrays)
+    if remote is None:
+        return compute_slab(cfg, i0, i1, parallel=False)
+    # the step keeps none of the arrays (what it sends is new: compressed chunks, copies),
+    # so they go back to this worker's pool for its next slab, as a local sweep's do:
+    # fresh arrays cost the kernel the zeroing of every page it writes
+    arrays = compute_slab(cfg, i0, i1, parallel=False, pool=_WORKER_POOL)
+    try:
+        return remote(i0, arrays)
+    finally:
+        _WORKER_POOL.give_back(arrays)
+
+
+#: Each worker process's output arrays, handed back after a slab is encoded (``_slab_task``).
+_WORKER_POOL = ArrayPool()
 
 
 class DaskExecutor:

@@ -226,12 +226,14 @@ class SlabEncoder:
         self.compiled = compiled
 
     def __call__(self, i0: int, arrays: dict) -> EncodedSlab:
-        """The slab of radii from ``i0``, encoded in this thread."""
-        return EncodedSlab(self.finish(self.start(i0, arrays, _now)))
+        """The slab of radii from ``i0``, encoded in this thread; it shares no memory with
+        ``arrays`` (what is not compressed is copied), so they may be reused at once."""
+        return EncodedSlab(self.finish(self.start(i0, arrays, _now, copy=True)))
 
-    def start(self, i0: int, arrays: dict, submit):
+    def start(self, i0: int, arrays: dict, submit, copy: bool = False):
         """Hand each whole chunk of the slab to ``submit(fn, *args)`` (a thread pool's, or
-        :func:`_now`); :meth:`finish` collects."""
+        :func:`_now`); :meth:`finish` collects. What is not compressed is kept as it is,
+        or copied with ``copy``."""
         codec = CODECS[self.codec]
         out, jobs = {}, []
         for name, data in arrays.items():
@@ -241,7 +243,7 @@ class SlabEncoder:
                     aligned(plan.chunks, plan.shape, i0, i1):
                 jobs.append((name, list(self._compress(plan, codec, i0, data, submit))))
             else:
-                out[name] = np.asarray(data)
+                out[name] = np.array(data) if copy else np.asarray(data)
         return out, jobs
 
     @staticmethod
