@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..variables import CATEGORIES, is_complete
+from .codec import read_box
 from .cube import STORED_DIMS
 from .netcdf4 import HIDDEN_ATTRS, read_layout
 from .reader import MASKED, _attr, checked_attrs, incomplete_warning, validated
@@ -136,7 +137,7 @@ class LightCube:
         var, index = self.variables[name], index or {}
         key = tuple(index.get(d, slice(None)) for d in var.dims)
         kept = [d for d, k in zip(var.dims, key) if isinstance(k, slice)]
-        x = np.asarray(self._f[name][key], dtype=np.float64)
+        x = np.asarray(read_box(self._f[name], key), dtype=np.float64)
         for fill in var.fills:
             x[x == fill] = np.nan
         if self.done is not None and name in MASKED and "radius" in var.dims:
