@@ -207,3 +207,21 @@ def test_the_one_design_path_calls_one_compiled_signature_straight(monkeypatch):
     entry = pointwise._ENTRY["one"]
     assert entry is not kernels.design_points
     assert entry is kernels.points_entry(made[0])
+
+
+def test_the_one_design_table_value_is_numpys_interp_bit_for_bit():
+    # every named set's tables, at random coil indices over the table, at each node and
+    # its neighbours, and at the ends
+    rng = np.random.default_rng(49)
+    for nylon in nf.materials.NYLON_PARAMETERS:
+        sets = pointwise._one_design_sets("tc5005", nylon)
+        xs = sets.coil_index
+        points = [*xs, *(math.nextafter(x, 0.0) for x in xs[1:]),
+                  *(math.nextafter(x, 9.0) for x in xs[:-1]),
+                  *rng.uniform(xs[0], xs[-1], 20_000).tolist()]
+        for ys in (sets.stroke_max, sets.strength):
+            got = np.array([pointwise._table_value(x, xs, ys) for x in points])
+            want = np.interp(points, np.array(xs), np.array(ys))
+            assert got.tobytes() == want.tobytes()
+            assert all(pointwise._table_value(x, xs, ys) == np.interp(x, xs, ys)
+                       for x in points[:50])

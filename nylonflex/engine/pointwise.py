@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import threading
+from bisect import bisect_right
 from collections.abc import Mapping
 from functools import lru_cache
 
@@ -389,11 +390,11 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
 
 # ------------------------------------------------------------------------- one design
 
-#: The inputs the one-design path tests as floats, in :func:`evaluate`'s order of checks,
-#: with their registry ranges (what :func:`~nylonflex.physics.check_input` tests).
-_ONE_RANGES = {name: input_range(name) for name in
-               ("supply_voltage", "radius", "wall_thickness", "base_thickness", "length",
-                "wrap_angle")}
+#: The registry ranges of the inputs the one-design path tests as floats, in
+#: :func:`evaluate`'s order of checks (what :func:`~nylonflex.physics.check_input` tests).
+_V_RANGE, _A_RANGE, _T_RANGE, _B_RANGE, _L_RANGE, _PSI_RANGE = (
+    input_range(name) for name in ("supply_voltage", "radius", "wall_thickness",
+                                   "base_thickness", "length", "wrap_angle"))
 
 
 def _one_design(inputs, silicone: str, nylon: str, model, supply_voltage, chamber):
@@ -409,13 +410,11 @@ def _one_design(inputs, silicone: str, nylon: str, model, supply_voltage, chambe
     general path raises them at the same point of its checks.
     """
     a, t, b, length, psi, c = inputs
-    ranges = _ONE_RANGES
-    if not (model in MODELS and (supply_voltage is None or float_in_range(
-            supply_voltage, *ranges["supply_voltage"])) and float_in_range(a, *ranges["radius"])
-            and float_in_range(t, *ranges["wall_thickness"])
-            and (b is None or float_in_range(b, *ranges["base_thickness"]))
-            and float_in_range(length, *ranges["length"])
-            and float_in_range(psi, *ranges["wrap_angle"])):
+    if not (model in MODELS
+            and (supply_voltage is None or float_in_range(supply_voltage, *_V_RANGE))
+            and float_in_range(a, *_A_RANGE) and float_in_range(t, *_T_RANGE)
+            and (b is None or float_in_range(b, *_B_RANGE))
+            and float_in_range(length, *_L_RANGE) and float_in_range(psi, *_PSI_RANGE)):
         return None
     sets = _one_design_sets(silicone, nylon)
     if not (isinstance(c, float) and math.isfinite(c) and sets.c_lo <= c <= sets.c_hi):
@@ -426,15 +425,16 @@ def _one_design(inputs, silicone: str, nylon: str, model, supply_voltage, chambe
     c = float(c)
     arrays = _one_arrays()  # _one_named_design's values, its operations
     arrays.values[:] = (a, t, t if b is None else b, length, psi,
-                        np.interp(c, sets.coil_index, sets.stroke_max),
-                        np.interp(c, sets.coil_index, sets.strength) * sets.fibre_area,
+                        _table_value(c, sets.coil_index, sets.stroke_max),
+                        _table_value(c, sets.coil_index, sets.strength) * sets.fibre_area,
                         sets.fibre_diameter * (c + 1.0),
                         coil_resistance(sets.r_ref, sets.c_ref, c), sets.loss_per_len)
     out = PointOut(np.empty((N_FLOAT_DESIGN, 1)), np.empty((N_FLAGS, 1), dtype=np.int8))
     _point_call((arrays.designs, arrays.coil, sets.ogden, arrays.nodes, sets.muscle, options,
                  P_ATM, out, arrays.table, 0, 1))
-    check_supply_rise(voltage, out.design[DESIGN_ROWS["muscle_length"], 0], arrays.values[8],
-                      arrays.values[9], "supply_voltage")
+    if voltage > 0.0:  # check_supply_rise checks nothing without a supply
+        check_supply_rise(voltage, out.design[DESIGN_ROWS["muscle_length"], 0],
+                          arrays.values[8], arrays.values[9], "supply_voltage")
     return out
 
 
@@ -450,16 +450,35 @@ class _OneSets:
         self.muscle = Muscle(*_single_muscle(nylon))
         self.options = tuple(Options(i, -1.0, stretch_max, sealed_coefficients(None))
                              for i in range(len(MODELS)))
-        # _one_named_design's constants (floats, the same operations)
-        self.coil_index = ny["coil_index_table"]
-        self.c_lo, self.c_hi = float(self.coil_index[0]), float(self.coil_index[-1])
-        self.stroke_max = ny["stroke_max_table"]
-        self.strength = ny["tensile_strength_table"]
+        # _one_named_design's constants (floats, the same operations; the tables as
+        # tuples of floats for _table_value)
+        self.coil_index, self.stroke_max, self.strength = (
+            tuple(ny[k].tolist()) for k in ("coil_index_table", "stroke_max_table",
+                                             "tensile_strength_table"))
+        self.c_lo, self.c_hi = self.coil_index[0], self.coil_index[-1]
         self.fibre_diameter = float(ny["fibre_diameter"])
         self.fibre_area = np.pi * self.fibre_diameter**2 / 4.0
         self.r_ref = float(ny["resistance_per_length"])
         self.c_ref = float(ny["resistance_coil_index"])
         self.loss_per_len = float(ny["heat_loss_per_length"])
+
+
+def _table_value(x: float, xs: tuple, ys: tuple) -> float:
+    """``np.interp(x, xs, ys)`` of one ``x`` in [xs[0], xs[-1]] (a named set's table, its
+    nodes increasing) in float arithmetic, 2 us less: NumPy's operations, so its bits
+    (tests/test_one_design.py; :func:`_interp` repeats them too). The last node at or below
+    x; at a node its value, else the slope times the offset plus the left value (from the
+    right where that is NaN, the value where both are)."""
+    j = bisect_right(xs, x) - 1
+    if j == len(xs) - 1 or xs[j] == x:
+        return ys[j]
+    slope = (ys[j + 1] - ys[j]) / (xs[j + 1] - xs[j])
+    y = slope * (x - xs[j]) + ys[j]
+    if math.isnan(y):
+        y = slope * (x - xs[j + 1]) + ys[j + 1]
+        if math.isnan(y) and ys[j] == ys[j + 1]:
+            y = ys[j]
+    return y
 
 
 @lru_cache(maxsize=64)
