@@ -401,7 +401,7 @@ def _one_design(inputs, silicone: str, nylon: str, model, supply_voltage, chambe
     """The kernel's output (a :class:`~nylonflex.kernels.records.PointOut` of one column)
     of one design of two named sets without a cooling set: :func:`evaluate`'s general path
     (its checks in its order, as float comparisons; the records of the sets made once a
-    process; the same numbers into the same compiled kernel), about a third of its time.
+    process; the same numbers into the same compiled kernel), a quarter of its time.
 
     ``inputs`` holds radius, wall_thickness, base_thickness, length, wrap_angle and
     coil_index. None where one of them is not a float in its range, or the model or the
