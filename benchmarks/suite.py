@@ -150,7 +150,7 @@ def _pointwise_seconds(n: int) -> tuple[float, float, int]:
 
 def _single_vs_batch_cpu(n: int = 20_000, calls: int = 2000) -> tuple[float, float]:
     """CPU seconds [s] of ``nf.evaluate`` for one design, and per design of an ``n``-design
-    batch, measured back to back in this process (issue 27: at most 20x)."""
+    batch, measured back to back in this process (issue 27: at most 20x; issue 49: 5x)."""
     d = naive().random_designs(n, seed=27)
     one = {k: float(v[0]) for k, v in d.items()}
     evaluate(**d), evaluate(**one)  # compile or load the cache: both loops

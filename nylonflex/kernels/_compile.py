@@ -203,6 +203,25 @@ def jit_kernel(func=None, *, callee_body=False, borrows=False):
     return wrap if func is None else wrap(func)
 
 
+def compiled_entry(kernel, args):
+    """The machine-code entry that a call of ``kernel`` (a :func:`jit_kernel`) with
+    ``args`` runs, for later calls with arguments of exactly those Numba types; the
+    kernel itself where it has none (not compiled for them yet, or ``NUMBA_DISABLE_JIT``).
+
+    Numba's dispatcher types every argument of every call before it picks the compiled
+    code: for the pointwise kernel's records (about thirty arrays in seven named tuples)
+    that took 15-20 us, more than the kernel's own one design. The entry skips that typing
+    and checks nothing, so a caller passes only arguments made the way ``args`` were (the
+    same record types, array dtypes, dimensions, layouts and flags): another type would be
+    read as this one's.
+    """
+    overloads = getattr(kernel, "overloads", None)
+    if overloads is None:
+        return kernel
+    compiled = overloads.get(tuple(numba.typeof(a) for a in args))
+    return getattr(compiled, "entry_point", None) or kernel
+
+
 def _calling(f, borrows=False):
     """A function like ``f`` (name, module, file, first line, parameters, docstring) whose
     body is ``return f(...)``, with ``f`` made a Numba callee (without reference counting

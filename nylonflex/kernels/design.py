@@ -42,7 +42,7 @@ from ..physics.records import (CoilRow, Cycle, Drive, NodeTable, Ogden, Section,
 from ..physics.silicone import _equibiaxial_stress_and_slope, _stress_and_slope
 from ..physics.thermal import _cooling_time
 from ..physics.wrap import _outer_perimeter, _pitch, _wrap_force
-from ._compile import jit_kernel
+from ._compile import compiled_entry, jit_kernel
 from .records import GridScratch
 from .rows import (ROW_BEND_ANGLE_MAX, ROW_COOLING_TIME, ROW_CYCLE_RATE, ROW_CYCLE_TIME,
                    ROW_EFFICIENCY, ROW_HEATING_ENERGY, ROW_HEATING_POWER, ROW_HEATING_TIME,
@@ -374,6 +374,13 @@ design_points = jit_kernel(_design_points, callee_body=True, borrows=True)
 design_slab_paper = jit_kernel(specialised(_design_slab, "_design_slab_paper",
                                            **PAPER_ONLY_GLOBALS),
                                callee_body=True, borrows=True)
+
+
+def points_entry(args):
+    """:data:`design_points`'s compiled entry for arguments made the way ``args`` (one
+    call's) were (:func:`._compile.compiled_entry`): what ``nylonflex.evaluate``'s
+    one-design path calls, without the dispatcher's typing of its seven records."""
+    return compiled_entry(design_points, args)
 
 
 def grid_scratch(grid, nodes):

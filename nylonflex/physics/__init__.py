@@ -4,9 +4,10 @@ One module per domain: :mod:`.nylon` (stroke, coil-index table, eq. 1), :mod:`.t
 (eq. 3), :mod:`.chamber` (Boyle), :mod:`.silicone` (Ogden), :mod:`.wrap` (wrap geometry and
 nylon force), :mod:`.bending` (moments, curvature, angle, tip force) and :mod:`.limits`
 (design limits); :func:`check_input` and its two shorthands check an input against the
-registry's range for callers above (the evaluator, the FE twin). This package holds
-formulas and records, nothing about compilers (the kernels compile the formulas,
-:mod:`nylonflex.kernels`), and imports neither Numba, xarray nor matplotlib.
+registry's range for callers above (the evaluator, the FE twin), :func:`float_in_range`
+(with :func:`input_range`) is its test of one float, the evaluator's one-design path.
+This package holds formulas and records, nothing about compilers (the kernels compile the
+formulas, :mod:`nylonflex.kernels`), and imports neither Numba, xarray nor matplotlib.
 """
 
 from .bending import (
@@ -16,7 +17,8 @@ from .bending import (
     pressure_moment,
     tip_force,
 )
-from ._formula import check_input, check_section, check_wrap_angle
+from ._formula import (check_input, check_section, check_wrap_angle, float_in_range,
+                       input_range)
 from .chamber import P_ATM, chamber_pressure, volume_ratio
 from .limits import design_limits, stroke_limit
 from .nylon import (
@@ -55,9 +57,11 @@ __all__ = [
     "check_wrap_angle",
     "curvature",
     "design_limits",
+    "float_in_range",
     "free_strain",
     "hoop_stress",
     "initial_shear_modulus",
+    "input_range",
     "material_moment",
     "muscle_length",
     "muscle_resistance",

@@ -76,8 +76,7 @@ def check_input(name, value, lo=None, hi=None):
     v = INPUTS[name] if name in INPUTS else VARIABLES[name]
     lo = v.lo if lo is None else lo
     hi = v.hi if hi is None else hi
-    if isinstance(value, float) and lo <= value <= hi and (value > lo or not v.lo_open) \
-            and (value < hi or not v.hi_open) and math.isfinite(value):
+    if float_in_range(value, lo, hi, v.lo_open, v.hi_open):
         return np.asarray(value)  # one design in range: the array test below costs 10 us
     try:
         arr = np.asarray(value, dtype=float)
@@ -96,6 +95,21 @@ def check_input(name, value, lo=None, hi=None):
                     f"({got * slip[0]:g} {v.units})")
         raise ValueError(msg.replace(" 1,", ",").removesuffix(" 1"))
     return arr
+
+
+def input_range(name) -> tuple:
+    """``(lo, hi, lo_open, hi_open)`` of a design input in the registry [SI]: what
+    :func:`check_input` tests ``name`` against."""
+    v = INPUTS[name] if name in INPUTS else VARIABLES[name]
+    return v.lo, v.hi, v.lo_open, v.hi_open
+
+
+def float_in_range(value, lo, hi, lo_open=False, hi_open=False) -> bool:
+    """Whether ``value`` is a float (a NumPy float64 too) that :func:`check_input` accepts
+    without its array test: finite, in [lo, hi], an open bound left out. False says
+    nothing about other values (an int, an array), which the array test checks."""
+    return isinstance(value, float) and lo <= value <= hi and (value > lo or not lo_open) \
+        and (value < hi or not hi_open) and math.isfinite(value)
 
 
 def _short(value, n=40):
