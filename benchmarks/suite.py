@@ -249,7 +249,7 @@ def run_bench(quick: bool = False, log=None) -> dict:
         # S2 (the sweep beyond its start-up over its kernel and encoding): not in --quick,
         # whose 3,456 designs cost less than the noise of two process start-ups
         encode_cpu, _ = kernel_encode_seconds(cfg, tmp)
-        whole = process_ratios(Path(tmp) / "cube.h5", pairs=1 if quick else 3,
+        whole = process_ratios(Path(tmp) / "cube.h5", pairs=1 if quick else 5,
                                sweep=None if quick else bench_dict(sizes),
                                encode_cpu=encode_cpu)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
