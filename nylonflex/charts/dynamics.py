@@ -14,9 +14,9 @@ import numpy as np
 
 from ..units import InputError
 from ..variables import AXES, label, to_display
-from ._common import (_COLOURS, _FLAG_GREY, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coil_colour,
+from ._common import (_FLAG_GREY, _LENGTH_DEFAULT, _WRAP_DEFAULT, _coil_colour,
                       _coils, _eq, _flag_patch, _flag_text, _footer, _grey_flagged, _nearest,
-                      _valid, _valid_range, new_figure)
+                      _valid_range, new_figure)
 
 __all__ = ["cycle_rate_lines", "cycle_rate_map", "force_rate", "tracking_map"]
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config import read_yaml
-from ..query import COLUMNS, Condition, parse_constraint
+from ..query import COLUMNS, parse_constraint
 from ..variables import TRACKING, VARIABLES
 from ..units import InputError, parse_quantity
 from ..variables import AXES

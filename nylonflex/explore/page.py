@@ -33,7 +33,7 @@ import numpy as np
 
 from ..query import parse_where
 from ..units import InputError
-from ..variables import AXES, incomplete_text, label, name_label
+from ..variables import AXES, incomplete_text, label
 from .data import (PAPER_EXAMPLES, design_config, design_variables, display_unit,
                    first_design, flag_meanings, snap, stand_in_note, to_display_any,
                    validity_names)

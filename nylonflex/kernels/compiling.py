@@ -24,7 +24,6 @@ import time
 import warnings
 from contextlib import contextmanager
 
-import numba
 from numba.core import event
 
 from .cache import cache_dir, mark_compiled

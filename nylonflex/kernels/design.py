@@ -98,7 +98,6 @@ def _design_slab(grid, coil, silicone, nodes, muscle, options, out, scratch, k0,
     cauchy = model == CAUCHY_MOMENT
     top = _stroke_shape(t_max, t_amb, gamma, beta, t_g, sigma_g)
     b_fixed = grid.base_thickness
-    na = radius.shape[0]
     nt = wall.shape[0]
     nl = length.shape[0]
     nc = coil_s_max.shape[0]
