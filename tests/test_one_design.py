@@ -13,7 +13,7 @@ import pytest
 
 import nylonflex as nf
 from naive import random_designs
-from nylonflex.engine import pointwise
+from nylonflex.engine import one_design
 from nylonflex.engine.pointwise import MODELS
 from nylonflex.physics import check_input, float_in_range, input_range
 from nylonflex.variables import DESIGN
@@ -197,14 +197,14 @@ def test_the_one_design_path_calls_one_compiled_signature_straight(monkeypatch):
     from nylonflex.kernels import design as kernels
 
     made = []
-    call = pointwise._point_call
-    monkeypatch.setattr(pointwise, "_point_call", lambda args: (made.append(args), call(args)))
+    call = one_design._point_call
+    monkeypatch.setattr(one_design, "_point_call", lambda args: (made.append(args), call(args)))
     for values, kw in _cases(16):
         _outcome(lambda: nf.evaluate(**values, **kw))
     signatures = {tuple(numba.typeof(a) for a in args) for args in made}
     assert len(made) >= 16 and len(signatures) == 1
     assert signatures <= set(kernels.design_points.signatures)
-    entry = pointwise._ENTRY["one"]
+    entry = one_design._ENTRY["one"]
     assert entry is not kernels.design_points
     assert entry is kernels.points_entry(made[0])
 
@@ -214,14 +214,14 @@ def test_the_one_design_table_value_is_numpys_interp_bit_for_bit():
     # its neighbours, and at the ends
     rng = np.random.default_rng(49)
     for nylon in nf.materials.NYLON_PARAMETERS:
-        sets = pointwise._one_design_sets("tc5005", nylon)
+        sets = one_design._one_design_sets("tc5005", nylon)
         xs = sets.coil_index
         points = [*xs, *(math.nextafter(x, 0.0) for x in xs[1:]),
                   *(math.nextafter(x, 9.0) for x in xs[:-1]),
                   *rng.uniform(xs[0], xs[-1], 20_000).tolist()]
         for ys in (sets.stroke_max, sets.strength):
-            got = np.array([pointwise._table_value(x, xs, ys) for x in points])
+            got = np.array([one_design._table_value(x, xs, ys) for x in points])
             want = np.interp(points, np.array(xs), np.array(ys))
             assert got.tobytes() == want.tobytes()
-            assert all(pointwise._table_value(x, xs, ys) == np.interp(x, xs, ys)
+            assert all(one_design._table_value(x, xs, ys) == np.interp(x, xs, ys)
                        for x in points[:50])

@@ -12,29 +12,22 @@ runs in parallel over the designs; its body is the one the pure-Python reference
 from __future__ import annotations
 
 import math
-import threading
-from bisect import bisect_right
-from collections.abc import Mapping
-from functools import lru_cache
 
 import numpy as np
 
-from ..kernels.records import CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut
-from ..kernels.rows import DESIGN_ROWS, FLAG_ROWS, N_FLAGS, N_FLOAT_DESIGN
+from ..kernels.rows import N_FLAGS, N_FLOAT_DESIGN
 from ..kernels.scratch import node_scratch
-from ..materials import (NYLON_PARAMETERS, NYLON_TABLES, SILICONE_PARAMETERS, Nylon, Silicone,
-                         check_nylon, check_silicone, cooling_parameters, nylon_parameters,
-                         silicone_kind, silicone_parameters)
-from ..physics import (check_input, check_section, check_wrap_angle, float_in_range,
-                       input_range)
+from ..materials import cooling_parameters
+from ..physics import check_input, check_section, check_wrap_angle
 from ..physics.bending import quadrature_nodes
 from ..physics.chamber import P_ATM
 from ..physics.limits import MODELS  # the model variants (docs/model.md s. 16)
-from ..physics.nylon import check_stroke_shape
 from ..physics.sealed import sealed_coefficients
 from ..physics.thermal import check_supply_rise, coil_resistance, convection_loss_per_length
-from ..units import short
-from ..variables import AXES, DESIGN
+from ..variables import AXES
+from .one_design import _kernels, _named_numbers, _named_rows, _one_design
+from .point_sets import (_MUSCLE_FIELDS, _batch_shapes, _flat, _interp, _materials,
+                         _named_batch, _rows, _short, _silicone_rows, _single_muscle)
 from .results import to_dataset
 from .threads import run_chunks
 
@@ -42,11 +35,6 @@ __all__ = ["MODELS", "design_limits", "evaluate"]
 
 #: Designs below which the kernel runs in the calling thread (threads cost more than they save).
 _PARALLEL_FROM = 64
-
-_MUSCLE_FIELDS = ("t_amb", "t_max", "gamma", "beta", "t_g", "sigma_g", "resistance_per_length",
-                  "heat_capacity_per_length", "heat_loss_per_length",
-                  "thermal_force_coefficient")
-_SILICONE_FIELDS = ("mu", "alpha")
 
 
 def evaluate(radius, wall_thickness, length, coil_index, wrap_angle, *, base_thickness=None,
@@ -237,83 +225,6 @@ def _heat_loss(cooling, d_f, t_max, t_amb, c, own):
     return np.ascontiguousarray(values[inverse.reshape(-1)])
 
 
-def _flat(x, shape, n):
-    """``x`` broadcast to ``shape``, as a read-only contiguous 1-D float array of ``n``.
-
-    A scalar (the common single-design case) is filled directly, 2 us instead of the
-    broadcast's 10; either way the same values and the same array type (read-only, C), so
-    the kernel is the one compiled body.
-    """
-    if isinstance(x, float) or (isinstance(x, np.ndarray) and x.ndim == 0):
-        out = np.full(n, x, dtype=float)
-        out.flags.writeable = False
-        return out
-    return np.ascontiguousarray(np.broadcast_to(x, shape), float).reshape(-1)
-
-
-def _materials(silicone, nylon):
-    """``(ogden, stretch_max, nylon arrays)`` of the material arguments, checked.
-
-    Named sets (strings, the usual case) are prepared once a process
-    (:func:`_named_materials`): a single design spent 0.6 ms here on every call. The
-    cached nylon arrays are read-only; the Ogden arrays are copied (the kernel's record
-    takes them writable, one compiled type).
-    """
-    if isinstance(silicone, str) and isinstance(nylon, str):
-        (mu, alpha), stretch_max, ny = _named_materials(silicone, nylon)
-        return (mu.copy(), alpha.copy()), stretch_max, dict(ny)
-    ogden = _silicone_arrays(silicone)
-    stretch_max = _stretch_max(silicone)
-    ny = _nylon_arrays(nylon)
-    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
-                                          "sigma_g")))
-    return ogden, stretch_max, ny
-
-
-@lru_cache(maxsize=64)
-def _named_materials(silicone: str, nylon: str):
-    """:func:`_materials` of two set names (the registry's sets do not change)."""
-    ogden = _silicone_arrays(silicone)
-    stretch_max = _stretch_max(silicone)
-    ny = _nylon_arrays(nylon)
-    check_stroke_shape(*(ny[k] for k in ("t_max", "t_amb", "gamma", "beta", "t_g",
-                                          "sigma_g")))
-    for value in ny.values():
-        value.flags.writeable = False
-    return ogden, stretch_max, ny
-
-
-def _batch_shapes(ogden, ny) -> list:
-    """The shapes the material arrays add to the designs' broadcast (tables: columns off)."""
-    return [ogden[0].shape[:-1], ogden[1].shape[:-1], ny["coil_index_table"].shape[:-1],
-            ny["stroke_max_table"].shape[:-1], ny["tensile_strength_table"].shape[:-1],
-            *(np.shape(v) for k, v in ny.items() if k not in NYLON_TABLES)]
-
-
-@lru_cache(maxsize=64)
-def _named_batch(silicone: str, nylon: str) -> list:
-    """:func:`_batch_shapes` of two named sets (all scalars: every shape ``()``)."""
-    ogden, _, ny = _named_materials(silicone, nylon)
-    return _batch_shapes(ogden, ny)
-
-
-@lru_cache(maxsize=16)
-def _single_muscle(nylon: str) -> tuple:
-    """The muscle record's arrays of one design of a named nylon set (read-only, cached),
-    as ``_flat`` makes them."""
-    ny = _nylon_arrays(nylon)
-    return tuple(_flat(ny[k], (), 1) for k in _MUSCLE_FIELDS)
-
-
-def _stretch_max(silicone) -> float:
-    """Top of the silicone set's fitted stretch range [-] (inf when it records none)."""
-    base = silicone
-    if isinstance(silicone, Mapping):
-        base = {k: v for k, v in silicone.items() if np.ndim(v) <= 1 or k == "stretch_range"}
-        base = {k: v for k, v in base.items() if k not in _SILICONE_FIELDS}
-    return float(silicone_parameters(base).stretch_range[1])
-
-
 def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
     kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut) = _kernels()
 
@@ -332,37 +243,11 @@ def _run(shape, n, design_arrays, coil_arrays, ogden, muscle, options):
                        out.flags.reshape(N_FLAGS, *shape))
 
 
-#: ``(name, is_flag, index)`` of each design variable in the registry's order: its row of
-#: the kernel's ``design`` or ``flags`` (kernels.rows, the one table both sides read).
-_ROWS = tuple((name, name in FLAG_ROWS, (FLAG_ROWS[name] if name in FLAG_ROWS
-                                         else DESIGN_ROWS[name], Ellipsis)) for name in DESIGN)
-
-
-def _named_rows(design, flags) -> dict:
-    """The kernel's output rows by name, in the registry's order (views)."""
-    return {name: flags[index] if flag else design[index] for name, flag, index in _ROWS}
-
-
-def _named_numbers(out) -> dict:
-    """:func:`_named_rows` of one design's output as Python floats and ints (the numbers
-    that ``float()`` and ``int()`` of its 0-d arrays give)."""
-    design, flags = out.design[:, 0].tolist(), out.flags[:, 0].tolist()
-    return {name: flags[index[0]] if flag else design[index[0]] for name, flag, index in _ROWS}
-
-
 def _frozen(x: np.ndarray) -> np.ndarray:
     """``x`` (a contiguous float64 array, made here) marked read-only: the one type the
     pointwise kernel's 1-D record fields are compiled for."""
     x.flags.writeable = False
     return x
-
-
-@lru_cache(maxsize=1)
-def _kernels():
-    """The pointwise kernels' module and records, imported on first use (Numba)."""
-    from ..kernels import design as kernels
-
-    return kernels, (CoilTable, Muscle, Nodes, Ogden, Options, PointDesigns, PointOut)
 
 
 def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_thickness=None,
@@ -388,259 +273,3 @@ def design_limits(radius, wall_thickness, length, coil_index, wrap_angle, base_t
             for name, v in out.items()}
 
 
-# ------------------------------------------------------------------------- one design
-
-#: The registry ranges of the inputs the one-design path tests as floats, in
-#: :func:`evaluate`'s order of checks (what :func:`~nylonflex.physics.check_input` tests).
-_V_RANGE, _A_RANGE, _T_RANGE, _B_RANGE, _L_RANGE, _PSI_RANGE = (
-    input_range(name) for name in ("supply_voltage", "radius", "wall_thickness",
-                                   "base_thickness", "length", "wrap_angle"))
-
-
-def _one_design(inputs, silicone: str, nylon: str, model, supply_voltage, chamber):
-    """The kernel's output (a :class:`~nylonflex.kernels.records.PointOut` of one column)
-    of one design of two named sets without a cooling set: :func:`evaluate`'s general path
-    (its checks in its order, as float comparisons; the records of the sets made once a
-    process; the same numbers into the same compiled kernel), a quarter of its time.
-
-    ``inputs`` holds radius, wall_thickness, base_thickness, length, wrap_angle and
-    coil_index. None where one of them is not a float in its range, or the model or the
-    supply voltage is not accepted: the general path checks those, and refuses with its
-    message. A set's refusal, the chamber's and the supply's (rise) are raised here, as the
-    general path raises them at the same point of its checks.
-    """
-    a, t, b, length, psi, c = inputs
-    if not (model in MODELS
-            and (supply_voltage is None or float_in_range(supply_voltage, *_V_RANGE))
-            and float_in_range(a, *_A_RANGE) and float_in_range(t, *_T_RANGE)
-            and (b is None or float_in_range(b, *_B_RANGE))
-            and float_in_range(length, *_L_RANGE) and float_in_range(psi, *_PSI_RANGE)):
-        return None
-    sets = _one_design_sets(silicone, nylon)
-    if not (isinstance(c, float) and math.isfinite(c) and sets.c_lo <= c <= sets.c_hi):
-        return None
-    voltage = -1.0 if supply_voltage is None else float(supply_voltage)
-    options = sets.options[MODELS.index(model)] if voltage < 0.0 and chamber is None else \
-        Options(MODELS.index(model), voltage, sets.stretch_max, sealed_coefficients(chamber))
-    c = float(c)
-    arrays = _one_arrays()  # _one_named_design's values, its operations
-    arrays.values[:] = (a, t, t if b is None else b, length, psi,
-                        _table_value(c, sets.coil_index, sets.stroke_max),
-                        _table_value(c, sets.coil_index, sets.strength) * sets.fibre_area,
-                        sets.fibre_diameter * (c + 1.0),
-                        coil_resistance(sets.r_ref, sets.c_ref, c), sets.loss_per_len)
-    out = PointOut(np.empty((N_FLOAT_DESIGN, 1)), np.empty((N_FLAGS, 1), dtype=np.int8))
-    _point_call((arrays.designs, arrays.coil, sets.ogden, arrays.nodes, sets.muscle, options,
-                 P_ATM, out, arrays.table, 0, 1))
-    if voltage > 0.0:  # check_supply_rise checks nothing without a supply
-        check_supply_rise(voltage, out.design[DESIGN_ROWS["muscle_length"], 0],
-                          arrays.values[8], arrays.values[9], "supply_voltage")
-    return out
-
-
-class _OneSets:
-    """What the one-design path reads of two named sets (:func:`_one_design_sets`)."""
-
-    def __init__(self, silicone: str, nylon: str):
-        (mu, alpha), stretch_max, ny = _named_materials(silicone, nylon)
-        self.stretch_max = stretch_max
-        # the general path's records of one design: the Ogden rows a writable copy, every
-        # muscle field a read-only array of one (_run, _single_muscle)
-        self.ogden = Ogden(mu.copy().reshape(1, -1), alpha.copy().reshape(1, -1))
-        self.muscle = Muscle(*_single_muscle(nylon))
-        self.options = tuple(Options(i, -1.0, stretch_max, sealed_coefficients(None))
-                             for i in range(len(MODELS)))
-        # _one_named_design's constants (floats, the same operations; the tables as
-        # tuples of floats for _table_value)
-        self.coil_index, self.stroke_max, self.strength = (
-            tuple(ny[k].tolist()) for k in ("coil_index_table", "stroke_max_table",
-                                             "tensile_strength_table"))
-        self.c_lo, self.c_hi = self.coil_index[0], self.coil_index[-1]
-        self.fibre_diameter = float(ny["fibre_diameter"])
-        self.fibre_area = np.pi * self.fibre_diameter**2 / 4.0
-        self.r_ref = float(ny["resistance_per_length"])
-        self.c_ref = float(ny["resistance_coil_index"])
-        self.loss_per_len = float(ny["heat_loss_per_length"])
-
-
-def _table_value(x: float, xs: tuple, ys: tuple) -> float:
-    """``np.interp(x, xs, ys)`` of one ``x`` in [xs[0], xs[-1]] (a named set's table, its
-    nodes increasing) in float arithmetic, 2 us less: NumPy's operations, so its bits
-    (tests/test_one_design.py; :func:`_interp` repeats them too). The last node at or below
-    x; at a node its value, else the slope times the offset plus the left value (from the
-    right where that is NaN, the value where both are)."""
-    j = bisect_right(xs, x) - 1
-    if j == len(xs) - 1 or xs[j] == x:
-        return ys[j]
-    slope = (ys[j + 1] - ys[j]) / (xs[j + 1] - xs[j])
-    y = slope * (x - xs[j]) + ys[j]
-    if math.isnan(y):
-        y = slope * (x - xs[j + 1]) + ys[j + 1]
-        if math.isnan(y) and ys[j] == ys[j + 1]:
-            y = ys[j]
-    return y
-
-
-@lru_cache(maxsize=64)
-def _one_design_sets(silicone: str, nylon: str) -> _OneSets:
-    """:class:`_OneSets` of two set names, made once a process (the registry's sets do not
-    change; the kernel only reads them)."""
-    return _OneSets(silicone, nylon)
-
-
-class _OneArrays:
-    """A thread's arrays of the one-design path (its own: the kernel runs without the GIL).
-
-    ``values`` holds the design's radius, wall, base, length, wrap and its coil table's
-    s_max, force limit, width, r' and lambda', rewritten on each call; ``designs`` and
-    ``coil`` are the kernel's records of them, one read-only row each as the general
-    path's (the one compiled type). ``nodes`` is the quadrature of
-    :data:`~nylonflex.physics.bending.QUADRATURE_ORDERS` (constants, read once a thread)
-    and ``table`` the node table the kernel fills.
-    """
-
-    def __init__(self):
-        block = np.zeros((10, 1))
-        rows = list(block)
-        for row in rows:
-            row.flags.writeable = False
-        self.values = block.reshape(10)
-        self.designs = PointDesigns(*rows[:5])
-        self.coil = CoilTable(*rows[5:])
-        self.nodes = Nodes(*quadrature_nodes())
-        self.table = node_scratch(self.nodes)
-
-
-_THREAD = threading.local()
-
-
-def _one_arrays() -> _OneArrays:
-    """This thread's :class:`_OneArrays`, made on its first one-design call."""
-    try:
-        return _THREAD.arrays
-    except AttributeError:
-        _THREAD.arrays = _OneArrays()
-        return _THREAD.arrays
-
-
-#: The pointwise kernel's compiled entry for the one-design path's arguments, found on its
-#: first call (:func:`nylonflex.kernels.design.points_entry`).
-_ENTRY = {}
-
-
-def _point_call(args) -> None:
-    """The pointwise kernel on the one-design path's ``args``: the first call through
-    Numba's dispatcher (which compiles or loads it, with its notice), the later ones
-    straight into the compiled code it ran (the same records, the same types)."""
-    entry = _ENTRY.get("one")
-    if entry is not None:
-        entry(*args)
-        return
-    kernels = _kernels()[0]
-    kernels.design_points(*args)
-    _ENTRY["one"] = kernels.points_entry(args)
-
-
-# --------------------------------------------------------------------------- materials
-
-def _short(value, n=40):
-    return short(value, n)
-
-
-def _split(kind, value, table, fields):
-    """(base set object, {field: array override}) of a material argument."""
-    if isinstance(value, (Silicone, Nylon)) or isinstance(value, str):
-        return value, {}
-    if not isinstance(value, Mapping):
-        raise ValueError(f"{kind}: must be a set name, a mapping with 'set' or a material "
-                         f"object, got {_short(value)}")
-    arrays = {k: v for k, v in value.items() if k != "set" and k in fields and np.ndim(v) > 1}
-    scalar = {k: v for k, v in value.items() if k not in arrays}
-    return scalar, arrays
-
-
-def _as_array(kind, key, value):
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{kind}.{key}: must be numbers, got {_short(value)}") from None
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{kind}.{key}: must be finite, got {arr[~np.isfinite(arr)].flat[0]:g}")
-    return arr
-
-
-def _silicone_arrays(silicone):
-    """``(mu, alpha)`` arrays of shape (..., terms) of a silicone argument, checked."""
-    base, arrays = _split("silicone", silicone, SILICONE_PARAMETERS, _SILICONE_FIELDS)
-    if not arrays:
-        s = silicone_parameters(base)
-        return np.asarray(s.mu, float), np.asarray(s.alpha, float)
-    s = silicone_parameters({k: v for k, v in base.items()})  # the set and scalar fields
-    mu = _as_array("silicone", "mu", arrays.get("mu", s.mu))
-    alpha = _as_array("silicone", "alpha", arrays.get("alpha", s.alpha))
-    if mu.shape[-1] != alpha.shape[-1]:
-        raise ValueError("silicone.mu/alpha: need the same number (1 to 6) of terms on the "
-                         f"last axis, got shapes {mu.shape} and {alpha.shape}")
-    name = base.get("set") if isinstance(base, Mapping) else None
-    check_silicone(mu, alpha, kind=silicone_kind(base),
-                   name=name if isinstance(name, str) else None)
-    return mu, alpha
-
-
-def _silicone_rows(ogden, shape):
-    mu, alpha = ogden
-    if mu.ndim == 1 and alpha.ndim == 1:
-        return mu.reshape(1, -1), alpha.reshape(1, -1)
-    k = mu.shape[-1]
-    return (np.broadcast_to(mu, (*shape, k)), np.broadcast_to(alpha, (*shape, k)))
-
-
-def _nylon_arrays(nylon) -> dict:
-    """Every numeric field of a nylon argument as an array (tables: columns last), checked."""
-    base, arrays = _split("nylon", nylon, NYLON_PARAMETERS, NYLON_TABLES)
-    numeric = {k: v for k, v in (base.items() if isinstance(base, Mapping) else ())
-               if k != "set" and np.ndim(v) > 0 and k not in NYLON_TABLES}
-    scalar_base = {k: v for k, v in base.items() if k not in numeric} \
-        if isinstance(base, Mapping) else base
-    ny = nylon_parameters(scalar_base)
-    out = {k: np.asarray(v, float) for k, v in ny.to_dict().items() if k != "name"}
-    # to_dict leaves a resistance_coil_index of 0 out (the set's hash); the kernel needs it
-    out.setdefault("resistance_coil_index", np.asarray(ny.resistance_coil_index, float))
-    for key, value in {**numeric, **arrays}.items():
-        out[key] = _as_array("nylon", key, value)
-    if not numeric and not arrays:
-        return out
-    check_nylon(out)  # the named sets' own validator, on the arrays
-    return out
-
-
-def _rows(table, shape):
-    """A table as (m,) when shared by every design, else (n, m) one row a design."""
-    if table.ndim == 1:
-        return table
-    return np.ascontiguousarray(np.broadcast_to(table, (*shape, table.shape[-1]))).reshape(
-        -1, table.shape[-1])
-
-
-def _interp(x, xp, fp):
-    """``np.interp`` of each design's coil index in its own table (rows of ``xp``, ``fp``).
-
-    With 1-D tables this is ``np.interp`` itself; with per-design tables it repeats
-    NumPy's arithmetic (slope times offset plus the left value; a node returns its value)
-    so both give the same bits.
-    """
-    if xp.ndim == 1 and fp.ndim == 1:
-        return np.interp(x, xp, fp)
-    xp, fp = np.broadcast_arrays(np.atleast_2d(xp), np.atleast_2d(fp))
-    xp = np.broadcast_to(xp, (x.size, xp.shape[-1]))
-    fp = np.broadcast_to(fp, (x.size, fp.shape[-1]))
-    m = xp.shape[-1]
-    if m == 1:
-        return fp[:, 0].copy()
-    j = np.clip(np.sum(xp[:, 1:] <= x[:, None], axis=1), 0, m - 2)
-    rows = np.arange(x.size)
-    x0, x1, y0, y1 = xp[rows, j], xp[rows, j + 1], fp[rows, j], fp[rows, j + 1]
-    slope = (y1 - y0) / (x1 - x0)
-    out = slope * (x - x0) + y0
-    out = np.where(x == x0, y0, out)
-    return np.where(x == xp[:, -1], fp[:, -1], out)
