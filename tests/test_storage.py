@@ -156,6 +156,14 @@ def test_a_box_read_by_the_chunks_is_h5pys_read(tmp_path):
         got = read_box(d, tuple(slice(None) for _ in d.shape))
         np.testing.assert_array_equal(got[:4], whole[:4])
         assert np.isnan(got[4:]).all()
+    # a damaged chunk is HDF5's error, as h5py's read gives it (the CLI names the variable)
+    with h5py.File(part, "r") as f:
+        info = f["tip_force_max"].id.get_chunk_info(0)
+    with open(part, "r+b") as fh:
+        fh.seek(info.byte_offset + 8)
+        fh.write(b"\xff" * min(64, info.size - 8))
+    with h5py.File(part, "r") as f, pytest.raises(OSError):
+        read_box(f["tip_force_max"], tuple(slice(None) for _ in f["tip_force_max"].shape))
 
 
 # ------------------------------------------------------------------ the netCDF-4 layout

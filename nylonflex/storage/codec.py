@@ -321,7 +321,8 @@ def read_box(dset, key) -> np.ndarray:
     step 1 per dimension), its chunks inflated here (:func:`decode_chunk`) when they are
     deflate with or without the shuffle and nothing else, as nylonflex writes the default
     codec: h5py would inflate them with zlib, about half the speed; anything else (another
-    codec, a chunk not written, a chunk whose filters were skipped) is h5py's read."""
+    codec, a chunk not written, a chunk whose filters were skipped, a chunk that does not
+    inflate, whose read then raises HDF5's OSError naming it) is h5py's read."""
     box = _box(dset, key)
     if box is None or not _deflate_only(dset):
         return dset[key]
@@ -340,12 +341,19 @@ def read_box(dset, key) -> np.ndarray:
         lo = [max(a, c) for a, c in zip(starts, corner)]
         hi = [min(b, c + n) for b, c, n in zip(stops, corner, chunks)]
         region = out[tuple(slice(x - a, y - a) for x, y, a in zip(lo, hi, starts))]
-        if region.shape == tuple(chunks) and region.flags.c_contiguous:  # straight in
-            decode_chunk(raw, chunks, dset.dtype, dset.shuffle, out=region)
-            continue
-        block = decode_chunk(raw, chunks, dset.dtype, dset.shuffle)
-        region[...] = block[tuple(slice(x - c, y - c) for x, y, c in zip(lo, hi, corner))]
+        straight = region.shape == tuple(chunks) and region.flags.c_contiguous
+        try:
+            block = decode_chunk(raw, chunks, dset.dtype, dset.shuffle,
+                                 out=region if straight else None)
+        except (*_INFLATE_ERRORS, ValueError):  # a damaged chunk: HDF5 says which (OSError)
+            return dset[key]
+        if not straight:
+            region[...] = block[tuple(slice(x - c, y - c) for x, y, c in zip(lo, hi, corner))]
     return out[tuple(0 if isinstance(k, (int, np.integer)) else slice(None) for k in key)]
+
+
+#: What inflating a damaged chunk raises (ISA-L's error, zlib's).
+_INFLATE_ERRORS = (zlib.error,) if isal_zlib is None else (isal_zlib.error, zlib.error)
 
 
 def _box(dset, key):
