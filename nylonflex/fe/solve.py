@@ -11,6 +11,8 @@ ends of the line give it), unwrapped over the increments so angles past pi are r
 
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
 
 from .measures import chamber_volume, tip_moment
@@ -88,12 +90,36 @@ class PardisoSteps:
         self.solver.set_phase(23 if same else 13)
         rhs = np.asfortranarray(np.asarray(b, dtype=float).reshape(A.shape[0], -1))
         self.pattern = None
+        previous = self._one_thread()
         try:
             x = self.solver._call_pardiso(A, rhs)
         except Exception as err:  # pypardiso's PyPardisoError: a singular or NaN matrix
             raise RuntimeError(f"PARDISO: {err}") from err
+        finally:
+            self._threads(previous)
         self.pattern = pattern
         return x.reshape(np.shape(b))
+
+    def _one_thread(self):
+        """Keep this thread's MKL calls to one thread; returns what to restore
+        (:meth:`_threads`), or None where MKL has no thread-local setting.
+
+        With two threads PARDISO's factorisation gave other last bits on every run (a
+        killed verify resumed to another dataset than an uninterrupted one; the same design
+        solved twice differed), and it took 258 CPU-s against 141 for a default-mesh
+        ``nylonflex fe`` run at about the same wall time (144 against 141 s, this 2-core
+        machine): one thread is reproducible and half the CPU. Parallel FE work is one
+        solve a process (``verify --workers``), as the kernels' one level of parallelism.
+        """
+        set_local = getattr(self.solver.libmkl, "MKL_Set_Num_Threads_Local", None)
+        if set_local is None:  # pragma: no cover - every MKL since 10.3 has it
+            return None
+        set_local.argtypes, set_local.restype = [ctypes.c_int], ctypes.c_int
+        return set_local(1)
+
+    def _threads(self, previous):
+        if previous is not None:
+            self.solver.libmkl.MKL_Set_Num_Threads_Local(previous)
 
     def close(self):
         """Free PARDISO's factorisation and analysis."""
