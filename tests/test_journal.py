@@ -126,3 +126,72 @@ def test_a_slab_file_is_an_npz_numpy_reads(journal):
         np.testing.assert_array_equal(z["limit"], ARRAYS["limit"])
         assert z["limit"].dtype == np.int8
     assert _meta(journal, 0)["slab"] == [0, 2]
+
+
+# --------------------------------------------------------------- format 5: chunks found back
+
+def _chunk_files(tmp_path, blobs, *, gap=7):
+    """Two files holding ``blobs`` at the same addresses; the first with its second chunk
+    changed. Returns (paths, a record of the chunks as the journal keeps it)."""
+    from nylonflex.storage.codec import crc32
+
+    addresses, data = [], bytearray(b"x" * gap)
+    for blob in blobs:
+        addresses.append(len(data))
+        data += blob + b"y" * gap
+    good, bad = tmp_path / "good.h5", tmp_path / "bad.h5"
+    good.write_bytes(bytes(data))
+    damaged = bytearray(data)
+    damaged[addresses[1]] ^= 0xFF
+    bad.write_bytes(bytes(damaged))
+    record = {"v:offsets": np.array([[0], [2]], dtype=np.int64),
+              "v:sizes": np.array([len(b) for b in blobs], dtype=np.int64),
+              "v:crcs": np.array([crc32(b) for b in blobs], dtype=np.uint32),
+              "v:addresses": np.array(addresses, dtype=np.int64),
+              "plain": np.arange(3)}
+    return (bad, good), record
+
+
+def test_a_slab_is_read_back_from_the_file_whose_chunks_all_match(tmp_path):
+    from nylonflex.storage.restore import ChunkSources
+
+    blobs = [b"first chunk", b"second chunk, longer"]
+    (bad, good), record = _chunk_files(tmp_path, blobs)
+    with ChunkSources([tmp_path / "missing.h5", bad, good]) as sources:
+        slab = sources.slab(record)
+    assert bytes(slab["v:bytes"]) == b"".join(blobs)
+    assert "v:addresses" not in slab and slab["plain"].tolist() == [0, 1, 2]
+    assert slab["v:crcs"] is record["v:crcs"]  # the rest of the record as it was
+
+
+@pytest.mark.parametrize("edit", [
+    lambda r: r["v:addresses"].__setitem__(1, 10**9),  # past the end of every file
+    lambda r: r["v:addresses"].__setitem__(0, -1),
+    lambda r: r["v:sizes"].__setitem__(0, 10**12),  # more than any file holds
+    lambda r: r["v:crcs"].__setitem__(0, r["v:crcs"][0] ^ 1),
+], ids=["address_past_end", "negative_address", "huge_size", "crc"])
+def test_a_record_whose_chunks_no_file_holds_is_invalid(tmp_path, edit):
+    from nylonflex.storage.restore import ChunkSources
+
+    (bad, good), record = _chunk_files(tmp_path, [b"first chunk", b"second chunk"])
+    edit(record)
+    with ChunkSources([bad, good]) as sources, pytest.raises(SlabInvalid, match="slab 4"):
+        sources.slab(record, "slab 4")
+
+
+def test_a_link_is_never_a_source_of_chunks(tmp_path):
+    from nylonflex.storage.restore import ChunkSources
+
+    (bad, good), record = _chunk_files(tmp_path, [b"first chunk", b"second chunk"])
+    (tmp_path / "link.h5").symlink_to(good)
+    with ChunkSources([tmp_path / "link.h5"]) as sources, pytest.raises(SlabInvalid):
+        sources.slab(record)
+
+
+def test_journal_records_drop_the_bytes_and_keep_the_addresses():
+    from nylonflex.storage.restore import journal_record
+
+    encoded = {"v:offsets": np.zeros((1, 1)), "v:sizes": np.ones(1), "v:crcs": np.ones(1),
+               "v:bytes": np.zeros(1, np.uint8), "plain": np.arange(2)}
+    record = journal_record(encoded, {"v:addresses": np.array([40])})
+    assert sorted(record) == ["plain", "v:addresses", "v:crcs", "v:offsets", "v:sizes"]

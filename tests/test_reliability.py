@@ -172,15 +172,38 @@ def _tamper_deflate(parts):
 
 
 def _tamper_arrays(parts):
-    # a well-formed slab file whose arrays were changed: only the digest can tell
+    # a well-formed slab file whose arrays were changed: only the digest can tell. Journal
+    # format 5 keeps each chunk's CRC-32 where format 4 kept its bytes: both are changed
     p = parts / "slab-000000.npz"
     with np.load(p) as z:
         arrays = {k: z[k] for k in z.files}
-    key = next(k for k in arrays if k.endswith(":bytes"))
+    key = next(k for k in arrays if k.endswith((":bytes", ":crcs")))
     arrays[key] = arrays[key].copy()
     arrays[key][:8] = 0
     with open(p, "wb") as fh:
         np.savez(fh, **arrays)
+
+
+def _record(parts, k):
+    with np.load(parts / f"slab-{k:06d}.npz") as z:
+        return {key: z[key] for key in z.files}
+
+
+def _tamper_chunk_in_cube(parts):
+    # the journal is intact, but a chunk it points to was changed in the (incomplete,
+    # published) cube: only the chunk's CRC-32 can tell
+    record = _record(parts, 1)
+    name = next(k for k in record if k.endswith(":addresses"))
+    where, size = int(record[name][0]), int(record[name.replace("addresses", "sizes")][0])
+    cube = parts.with_name(parts.name.removesuffix(".parts"))
+    with open(cube, "r+b") as fh:
+        fh.seek(where + size // 2)
+        fh.write(b"\x00\x01\x02\x03")
+
+
+def _tamper_cube_gone(parts):
+    # the files the records point into are gone: every slab is recomputed
+    parts.with_name(parts.name.removesuffix(".parts")).unlink()
 
 
 def _tamper_copy(parts):
@@ -199,7 +222,9 @@ def _tamper_foreign(parts):
 @pytest.mark.parametrize("tamper", [_tamper_swap, _tamper_copy, _tamper_deflate,
                                     pytest.param(_tamper_foreign, marks=pytest.mark.slow),
                                     pytest.param(_tamper_empty, marks=pytest.mark.slow),
-                                    pytest.param(_tamper_arrays, marks=pytest.mark.slow)])
+                                    pytest.param(_tamper_arrays, marks=pytest.mark.slow),
+                                    _tamper_chunk_in_cube,
+                                    pytest.param(_tamper_cube_gone, marks=pytest.mark.slow)])
 def test_a_tampered_slab_is_recomputed_not_trusted(tmp_path, whole, tamper):
     out = tmp_path / "cube.h5"
     interrupted(out, k=3)
@@ -250,6 +275,33 @@ def test_a_journal_of_another_version_or_model_is_refused(tmp_path, capsys, key,
     assert main(["sweep", str(cfg), "--out", str(out), "--resume", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and key in err and "delete" in err
+
+
+def test_a_journal_of_format_4_is_refused_in_one_line(tmp_path, capsys):
+    # format 4 kept every chunk's bytes in the journal; format 5 keeps where they lie
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=2)
+    journal = Journal(out)
+    raw = journal.read_manifest()
+    raw["format"] = 4
+    raw["digest"] = journal_mod.manifest_digest(raw)
+    journal.manifest.write_text(json.dumps(raw))
+    cfg = write_config(tmp_path, MULTI)
+    assert main(["sweep", str(cfg), "--out", str(out), "--resume", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "format" in err and "delete" in err, err
+
+
+def test_the_journal_holds_no_chunk_of_the_cube(tmp_path):
+    # the journal records where the chunks lie, not the chunks: its slab files are small
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=3)
+    parts = Journal(out).dir
+    records = [_record(parts, k) for k in range(3)]
+    assert all(not any(key.endswith(":bytes") for key in r) for r in records)
+    assert all(any(key.endswith(":addresses") for key in r) for r in records)
+    journal_bytes = sum(p.stat().st_size for p in parts.glob("slab-*.npz"))
+    assert journal_bytes < 0.2 * out.stat().st_size, (journal_bytes, out.stat().st_size)
 
 
 def test_crash_safety_kill_at_random_points_resumes_identical(tmp_path, whole):

@@ -131,6 +131,26 @@ def test_killed_sweep_resumes_to_an_identical_cube(tmp_path, sig):
     assert not Journal(out).dir.exists()
 
 
+@pytest.mark.slow
+def test_a_killed_resume_of_a_killed_sweep_resumes_to_an_identical_cube(tmp_path):
+    # journal format 5: the chunks of the first run lie in its building file, which the
+    # resume moves into the journal (aside-000001.h5), restores from, points the records
+    # at its own building file and drops; killed in its turn, it leaves that building
+    # file, which the third run moves aside and restores from
+    cfg_path = write_config(tmp_path, BIGGER)
+    out = tmp_path / "run" / "cube.h5"
+    cmd = ["sweep", str(cfg_path), "--out", str(out), "--quiet", "--no-charts"]
+    assert kill_after_slabs(cmd, 3, signal.SIGKILL) != 0
+    assert kill_after_slabs([*cmd, "--resume"], 2, signal.SIGKILL) != 0
+    assert _journaled(out) == 5 and not Journal(out).asides()
+    assert main([*cmd, "--resume"]) == 0
+    resumed = open_cube(out)
+    assert resumed.attrs["resumed_slabs"] == 5
+    whole = run_sweep(parse_config(BIGGER), tmp_path / "whole.h5")
+    xr.testing.assert_identical(stable(resumed), stable(whole))
+    assert not Journal(out).dir.exists()
+
+
 def test_resume_refuses_a_changed_config(tmp_path, capsys):
     out = tmp_path / "cube.h5"
     cfg = parse_config(SMALL)

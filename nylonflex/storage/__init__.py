@@ -2,7 +2,9 @@
 
 - :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once;
 - :mod:`.netcdf4`: the netCDF-4 layout (dimensions, coordinates, attributes) in h5py;
-- :mod:`.journal`: the journal of finished slabs and the one-writer lock;
+- :mod:`.journal`: the journal of finished slabs;
+- :mod:`.locks`: the one-writer lock on a cube being written;
+- :mod:`.restore`: a journal's record of a slab, and the slab restored from it;
 - :mod:`.reader`: :func:`open_cube` and friends;
 - :mod:`.describe`: a cube's summary (``nylonflex info``) and the check of its chunks,
   with h5py alone;
@@ -21,7 +23,7 @@ import importlib
 _WHERE = {
     "CUBE_FORMAT": "..engine.provenance", "VOLATILE_ATTRS": "..engine.provenance",
     "CubeFile": ".cube",
-    "Journal": ".journal", "exclusive": ".journal",
+    "Journal": ".journal", "exclusive": ".locks",
     "check_cube": ".describe", "cube_attrs": ".reader", "cube_summary": ".describe",
     "cube_description": ".describe",
     "open_cube": ".reader",

@@ -155,42 +155,59 @@ class CubeFile:
         HDF5 compresses them itself (lz4: the chunks are written as plain arrays)."""
         return self.encoder if self.codec.encode is not None else None
 
-    def write_encoded(self, i0: int, i1: int, encoded: dict):
-        """Store what :meth:`encode` made for the radii [i0, i1)."""
+    def write_encoded(self, i0: int, i1: int, encoded: dict) -> dict:
+        """Store what :meth:`encode` made for the radii [i0, i1); return where each
+        compressed chunk now lies in the file: ``{NAME:addresses: byte offsets [B]}``, in
+        the order of ``NAME:offsets`` (HDF5 writes a chunk given whole at once, with
+        ``pwrite``, at an address it never moves: what the journal records,
+        :func:`nylonflex.storage.restore.journal_record`)."""
+        addresses = {}
         for key, value in encoded.items():
             name, _, part = key.partition(":")
             layout = self._layout[name]
             if part == "offsets":
-                sizes = encoded[f"{name}:sizes"]
-                blob = memoryview(encoded[f"{name}:bytes"])
-                write_chunk = layout.dset.id.write_direct_chunk
-                end = 0
-                for offset, size in zip(value.tolist(), sizes.tolist()):
-                    write_chunk(tuple(offset), blob[end:end + size])  # a view: no copy
-                    end += size
+                addresses[f"{name}:addresses"] = self._write_chunks(
+                    layout.dset.id, value, encoded[f"{name}:sizes"], encoded[f"{name}:bytes"])
             elif part:
-                continue  # sizes and bytes go with their offsets
+                continue  # sizes, CRCs and bytes go with their offsets
             elif layout.dims and layout.dims[0] == "radius":
                 layout.dset[i0:i1] = value
             else:
                 layout.dset[...] = value
         self._layout["slab_done"].dset[i0:i1] = 1
+        return addresses
+
+    @staticmethod
+    def _write_chunks(dsid, offsets, sizes, data) -> np.ndarray:
+        """Write chunks (``offsets`` [-], ``sizes`` [B], their bytes one after another in
+        ``data``); their byte offsets in the file [B]."""
+        blob, end, where = memoryview(data), 0, []
+        for offset, size in zip(offsets.tolist(), sizes.tolist()):
+            dsid.write_direct_chunk(tuple(offset), blob[end:end + size])  # a view: no copy
+            where.append(dsid.get_chunk_info_by_coord(tuple(offset)).byte_offset)
+            end += size
+        return np.array(where, dtype=np.int64)
+
+    def sync(self):
+        """Make what was written to the file so far durable (``fsync`` of its descriptor;
+        the chunks a journal record points to, before that record is written)."""
+        os.fsync(self.f.fd)
 
     def abandon(self):
         """Close after a failure (a full disk, an error) without raising, and without
         writing anything more to the disk.
 
-        A failed run's file is never published (``--resume`` rebuilds it from the journal),
-        so its bytes are dropped and its descriptor is pointed at a memory file first
-        (:func:`_divert`): whatever HDF5 still flushes as it closes (chunk caches, metadata)
-        then cannot fail. A close that failed partway left HDF5 ids half closed, and a
-        second close freed them again: a segfault on a full disk (exit 139 when the disk
-        filled while the finished cube was being closed). A file whose close already
-        failed is therefore never closed again (:meth:`NetCDF4File.close`).
+        A failed run's file is never published, but its chunks are what the journal's
+        records point to (``--resume`` reads them back), so its bytes stay; its
+        descriptor is pointed at a memory file first (:func:`_divert`): whatever HDF5
+        still flushes as it closes (chunk caches, metadata) then goes there and cannot
+        fail, nor write over what is on disk. A close that failed partway left HDF5 ids
+        half closed, and a second close freed them again: a segfault on a full disk (exit
+        139 when the disk filled while the finished cube was being closed). A file whose
+        close already failed is therefore never closed again (:meth:`NetCDF4File.close`).
         """
         self._pool.shutdown(cancel_futures=True)
         with contextlib.suppress(OSError):  # the descriptor read at open: no HDF5 call
-            os.ftruncate(self.f.fd, 0)
             _divert(self.f.fd)  # what HDF5 still writes, now or at exit, goes to memory
         if self.f.close_failed:
             return  # its objects are parked: freeing them again is what crashed
@@ -207,8 +224,8 @@ class CubeFile:
 
 def _divert(fd: int):
     """Point the descriptor ``fd`` at a new empty memory file (Linux ``memfd_create``):
-    writes to it then succeed whatever the disk, and the disk file's own blocks are freed
-    with its last descriptor. Does nothing where there is no memory file."""
+    writes to it then succeed whatever the disk, and the disk file keeps what it held.
+    Does nothing where there is no memory file."""
     if not hasattr(os, "memfd_create"):  # pragma: no cover - not Linux
         return
     mem = os.memfd_create("nylonflex-abandoned", getattr(os, "MFD_CLOEXEC", 0))

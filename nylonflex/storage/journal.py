@@ -1,27 +1,29 @@
-"""The journal of a sweep (``<cube>.parts/``) and the lock that makes one writer.
+"""The journal of a sweep (``<cube>.parts/``): what makes an interrupted run resumable.
 
-One writer, provably: :func:`exclusive` holds an ``flock`` on ``<cube>.lock`` (a releasing
-writer unlinks it while still holding it, and a taker checks that the file it locked is
-still the one at that path, so the unlink-then-unlock race cannot admit two writers) *and*
-on ``<cube>.building`` itself, opened without truncation. Deleting a "stale" lock file
-therefore does not let a second writer in: the building file's lock refuses it before it
-touches any file. The cube writer opens the building file with HDF5's own locking off,
-since this process already holds the lock on it. Before the building file is renamed onto
-the cube, its lock is made a shared one (:func:`share_building`): a reader's HDF5 lock
-(shared) never meets the writer's on the published file, and a second writer's
-(exclusive) is still refused.
+The journal records where each finished slab lies in the cube, not the slab again (format
+5): for each compressed variable, each chunk's offset, its address in the cube file [B],
+its size [B] and its CRC-32 (:func:`.restore.journal_record`). The chunks themselves are
+written once, into ``<cube>.building``, and made durable (``fsync``) before their record
+is written; on ``--resume`` they are read back from the files that may hold them (the
+interrupted run's building file, moved into the journal as ``aside-NNNNNN.h5``, or the
+incomplete cube a stopped run published) and each is checked against its size and CRC
+(:class:`.restore.ChunkSources`). What is not a whole compressed chunk (a variable without
+the radius axis, a chunk the slab only partly covers, every array of an lz4 cube, which
+HDF5 compresses itself) is kept in the record as it is. docs/reliability.md argues the
+crash safety.
 
-No side path is followed: a symbolic link at ``<cube>.lock``, ``<cube>.building``,
-``<cube>.parts`` or inside it is refused with one line naming it, and every file there is
-created new (``O_EXCL | O_NOFOLLOW``) and renamed into place, so that a run never writes
-outside the output's folder.
+No side path is followed: a symbolic link at ``<cube>.parts`` or inside it is refused with
+one line naming it, and every file there is created new (``O_EXCL | O_NOFOLLOW``) and
+renamed into place, so that a run never writes outside the output's folder. The lock
+that makes one writer is :mod:`.locks`.
 
 The journal verifies itself: the manifest records its format, the nylonflex version, the
 model digest, the slab plan and the codec; the run checks each against what the config
 and the code imply (:mod:`.run`), not against the manifest itself. Every slab file records
 its index, its radius range and a digest of its arrays (of the CRC-32 each zip member
-records) bound to the config's hash and to everything that decodes them (codec, filters,
-chunking: ``decoding``). A slab that fails verification is recomputed, never trusted.
+records, the chunks' own CRC-32s among them) bound to the config's hash and to everything
+that decodes them (codec, filters, chunking: ``decoding``). A slab that fails
+verification, or whose chunks are found in no file, is recomputed, never trusted.
 """
 
 from __future__ import annotations
@@ -42,17 +44,18 @@ import stat
 from ..units import InputError
 from ..files.atomic import create_new, fsync_dir, publish, refuse_link, refuse_special
 
-__all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "exclusive", "fsync_dir",
-           "publish", "refuse_special", "share_building"]
+__all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "file_locks", "fsync_dir", "publish",
+           "refuse_special"]
 
 #: Version of the journal's layout (manifest keys, slab metadata). 3: a slab's digest
 #: covers how its chunks decode (codec, filters, chunking). 4: it covers each array's
 #: CRC-32 (the one its zip member records) instead of hashing the arrays' bytes again.
-JOURNAL_FORMAT = 4
+#: 5: a slab's file records where its compressed chunks lie in the cube (addresses, sizes,
+#: CRC-32s), not their bytes.
+JOURNAL_FORMAT = 5
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _MANIFEST_KEYS = ("format", "name", "config_sha256", "slabs", "radius_chunk",
                   "nylonflex_version", "model_digest", "replaces")
-_LOCK_TEXT = b"nylonflex sweep lock\n"
 
 
 class SlabInvalid(Exception):
@@ -91,7 +94,7 @@ class Journal:
 
     def exists(self) -> bool:
         """Whether the folder holds a manifest (a regular file, never a link's target)."""
-        return _regular(self.manifest) and _regular(self.dir, stat.S_ISDIR)
+        return regular(self.manifest) and regular(self.dir, stat.S_ISDIR)
 
     def read_manifest(self) -> dict:
         """The manifest's content; {} when it cannot be read or is not a JSON object."""
@@ -107,7 +110,7 @@ class Journal:
         """Refuse a symbolic link at ``<cube>.parts`` or inside it, with one line naming
         it (a link there would carry the journal's writes out of the output's folder)."""
         refuse_link(self.dir, "--out")
-        if _regular(self.dir, stat.S_ISDIR):
+        if regular(self.dir, stat.S_ISDIR):
             for p in self.dir.iterdir():
                 refuse_link(p, "--out")
 
@@ -117,12 +120,13 @@ class Journal:
         temporaries in it (regular files, never links)."""
         if not os.path.lexists(self.dir):
             return False
-        if not _regular(self.dir, stat.S_ISDIR):
+        if not regular(self.dir, stat.S_ISDIR):
             return True
         for p in self.dir.iterdir():
             ours = p.name in ("manifest.json", "manifest.json.tmp") or \
-                (p.name.startswith("slab-") and p.suffix in (".npz", ".tmp"))
-            if not (ours and _regular(p)):
+                (p.name.startswith("slab-") and p.suffix in (".npz", ".tmp")) or \
+                (p.name.startswith("aside-") and p.suffix == ".h5" and p.stem[6:].isdigit())
+            if not (ours and regular(p)):
                 return True
         return False
 
@@ -207,6 +211,25 @@ class Journal:
             raise SlabInvalid(f"{path.name} fails its digest")
         return arrays
 
+    def asides(self) -> list[Path]:
+        """The building files of interrupted runs moved here (:meth:`aside_path`), newest
+        first: where this journal's chunks may lie."""
+        return sorted((p for p in self.dir.glob("aside-*.h5") if p.stem[6:].isdigit()),
+                      reverse=True)
+
+    def aside_path(self) -> Path:
+        """A new name for an interrupted run's building file in this folder."""
+        last = self.asides()
+        n = int(last[0].stem.split("-")[1]) + 1 if last else 1
+        return self.dir / f"aside-{n:06d}.h5"
+
+    def drop_asides(self):
+        """Remove the moved building files (every record now points into the new cube)."""
+        for p in self.asides():
+            with contextlib.suppress(OSError):
+                p.unlink()
+        fsync_dir(self.dir)
+
     def discard(self, k: int):
         """Remove slab ``k``'s file (it failed verification and will be recomputed)."""
         with contextlib.suppress(OSError):
@@ -217,7 +240,7 @@ class Journal:
         fsync_dir(self.dir.parent)
 
 
-def _regular(path, kind=stat.S_ISREG) -> bool:
+def regular(path, kind=stat.S_ISREG) -> bool:
     """Whether ``path`` itself (not a link's target) is of ``kind`` (a regular file)."""
     try:
         return kind(os.lstat(path).st_mode)
@@ -251,11 +274,6 @@ def _atomic_write(path: Path, data: bytes):
     fsync_dir(path.parent)
 
 
-def _busy(cube_path, what) -> RuntimeError:
-    return RuntimeError(f"another sweep is writing {cube_path} ({what} is locked); wait "
-                        "for it or stop it first")
-
-
 def file_locks():
     """The ``fcntl`` module, whose ``flock`` guards a cube being written (POSIX: Linux,
     macOS, the BSDs). Without it (Windows) writing a cube is refused with one line
@@ -268,144 +286,3 @@ def file_locks():
                          "platform lacks: run it on Linux or macOS (or WSL), or sweep in "
                          "memory from Python with nylonflex.run_sweep(cfg)") from None
     return fcntl
-
-
-def _lock_file(lock: Path):
-    """An fd of ``lock`` holding its flock: the file at that path when the lock was won."""
-    fcntl = file_locks()
-
-    refuse_special(lock, "--out")
-    if _regular(lock):
-        with os.fdopen(os.open(lock, os.O_RDONLY | _NOFOLLOW), "rb") as fh:
-            head = fh.read(64)
-        if head and not head.startswith(_LOCK_TEXT.strip()):
-            raise InputError(f"{lock} exists and is not a nylonflex lock; it is not "
-                             "replaced: move it or choose another --out")
-    while True:
-        fd = _open_side(lock)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            return None
-        try:
-            same = os.lstat(lock).st_ino == os.fstat(fd).st_ino
-        except FileNotFoundError:
-            same = False
-        if same:
-            os.ftruncate(fd, 0)
-            os.write(fd, _LOCK_TEXT + f"pid {os.getpid()}\n".encode())
-            return fd
-        os.close(fd)  # a releasing writer unlinked it after we opened it: take the new one
-
-
-def _open_side(path: Path) -> int:
-    """An fd of the side file ``path`` for reading and writing, made if missing, never
-    truncated and never through a link (one placed there meanwhile is refused)."""
-    try:
-        return os.open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW, 0o644)
-    except OSError as exc:
-        if os.path.islink(path):
-            refuse_link(path, "--out")
-        raise InputError(f"--out: {path} cannot be opened ({exc.strerror})") from None
-
-
-#: The building files this process holds: path -> the fd that holds its lock.
-_HELD: dict = {}
-
-
-def share_building(building):
-    """Make this process's lock on ``building`` a shared one, before it is published.
-
-    A reader's HDF5 lock is a shared ``flock``: an exclusive lock on the published inode
-    made it fail ("unable to lock file") until the journal was removed. A second writer's
-    exclusive lock is still refused (and the lock file is still held).
-    """
-    fcntl = file_locks()
-
-    fd = _HELD.get(str(building))
-    if fd is not None:
-        fcntl.flock(fd, fcntl.LOCK_SH)
-
-
-def check_building(building):
-    """Raise RuntimeError unless ``building`` is still the file this process locked (not
-    replaced, nor by a link, since the lock was taken)."""
-    fd = _HELD.get(str(building))
-    try:
-        same = fd is not None and os.lstat(building).st_ino == os.fstat(fd).st_ino and \
-            _regular(building)
-    except OSError:
-        same = False
-    if not same:
-        raise RuntimeError(f"{building} was replaced while this run held it; nothing is "
-                           "published: run again")
-
-
-def building_path(cube_path) -> Path:
-    cube_path = Path(cube_path)
-    return cube_path.with_name(cube_path.name + ".building")
-
-
-def building_is_ours(building: Path, journal: Journal) -> bool:
-    """Whether an existing ``<cube>.building`` may be rewritten: empty, an HDF5 file (a
-    building cube), or accompanied by this output's journal."""
-    import h5py
-
-    if not os.path.lexists(building):
-        return True
-    if not _regular(building):
-        return False
-    if building.stat().st_size == 0 or journal.exists():
-        return True
-    try:
-        return h5py.is_hdf5(building)
-    except OSError:
-        return False
-
-
-@contextlib.contextmanager
-def exclusive(cube_path):
-    """Hold the writer's locks on ``<cube>.lock`` and ``<cube>.building`` for a run.
-
-    A second run on the same output is refused (RuntimeError) before it changes any file,
-    even when the first run's lock file was deleted. Yields the path of the building file,
-    which the holder may then open for writing (with HDF5 file locking off).
-    """
-    fcntl = file_locks()
-
-    cube_path = Path(cube_path)
-    lock = Path(str(cube_path) + ".lock")
-    building = building_path(cube_path)
-    lock.parent.mkdir(parents=True, exist_ok=True)
-    refuse_special(building, "--out")
-    Journal(cube_path).refuse_links()
-    fd = _lock_file(lock)
-    if fd is None:
-        raise _busy(cube_path, lock.name)
-    bfd, created = None, False
-    try:
-        if not building_is_ours(building, Journal(cube_path)):
-            raise InputError(f"{building} exists and was not written by nylonflex; it is "
-                             "not replaced: move it or choose another --out")
-        created = not os.path.lexists(building)
-        bfd = _open_side(building)  # never truncating
-        try:
-            fcntl.flock(bfd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise _busy(cube_path, building.name) from None
-        _HELD[str(building)] = bfd
-        yield building
-    finally:
-        _HELD.pop(str(building), None)
-        if bfd is not None:
-            # an unused building file this run created is not left behind
-            with contextlib.suppress(OSError):
-                st = os.lstat(building)
-                if created and st.st_ino == os.fstat(bfd).st_ino and st.st_size == 0:
-                    building.unlink()
-            os.close(bfd)
-        with contextlib.suppress(OSError):
-            lock.unlink()  # while still held: a waiting taker re-checks the inode
-        fcntl.flock(fd, fcntl.LOCK_UN)
-        os.close(fd)

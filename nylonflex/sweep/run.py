@@ -1,13 +1,16 @@
 """A sweep into a cube file: the journaled sink, and resume.
 
-Durability: every finished slab of radii is journaled as its own ``.npz`` file in
-``<cube>.parts/`` (written to a temporary name, then renamed, so a slab file is whole or
-absent; it holds the slab's compressed chunks, see :meth:`CubeFile.encode`) and written
-into ``<cube>.building``. Only a finished run renames the building file to ``<cube>``: a
-killed run never leaves a file that reads as complete. ``--resume`` keeps the journal's
+Durability: every finished slab of radii is written into ``<cube>.building``, made durable
+there (``fsync``), and then journaled as its own ``.npz`` file in ``<cube>.parts/``
+(written to a temporary name, then renamed, so a slab file is whole or absent). The slab
+file records where the slab's compressed chunks lie in the building file and their CRC-32s,
+not the chunks again (:mod:`nylonflex.storage.restore`). Only a finished run renames the
+building file to ``<cube>``: a killed run never leaves a file that reads as complete.
+``--resume`` moves the interrupted building file into the journal, keeps the journal's
 slabs (if the config hash, the nylonflex version and the model digest match, the slab plan
-and codec are ones the config implies, and each slab passes its own verification, which
-covers the codec it decodes with; a slab that fails is recomputed) and computes the rest. A run
+and codec are ones the config implies, each slab file passes its own verification, which
+covers the codec it decodes with, and its chunks are found, unchanged, in that file or in
+the incomplete cube; a slab that fails is recomputed) and computes the rest. A run
 stopped by Ctrl-C or SIGTERM also leaves ``<cube>`` with ``complete`` 0 and a ``slab_done`` mask, so the part
 already done can be queried.
 """
@@ -15,6 +18,7 @@ already done can be queried.
 from __future__ import annotations
 
 import errno
+import os
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -28,8 +32,10 @@ from ..kernels import source_digest
 from ..units import InputError
 from ..storage.codec import CODECS, EncodedSlab
 from ..storage.cube import CubeFile
-from ..storage.journal import JOURNAL_FORMAT, Journal, SlabInvalid, check_building, exclusive, \
-    manifest_digest, publish, refuse_special, share_building
+from ..storage.journal import JOURNAL_FORMAT, Journal, SlabInvalid, manifest_digest, publish, \
+    refuse_special
+from ..storage.locks import check_building, exclusive, renew_building, share_building
+from ..storage.restore import ChunkSources, journal_record
 from ..storage.reader import cube_attrs
 
 __all__ = ["CubeSink", "DiskFull", "Interrupted", "sweep_to_file"]
@@ -44,16 +50,17 @@ class DiskFull(RuntimeError):
 
 
 class CubeSink:
-    """Journals each slab and writes it into the building cube file.
+    """Writes each slab into the building cube file and journals where it lies.
 
     :meth:`prepare` starts a slab's compression as soon as it is computed (the executor
     calls it from the computing thread; a Dask worker encodes it instead, with
-    :attr:`remote`); :meth:`put` journals it (in a second thread) while
-    it writes it into the cube. ``put`` returns once the slab is in the cube and the
-    *previous* slab's journal file is on disk; :meth:`close` waits for the last one (and
-    raises its error, a full disk). The journal's write and fsync so overlap the next slab
-    instead of holding up the loop (10-15 ms of each 27 ms slab turn of the 2 M sweep); a
-    killed run loses at most the slabs in flight, never a slab whose journal file exists.
+    :attr:`remote`); :meth:`put` writes it into the cube, then journals it in a second
+    thread: the cube file is made durable (``fsync``) first, then the slab's record (where
+    its chunks lie, their sizes and CRC-32s) is written. ``put`` returns once the slab is
+    in the cube and the *previous* slab's journal file is on disk; :meth:`close` waits for
+    the last one (and raises its error, a full disk). The fsync and the journal's write so
+    overlap the next slab instead of holding up the loop; a killed run loses at most the
+    slabs in flight, never a slab whose journal file exists.
     """
 
     def __init__(self, cube: CubeFile, journal: Journal, config_sha: str = ""):
@@ -82,15 +89,19 @@ class CubeSink:
             encoded = self.cube.encode_finish(arrays.started)
         else:
             encoded = self.cube.encode(i0, arrays)
-        saving = self._journaling.submit(self.journal.save, k, encoded, slab=(i0, i1),
-                                         config_sha=self.config_sha,
-                                         decoding=self.decoding)
-        previous, self._saving = self._saving, saving
+        previous, self._saving = self._saving, None
         try:
-            self.cube.write_encoded(i0, i1, encoded)
+            record = journal_record(encoded, self.cube.write_encoded(i0, i1, encoded))
+            self._saving = self._journaling.submit(self._save, k, record, (i0, i1))
         finally:
             if previous is not None:  # its error (a full disk) first, if both failed
                 previous.result()
+
+    def _save(self, k, record, slab):
+        """The cube made durable, then slab ``k``'s record journaled (the journal thread)."""
+        self.cube.sync()
+        self.journal.save(k, record, slab=slab, config_sha=self.config_sha,
+                          decoding=self.decoding)
 
     def flush(self):
         """Wait until every slab put so far is on disk in the journal (raising the error
@@ -287,6 +298,9 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
 def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, progress, log, *,
            replaces=False, command=None):
     """Restore the journaled slabs, compute the rest; finish or mark the cube incomplete."""
+    if keep and os.path.getsize(building) > 0:
+        # the interrupted run's chunks lie in it: kept (in the journal) until restored
+        renew_building(building, journal.aside_path())
     cube = CubeFile(building, coords(cfg), provenance(cfg), chunk, codec, cube_variables(cfg),
                     cfg.models, cfg.cooling_names)
     try:
@@ -298,25 +312,40 @@ def _write(cfg, out, building, journal, slabs, keep, chunk, codec, executor, pro
         raise
 
 
+def _restore(cfg, out, journal, slabs, keep, cube, progress, log) -> set:
+    """Write the journal's slabs ``keep`` into the new cube from the files that hold their
+    chunks; journal where they now lie; return the slabs restored (the others failed
+    their checks and are recomputed)."""
+    per_radius = cfg.n_designs // cfg.shape[0]
+    decoding = cube.decoding()
+    kept, moved = set(), {}
+    with ChunkSources([*journal.asides(), out]) as sources:
+        for k in sorted(keep):
+            i0, i1 = slabs[k]
+            try:
+                record = journal.load(k, slab=(i0, i1), config_sha=cfg.sha256,
+                                      decoding=decoding)
+                encoded = sources.slab(record, f"slab {k}")
+            except SlabInvalid as why:
+                log(f"journal: {why}; recomputing that slab")
+                journal.discard(k)
+                continue
+            moved[k] = journal_record(encoded, cube.write_encoded(i0, i1, encoded))
+            kept.add(k)
+            if progress is not None:
+                progress((i1 - i0) * per_radius)
+    if moved:  # the records point into the new cube once its chunks are durable
+        cube.sync()
+        for k, record in moved.items():
+            journal.save(k, record, slab=slabs[k], config_sha=cfg.sha256, decoding=decoding)
+    journal.drop_asides()
+    return kept
+
+
 def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
           replaces, command=None):
-    per_radius = cfg.n_designs // cfg.shape[0]
     cube.write(0, 0, global_arrays(cfg))
-    kept = set()
-    for k in sorted(keep):
-        i0, i1 = slabs[k]
-        try:
-            arrays = journal.load(k, slab=(i0, i1), config_sha=cfg.sha256,
-                                  decoding=cube.decoding())
-        except SlabInvalid as why:
-            log(f"journal: {why}; recomputing that slab")
-            journal.discard(k)
-            continue
-        cube.write_encoded(i0, i1, arrays)
-        kept.add(k)
-        if progress is not None:
-            progress((i1 - i0) * per_radius)
-    keep = kept
+    keep = _restore(cfg, out, journal, slabs, keep, cube, progress, log)
     todo = [k for k in range(len(slabs)) if k not in keep]
     sink = CubeSink(cube, journal, cfg.sha256)
     try:
