@@ -24,16 +24,7 @@ def kernel_seconds(cfg) -> tuple[float, float]:
     1.39 times slower than the sweep's own kernel time (issue 49), and every sweep / kernel
     ratio read too good by that much.
     """
-    from nylonflex.engine.grid import ArrayPool, compute_slab, plan_slabs
-
-    slabs, _ = plan_slabs(cfg)
-    pool = ArrayPool()
-    # compile or load the kernel, and fill the pool with one slab's arrays: not counted
-    pool.give_back(compute_slab(cfg, *slabs[0], pool=pool))
-    t0, c0 = time.perf_counter(), time.process_time()
-    for i0, i1 in slabs:
-        pool.give_back(compute_slab(cfg, i0, i1, pool=pool))
-    return time.process_time() - c0, time.perf_counter() - t0
+    return _pooled_seconds(cfg)
 
 
 def kernel_encode_seconds(cfg, folder) -> tuple[float, float]:
@@ -41,33 +32,45 @@ def kernel_encode_seconds(cfg, folder) -> tuple[float, float]:
     ``cfg``'s whole grid: what a local sweep cannot do without (issue 49, S2).
 
     Each slab is computed into pooled arrays as :func:`kernel_seconds` does, then shuffled
-    and compressed chunk by chunk into what the sweep stores and journals
+    and compressed chunk by chunk into what the sweep stores
     (:meth:`~nylonflex.storage.cube.CubeFile.encode`, its thread pool included), with
     nothing written to the cube (a scratch file in ``folder``, dropped) or the journal.
     """
     from pathlib import Path
 
-    from nylonflex.engine.grid import (ArrayPool, compute_slab, coords, cube_variables,
-                                       plan_slabs)
+    from nylonflex.engine.grid import coords, cube_variables, plan_slabs
     from nylonflex.engine.provenance import provenance
     from nylonflex.storage.cube import CubeFile
 
-    slabs, chunk = plan_slabs(cfg)
+    _, chunk = plan_slabs(cfg)
     cube = CubeFile(Path(folder) / "encode-only.h5", coords(cfg), provenance(cfg), chunk,
                     cfg.compression, cube_variables(cfg), cfg.models, cfg.cooling_names)
-    pool = ArrayPool()
     try:
-        arrays = compute_slab(cfg, *slabs[0], pool=pool)  # compile or load: not counted
-        cube.encode(slabs[0][0], arrays)
-        pool.give_back(arrays)
-        t0, c0 = time.perf_counter(), time.process_time()
-        for i0, i1 in slabs:
-            arrays = compute_slab(cfg, i0, i1, pool=pool)
-            cube.encode(i0, arrays)
-            pool.give_back(arrays)
-        return time.process_time() - c0, time.perf_counter() - t0
+        return _pooled_seconds(cfg, cube.encode)
     finally:
         cube.abandon()
+
+
+def _pooled_seconds(cfg, then=None) -> tuple[float, float]:
+    """CPU [s] and wall [s] seconds of every slab of ``cfg`` computed into pooled arrays,
+    each followed by ``then(i0, arrays)`` when given; the first slab, which compiles or
+    loads the kernel and fills the pool, is run once before and not counted."""
+    from nylonflex.engine.grid import ArrayPool, compute_slab, plan_slabs
+
+    slabs, _ = plan_slabs(cfg)
+    pool = ArrayPool()
+
+    def one(i0, i1):
+        arrays = compute_slab(cfg, i0, i1, pool=pool)
+        if then is not None:
+            then(i0, arrays)
+        pool.give_back(arrays)
+
+    one(*slabs[0])
+    t0, c0 = time.perf_counter(), time.process_time()
+    for i0, i1 in slabs:
+        one(i0, i1)
+    return time.process_time() - c0, time.perf_counter() - t0
 
 
 def main(argv) -> int:

@@ -36,7 +36,7 @@ KINDS = {
 #: What the checker reports that the cube keeps, and why: nothing. (Before cube format 3,
 #: s. 5.1 asked the dimension *named* ``pressure`` for standard_name air_pressure, which
 #: the chamber's gauge pressure is not; the curves now lie over ``pressure_point`` with
-#: ``pressure`` their auxiliary coordinate: storage.cube.STORED_DIMS.)
+#: ``pressure`` their auxiliary coordinate: storage.netcdf4.STORED_DIMS.)
 KNOWN: dict = {}
 
 

@@ -31,7 +31,7 @@ __all__ = ["CUBE_FORMAT", "CubeSettings", "RECORD_HOST_ENV", "VOLATILE_ATTRS", "
 
 #: Value of the ``nylonflex_cube`` attribute that marks a file as a cube of this format:
 #: "3" stores the pressure curves over the dimension ``pressure_point``, with ``pressure``
-#: their auxiliary coordinate (``storage.cube.STORED_DIMS``: CF-clean), "2" over
+#: their auxiliary coordinate (``storage.netcdf4.STORED_DIMS``: CF-clean), "2" over
 #: ``pressure``; both store the settings as typed attributes (:func:`settings_attrs`), "1"
 #: (before issue 28) only as YAML text, which :func:`cube_settings` still reads.
 CUBE_FORMAT = "3"

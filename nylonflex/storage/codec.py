@@ -20,8 +20,8 @@ crc32 = isal_zlib.crc32 if isal_zlib is not None else zlib.crc32
 
 __all__ = ["CODECS", "COMPILED_SHUFFLE_BYTES", "DEFAULT_CODEC", "ChunkPlan", "Codec",
            "EncodedSlab", "MissingPlugin", "SlabEncoder", "aligned", "chunk_shape",
-           "compiled_shuffle", "crc32", "decode_chunk", "encode_chunk", "load_filter_plugins",
-           "read_box", "require_filters"]
+           "compiled_shuffle", "crc32", "decode_chunk", "deflate_only", "encode_chunk",
+           "load_filter_plugins", "read_box", "require_filters"]
 
 
 @dataclass(frozen=True)
@@ -329,15 +329,17 @@ def decode_chunk(raw: bytes, chunks, dtype, shuffle: bool, out=None) -> np.ndarr
     return out
 
 
-def read_box(dset, key) -> np.ndarray:
+def read_box(dset, key, deflate: bool | None = None) -> np.ndarray:
     """``dset[key]`` (an h5py dataset of a cube, ``key`` a tuple of an int or a slice of
     step 1 per dimension), its chunks inflated here (:func:`decode_chunk`) when they are
     deflate with or without the shuffle and nothing else, as nylonflex writes the default
     codec: h5py would inflate them with zlib, about half the speed; anything else (another
     codec, a chunk not written, a chunk whose filters were skipped, a chunk that does not
-    inflate, whose read then raises HDF5's OSError naming it) is h5py's read."""
+    inflate, whose read then raises HDF5's OSError naming it) is h5py's read.
+    ``deflate``: :func:`deflate_only` of ``dset``, when the caller knows it (it reads the
+    dataset's creation properties, about 50 us)."""
     box = _box(dset, key)
-    if box is None or not _deflate_only(dset):
+    if box is None or not (deflate_only(dset) if deflate is None else deflate):
         return dset[key]
     starts, stops = box
     chunks = dset.chunks
@@ -391,7 +393,7 @@ def _box(dset, key):
     return starts, stops
 
 
-def _deflate_only(dset) -> bool:
+def deflate_only(dset) -> bool:
     """Whether ``dset``'s filter pipeline is deflate, after the shuffle or alone."""
     import h5py
 

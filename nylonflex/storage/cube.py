@@ -15,25 +15,9 @@ import numpy as np
 from ..variables import COOLING, COORDS, CURVES, DESIGN, MODEL, slab_done_attrs
 from .codec import (CODECS, DEFAULT_CODEC, ZSTD_EXTRA, ChunkPlan, SlabEncoder, aligned,
                     chunk_shape, compiled_shuffle, load_filter_plugins)
-from .netcdf4 import NetCDF4File
+from .netcdf4 import STORED_DIMS, NetCDF4File, stored_dims
 
-__all__ = ["STORED_DIMS", "CubeFile", "stored_dims"]
-
-#: Axes a cube stores as an auxiliary coordinate over a dimension of another name (cube
-#: format 3): {axis: its dimension in the file}. compliance-checker (cf:1.8, s. 5.1) asks a
-#: dimension *named* ``pressure`` for ``standard_name = air_pressure``, which the chamber's
-#: gauge pressure is not (CF's air_pressure is the absolute pressure of the air). So the
-#: curves ``bend_angle`` and ``tip_force`` lie over ``pressure_point`` in the file, with
-#: ``coordinates = "pressure"``: every reader still finds the variable ``pressure`` [Pa],
-#: and :func:`nylonflex.open_cube` makes it the dimension again (``ds.sel(pressure=...)``).
-STORED_DIMS = {"pressure": "pressure_point"}
-
-
-def stored_dims(dims) -> tuple:
-    """A variable's dimensions as the file names them (:data:`STORED_DIMS`)."""
-    return tuple(STORED_DIMS.get(d, d) for d in dims)
-
-
+__all__ = ["CubeFile"]
 
 @dataclass(frozen=True)
 class _Layout:

@@ -14,9 +14,8 @@ except ImportError:  # pragma: no cover - isal is a dependency
     isal_zlib = None
 
 from ..variables import AXES, SPREAD_OF, VARIABLES, is_complete, to_display
-from .codec import require_filters
-from .cube import STORED_DIMS
-from .netcdf4 import read_layout
+from .codec import deflate_only, require_filters
+from .netcdf4 import STORED_DIMS, read_layout
 from .reader import _attr, check_chunk_sizes, checked_attrs, cube_attrs
 
 __all__ = ["check_cube", "cube_description", "cube_summary", "flag_histogram",
@@ -139,7 +138,7 @@ def _unreadable(f, path, full, progress=None) -> list[str]:
 
 def _check_dataset(path, name, dset, full):
     """Lines for the chunks of ``dset`` that cannot be read."""
-    if not full and _deflated(dset):
+    if not full and dset.chunks is not None and deflate_only(dset):
         return _check_first_stored_chunk(path, name, dset)
     if dset.chunks is None:  # contiguous (small): read in blocks of the first axis
         step = max(1, (1 << 24) // max(1, dset.dtype.itemsize * (dset.size // dset.shape[0])))
@@ -159,19 +158,6 @@ def _check_dataset(path, name, dset, full):
         if not full:
             break
     return out
-
-
-def _deflated(dset) -> bool:
-    """Whether ``dset`` is chunked with deflate alone, or the shuffle then deflate (the
-    cube's default codec): its stored chunks are then checked by inflating their bytes."""
-    import h5py
-
-    if dset.chunks is None:
-        return False
-    plist = dset.id.get_create_plist()
-    found = [plist.get_filter(k)[0] for k in range(plist.get_nfilters())]
-    return found in ([h5py.h5z.FILTER_DEFLATE],
-                     [h5py.h5z.FILTER_SHUFFLE, h5py.h5z.FILTER_DEFLATE])
 
 
 def _check_first_stored_chunk(path, name, dset) -> list[str]:

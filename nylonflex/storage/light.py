@@ -23,9 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from ..variables import CATEGORIES, is_complete
-from .codec import read_box
-from .cube import STORED_DIMS
-from .netcdf4 import HIDDEN_ATTRS, read_layout
+from .codec import deflate_only, read_box
+from .netcdf4 import HIDDEN_ATTRS, STORED_DIMS, read_layout
 from .reader import MASKED, _attr, checked_attrs, incomplete_warning, validated
 
 __all__ = ["LightCube", "LightVariable", "open_light"]
@@ -107,6 +106,7 @@ class LightCube:
             dtype = _as_float(dset.dtype) if _has_fill(var_attrs) else dset.dtype
             self.variables[name] = LightVariable(self, name, dims, dtype, var_attrs)
         self.dims = tuple(self.sizes)
+        self._datasets: dict = {}
         self.plain = not any(c in self.sizes for c in CATEGORIES) and \
             not any(_coded(v.attrs) for v in self.variables.values())
 
@@ -137,7 +137,8 @@ class LightCube:
         var, index = self.variables[name], index or {}
         key = tuple(index.get(d, slice(None)) for d in var.dims)
         kept = [d for d, k in zip(var.dims, key) if isinstance(k, slice)]
-        x = np.asarray(read_box(self._f[name], key), dtype=np.float64)
+        dset, deflate = self._dataset(name)
+        x = np.asarray(read_box(dset, key, deflate), dtype=np.float64)
         for fill in var.fills:
             x[x == fill] = np.nan
         if self.done is not None and name in MASKED and "radius" in var.dims:
@@ -147,6 +148,15 @@ class LightCube:
             elif skip:
                 x[...] = np.nan
         return x if dims is None else x.transpose([kept.index(d) for d in dims])
+
+    def _dataset(self, name: str):
+        """Variable ``name``'s h5py dataset and whether its chunks are deflate alone
+        (:func:`~nylonflex.storage.codec.deflate_only`), looked up once per variable."""
+        found = self._datasets.get(name)
+        if found is None:
+            dset = self._f[name]
+            found = self._datasets[name] = (dset, deflate_only(dset))
+        return found
 
     def mask(self, done):
         """Read the radii not ``done`` (bool over ``radius``) as NaN in every variable of

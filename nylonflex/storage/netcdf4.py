@@ -30,7 +30,23 @@ import numpy as np
 
 from .. import __version__
 
-__all__ = ["HIDDEN_ATTRS", "NOT_A_VARIABLE", "NetCDF4File", "read_layout"]
+__all__ = ["HIDDEN_ATTRS", "NOT_A_VARIABLE", "STORED_DIMS", "NetCDF4File", "read_layout",
+           "stored_dims"]
+
+#: Axes a cube stores as an auxiliary coordinate over a dimension of another name (cube
+#: format 3): {axis: its dimension in the file}. compliance-checker (cf:1.8, s. 5.1) asks a
+#: dimension *named* ``pressure`` for ``standard_name = air_pressure``, which the chamber's
+#: gauge pressure is not (CF's air_pressure is the absolute pressure of the air). So the
+#: curves ``bend_angle`` and ``tip_force`` lie over ``pressure_point`` in the file, with
+#: ``coordinates = "pressure"``: every reader still finds the variable ``pressure`` [Pa],
+#: and :func:`nylonflex.open_cube` makes it the dimension again (``ds.sel(pressure=...)``).
+STORED_DIMS = {"pressure": "pressure_point"}
+
+
+def stored_dims(dims) -> tuple:
+    """A variable's dimensions as the file names them (:data:`STORED_DIMS`)."""
+    return tuple(STORED_DIMS.get(d, d) for d in dims)
+
 
 #: Attributes the netCDF-4 layout itself uses; a variable's own attributes may not.
 HIDDEN_ATTRS = frozenset(("REFERENCE_LIST", "CLASS", "DIMENSION_LIST", "NAME",

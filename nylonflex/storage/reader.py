@@ -11,8 +11,7 @@ import numpy as np
 from ..units import InputError
 from ..variables import AXES, CURVES, DESIGN, SPREAD, UNCERTAIN, is_complete, validate
 from .codec import require_filters
-from .cube import STORED_DIMS
-from .journal import Journal
+from .netcdf4 import STORED_DIMS
 
 __all__ = ["MASKED", "MAX_CHUNK_BYTES", "MAX_AXIS_VALUES", "check_chunk_sizes",
            "checked_attrs", "cube_attrs", "incomplete_warning", "logical_dims", "open_cube",
@@ -88,6 +87,8 @@ def checked_attrs(path) -> dict:
     """
     path = Path(path)
     if not path.exists():
+        from .journal import Journal  # only here: its imports (zipfile, hashlib) are not light
+
         parts = Journal(path)
         extra = (f"; an interrupted run's slabs are in {parts.dir} (finish it with "
                  "'nylonflex sweep CONFIG --resume')") if parts.exists() else ""
