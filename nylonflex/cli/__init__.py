@@ -60,12 +60,14 @@ def _module(name):
     return importlib.import_module(f".{COMMANDS[name]}", __name__)
 
 
-def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+def build_parser(command: str | None = None, alone: bool = False) -> argparse.ArgumentParser:
     """The parser of every ``nylonflex`` command (docs/interface.md).
 
     ``command``: only that command's arguments are added (the others are listed by name
     and help line only, which is all ``--help`` and ``--version`` need), so a command
-    imports nothing it does not use; None adds every command's arguments.
+    imports nothing it does not use; None adds every command's arguments. ``alone``: the
+    other commands are left out altogether (their modules not imported, their parsers not
+    made: 25-30 ms of every command), for a command line that names ``command`` first.
     """
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--debug", action="store_true", help="show tracebacks on errors")
@@ -73,7 +75,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                 description="Design-space sweeps of nylon-muscle soft bending actuators.")
     p.add_argument("--version", action="version", version=f"nylonflex {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for name in COMMANDS:
+    for name in COMMANDS if not (alone and command) else (command,):
         mod = _module(name)
         sp = sub.add_parser(name, parents=[common], help=mod.HELP,
                             description=getattr(mod, "DESCRIPTION", mod.HELP),
@@ -86,6 +88,12 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 def _command(argv) -> str:
     """The command named in ``argv`` ("" when there is none: ``--help``, ``--version``)."""
     return next((a for a in argv if a in COMMANDS), "")
+
+
+def _named_first(argv, command: str) -> bool:
+    """Whether ``command`` is the first argument of ``argv`` that is not an option (so
+    that a parser of that command alone reads ``argv`` as the whole parser would)."""
+    return bool(command) and next((a for a in argv if not a.startswith("-")), "") == command
 
 
 def _join_negative_values(argv):
@@ -229,7 +237,8 @@ def _lighten_process():
 
 def _main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    parser = build_parser(_command(argv))
+    command = _command(argv)
+    parser = build_parser(command, alone=_named_first(argv, command))
     args = parser.parse_args(_join_negative_values(argv))
     if args.command is None:
         parser.print_help()
