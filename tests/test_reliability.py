@@ -1079,6 +1079,23 @@ def test_a_slab_temporary_link_is_refused_on_resume(tmp_path, capsys):
     assert victim.read_text() == "precious"
 
 
+def test_a_link_planted_as_an_aside_is_refused_on_resume(tmp_path, capsys):
+    # journal format 5 reads chunks back from <out>.parts/aside-NNNNNN.h5: a link planted
+    # there (to a file of the same chunks, or any other) is refused before anything is read
+    # or moved, with one line naming it
+    out = tmp_path / "cube.h5"
+    interrupted(out, k=2)
+    victim = tmp_path / "victim.h5"
+    victim.write_bytes(b"precious")
+    aside = Journal(out).dir / "aside-000007.h5"
+    aside.symlink_to(victim)
+    cfg = write_config(tmp_path, MULTI)
+    assert sweep(cfg, out, "--resume") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "symbolic link" in err and str(aside) in err, err
+    assert victim.read_bytes() == b"precious" and aside.is_symlink()
+
+
 def test_a_link_at_the_output_itself_is_refused(tmp_path, small_cfg, capsys):
     raw, cfg = small_cfg
     victim = tmp_path / "victim.h5"

@@ -19,6 +19,7 @@ from .netcdf4 import STORED_DIMS, NetCDF4File, stored_dims
 
 __all__ = ["CubeFile"]
 
+
 @dataclass(frozen=True)
 class _Layout:
     """A cube variable's HDF5 dataset, its dimension names, chunk shape, shape and dtype."""

@@ -287,7 +287,8 @@ def sweep_to_file(cfg: ResolvedConfig, out, *, resume=False, workers=None, sched
             if not _disk_full(exc):
                 raise
             raise DiskFull(f"the disk of {out.parent} is full; this run needs up to "
-                           f"{_needed_gigabytes(cfg):.3g} GB (cube and journal, before "
+                           f"{_needed_gigabytes(cfg):.3g} GB (the cube, and during a "
+                           "resume the interrupted run's file beside it, before "
                            f"compression); the finished slabs are kept in {journal.dir}: "
                            "free some space and run again with --resume") from None
         finally:
