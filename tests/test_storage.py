@@ -98,7 +98,8 @@ def test_a_chunk_decodes_to_what_was_encoded(dtype, codec):
     # decode_chunk is encode_chunk's inverse (gzip: deflate of shuffled bytes; a partial
     # block comes back padded with zeros to the chunk's shape), into a new array or a
     # given one
-    from nylonflex.storage.codec import CODECS, decode_chunk, encode_chunk
+    from nylonflex.storage.codec import CODECS, encode_chunk
+    from nylonflex.storage.decode import decode_chunk
 
     rng = np.random.default_rng(3)
     block = (rng.normal(size=(2, 5, 7)) * 100).astype(dtype)
@@ -123,7 +124,7 @@ def test_a_box_read_by_the_chunks_is_h5pys_read(tmp_path):
     # an incomplete cube's unwritten chunks, are h5py's own read
     import nylonflex as nf
     from nylonflex.config import parse_config
-    from nylonflex.storage.codec import read_box
+    from nylonflex.storage.decode import read_box
 
     raw = _reference_raw()
     raw["grid"]["radius"] = {"start": 5, "stop": 25, "num": 13, "units": "mm"}

@@ -1,6 +1,7 @@
 """The design cube on disk: netCDF-4/HDF5 written through h5py, read with xarray.
 
-- :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once;
+- :mod:`.cube`: the cube file, written slab by slab with its chunks compressed once
+  (:mod:`.codec`; read back by :mod:`.decode`);
 - :mod:`.netcdf4`: the netCDF-4 layout (dimensions, coordinates, attributes) in h5py;
 - :mod:`.journal`: the journal of finished slabs;
 - :mod:`.locks`: the one-writer lock on a cube being written;

@@ -14,7 +14,8 @@ except ImportError:  # pragma: no cover - isal is a dependency
     isal_zlib = None
 
 from ..variables import AXES, SPREAD_OF, VARIABLES, is_complete, to_display
-from .codec import deflate_only, require_filters
+from .codec import require_filters
+from .decode import deflate_only
 from .netcdf4 import STORED_DIMS, read_layout
 from .reader import _attr, check_chunk_sizes, checked_attrs, cube_attrs
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..variables import CATEGORIES, is_complete
-from .codec import deflate_only, read_box
+from .decode import deflate_only, read_box
 from .netcdf4 import HIDDEN_ATTRS, STORED_DIMS, read_layout
 from .reader import MASKED, _attr, checked_attrs, incomplete_warning, validated
 
@@ -151,7 +151,7 @@ class LightCube:
 
     def _dataset(self, name: str):
         """Variable ``name``'s h5py dataset and whether its chunks are deflate alone
-        (:func:`~nylonflex.storage.codec.deflate_only`), looked up once per variable."""
+        (:func:`~nylonflex.storage.decode.deflate_only`), looked up once per variable."""
         found = self._datasets.get(name)
         if found is None:
             dset = self._f[name]
