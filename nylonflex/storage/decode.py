@@ -13,7 +13,11 @@ try:
 except ImportError:  # pragma: no cover - isal is a dependency
     isal_zlib = None
 
-__all__ = ["decode_chunk", "deflate_only", "read_box"]
+__all__ = ["decode_chunk", "deflate_only", "inflate", "read_box"]
+
+#: A zlib stream (RFC 1950) inflated: ISA-L's, about twice zlib's speed (what HDF5's
+#: deflate filter uses), to the same bytes; else the standard library's.
+inflate = isal_zlib.decompress if isal_zlib is not None else zlib.decompress
 
 
 def decode_chunk(raw: bytes, chunks, dtype, shuffle: bool, out=None) -> np.ndarray:
@@ -23,7 +27,7 @@ def decode_chunk(raw: bytes, chunks, dtype, shuffle: bool, out=None) -> np.ndarr
     C-contiguous array of that shape and dtype). Inflated by ISA-L where installed, about
     twice zlib's speed (what HDF5's deflate filter uses), to the same bytes."""
     dtype = np.dtype(dtype)
-    data = np.frombuffer((isal_zlib or zlib).decompress(raw), dtype=np.uint8)
+    data = np.frombuffer(inflate(raw), dtype=np.uint8)
     if out is None:
         out = np.empty(chunks, dtype=dtype)
     flat = out.reshape(-1).view(np.uint8)

@@ -3,19 +3,13 @@ provenance, completeness) and the check of its chunks, read through h5py alone."
 
 from __future__ import annotations
 
-import zlib
 from pathlib import Path
 
 import numpy as np
 
-try:
-    from isal import isal_zlib
-except ImportError:  # pragma: no cover - isal is a dependency
-    isal_zlib = None
-
 from ..variables import AXES, SPREAD_OF, VARIABLES, is_complete, to_display
 from .codec import require_filters
-from .decode import deflate_only
+from .decode import deflate_only, inflate
 from .netcdf4 import STORED_DIMS, read_layout
 from .reader import _attr, check_chunk_sizes, checked_attrs, cube_attrs
 
@@ -175,7 +169,7 @@ def _check_first_stored_chunk(path, name, dset) -> list[str]:
         mask, raw = dset.id.read_direct_chunk(info.chunk_offset)
         if mask:  # a filter skipped for this chunk: let HDF5 decode it
             dset[tuple(slice(o, o + c) for o, c in zip(info.chunk_offset, dset.chunks))]
-        elif len(_inflate(raw)) != nbytes:
+        elif len(inflate(raw)) != nbytes:
             raise ValueError(f"inflates to the wrong size (expected {nbytes} bytes)")
     except Exception as exc:  # noqa: BLE001 - any decoder's error is a damaged chunk
         where = ", ".join(f"{o}:{min(o + c, n)}" for o, c, n in
@@ -184,13 +178,6 @@ def _check_first_stored_chunk(path, name, dset) -> list[str]:
         return [f"{path}: variable {name} [{where}] cannot be read ({reason}); "
                 "the cube is damaged: sweep it again with --overwrite"]
     return []
-
-
-def _inflate(raw: bytes) -> bytes:
-    """A zlib stream (RFC 1950) inflated: ISA-L's, else the standard library's."""
-    if isal_zlib is None:  # pragma: no cover - isal is a dependency
-        return zlib.decompress(raw)
-    return isal_zlib.decompress(raw)
 
 
 def _spread_lines(variants) -> list[str]:
