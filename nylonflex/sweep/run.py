@@ -319,7 +319,7 @@ def _restore(cfg, out, journal, slabs, keep, cube, progress, log) -> set:
     their checks and are recomputed)."""
     per_radius = cfg.n_designs // cfg.shape[0]
     decoding = cube.decoding()
-    kept, moved = set(), {}
+    moved = {}  # slab -> its record, pointing into the new cube
     with ChunkSources([*journal.asides(), out]) as sources:
         for k in sorted(keep):
             i0, i1 = slabs[k]
@@ -332,7 +332,6 @@ def _restore(cfg, out, journal, slabs, keep, cube, progress, log) -> set:
                 journal.discard(k)
                 continue
             moved[k] = journal_record(encoded, cube.write_encoded(i0, i1, encoded))
-            kept.add(k)
             if progress is not None:
                 progress((i1 - i0) * per_radius)
     if moved:  # the records point into the new cube once its chunks are durable
@@ -340,7 +339,7 @@ def _restore(cfg, out, journal, slabs, keep, cube, progress, log) -> set:
         for k, record in moved.items():
             journal.save(k, record, slab=slabs[k], config_sha=cfg.sha256, decoding=decoding)
     journal.drop_asides()
-    return kept
+    return set(moved)
 
 
 def _fill(cfg, out, building, journal, slabs, keep, cube, executor, progress, log,
