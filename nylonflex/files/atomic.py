@@ -26,12 +26,14 @@ from pathlib import Path
 
 from ..units import InputError
 
-__all__ = ["OwnedFiles", "create_files", "create_new", "fsync_dir", "make_folder", "publish",
+__all__ = ["NOFOLLOW", "OwnedFiles", "create_files", "create_new", "fsync_dir", "make_folder", "publish",
            "read_bounded", "read_json", "refuse_link", "refuse_special", "replacing",
            "save_figure", "write_atomic"]
 
+#: ``os.O_NOFOLLOW`` where the platform has it (0 elsewhere): open never through a link.
+NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 #: The flags of a file nylonflex creates: a new file, never through a link at its path.
-NEW_FILE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | \
+NEW_FILE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | NOFOLLOW | \
     getattr(os, "O_CLOEXEC", 0)
 
 
@@ -47,7 +49,7 @@ def fsync_dir(path):
 
 def publish(tmp: Path, final: Path):
     """Rename ``tmp`` onto ``final`` durably: fsync the file, rename, fsync the folder."""
-    fd = os.open(tmp, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    fd = os.open(tmp, os.O_RDONLY | NOFOLLOW)
     try:
         os.fsync(fd)
     finally:
@@ -246,7 +248,7 @@ def create_files(contents: dict, what: str) -> list[Path]:
 
 #: How a file nylonflex reads back is opened: never through a link, never waiting for a
 #: writer (a fifo opened for reading blocks until one comes: forever).
-READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0) | \
+READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | \
     getattr(os, "O_CLOEXEC", 0)
 
 
@@ -339,7 +341,7 @@ def write_atomic(path, data: bytes, what: str = "--out", inputs=()) -> Path:
     (:func:`replacing`); returns ``path``."""
     path = Path(path)
     with replacing(path, what, inputs) as tmp:
-        fd = os.open(tmp, os.O_WRONLY | getattr(os, "O_NOFOLLOW", 0))
+        fd = os.open(tmp, os.O_WRONLY | NOFOLLOW)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
     return path

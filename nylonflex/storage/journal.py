@@ -42,7 +42,8 @@ import numpy as np
 import stat
 
 from ..units import InputError
-from ..files.atomic import create_new, fsync_dir, publish, refuse_link, refuse_special
+from ..files.atomic import NOFOLLOW, create_new, fsync_dir, publish, refuse_link, \
+    refuse_special
 
 __all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "file_locks", "fsync_dir", "publish",
            "refuse_special"]
@@ -53,7 +54,6 @@ __all__ = ["JOURNAL_FORMAT", "Journal", "SlabInvalid", "file_locks", "fsync_dir"
 #: 5: a slab's file records where its compressed chunks lie in the cube (addresses, sizes,
 #: CRC-32s), not their bytes.
 JOURNAL_FORMAT = 5
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _MANIFEST_KEYS = ("format", "name", "config_sha256", "slabs", "radius_chunk",
                   "nylonflex_version", "model_digest", "replaces")
 
@@ -99,7 +99,7 @@ class Journal:
     def read_manifest(self) -> dict:
         """The manifest's content; {} when it cannot be read or is not a JSON object."""
         try:
-            fd = os.open(self.manifest, os.O_RDONLY | _NOFOLLOW)
+            fd = os.open(self.manifest, os.O_RDONLY | NOFOLLOW)
             with os.fdopen(fd, "rb") as fh:
                 data = json.loads(fh.read(10_000_000).decode("utf-8"))
         except (OSError, ValueError):
@@ -181,7 +181,7 @@ class Journal:
         match or cannot be read."""
         path = self._slab_path(k)
         try:
-            fd = os.open(path, os.O_RDONLY | _NOFOLLOW)
+            fd = os.open(path, os.O_RDONLY | NOFOLLOW)
             with os.fdopen(fd, "rb") as fh, zipfile.ZipFile(fh) as zf:
                 arrays, crcs = {}, {}
                 for info in zf.infolist():

@@ -17,14 +17,13 @@ import contextlib
 import os
 from pathlib import Path
 
-from ..files.atomic import create_new, fsync_dir, refuse_link, refuse_special
+from ..files.atomic import NOFOLLOW, create_new, fsync_dir, refuse_link, refuse_special
 from ..units import InputError
 from .journal import Journal, file_locks, regular
 
 __all__ = ["building_is_ours", "building_path", "check_building", "exclusive",
            "renew_building", "share_building"]
 
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _LOCK_TEXT = b"nylonflex sweep lock\n"
 
 
@@ -39,7 +38,7 @@ def _lock_file(lock: Path):
 
     refuse_special(lock, "--out")
     if regular(lock):
-        with os.fdopen(os.open(lock, os.O_RDONLY | _NOFOLLOW), "rb") as fh:
+        with os.fdopen(os.open(lock, os.O_RDONLY | NOFOLLOW), "rb") as fh:
             head = fh.read(64)
         if head and not head.startswith(_LOCK_TEXT.strip()):
             raise InputError(f"{lock} exists and is not a nylonflex lock; it is not "
@@ -66,7 +65,7 @@ def _open_side(path: Path) -> int:
     """An fd of the side file ``path`` for reading and writing, made if missing, never
     truncated and never through a link (one placed there meanwhile is refused)."""
     try:
-        return os.open(path, os.O_RDWR | os.O_CREAT | _NOFOLLOW, 0o644)
+        return os.open(path, os.O_RDWR | os.O_CREAT | NOFOLLOW, 0o644)
     except OSError as exc:
         if os.path.islink(path):
             refuse_link(path, "--out")

@@ -15,12 +15,12 @@ import os
 
 import numpy as np
 
+from ..files.atomic import NOFOLLOW
 from .codec import crc32
 from .journal import SlabInvalid
 
 __all__ = ["ChunkSources", "journal_record"]
 
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 
 
 def journal_record(encoded: dict, addresses: dict) -> dict:
@@ -43,7 +43,7 @@ class ChunkSources:
         self._fds = []
         for path in paths:
             with contextlib.suppress(OSError):
-                self._fds.append(os.open(path, os.O_RDONLY | _NOFOLLOW))
+                self._fds.append(os.open(path, os.O_RDONLY | NOFOLLOW))
 
     def slab(self, record: dict, name: str = "slab") -> dict:
         """``record`` with each compressed variable's ``NAME:bytes`` read back from the
